@@ -1,0 +1,245 @@
+//! The pinhole camera of the course report (sections 2.1 and 2.2).
+
+use glam::{UVec2, Vec3};
+
+/// A ray leaving the camera: origin at the pinhole, unit-length direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraRay {
+    pub origin: Vec3,
+    pub direction: Vec3,
+}
+
+/// Why a camera could not be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CameraError {
+    #[error("the vertical field of view must lie strictly between 0 and 180 degrees, got {0}")]
+    FieldOfView(f32),
+    #[error("the focal length must be positive, got {0}")]
+    FocalLength(f32),
+    #[error("the film resolution must be at least 1x1, got {0}x{1}")]
+    Resolution(u32, u32),
+    #[error("the camera position and the look-at point coincide")]
+    NoForward,
+    #[error("the reference up vector is zero or parallel to the viewing direction")]
+    UpParallelToForward,
+}
+
+/// A pinhole camera with an orthonormal basis and a film plane at `focal_length`.
+///
+/// With `forward = normalize(look_at − position)`, `right = normalize(forward × up_ref)`
+/// and `up = right × forward`, the film spans `±half_width · right` and
+/// `±half_height · up` around `position + focal_length · forward`, where
+/// `half_height = focal_length · tan(fov_y / 2)` and `half_width = aspect · half_height`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    position: Vec3,
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    focal_length: f32,
+    fov_y: f32,
+    half_width: f32,
+    half_height: f32,
+    resolution: UVec2,
+}
+
+impl Camera {
+    /// Builds a camera looking from `position` towards `look_at`.
+    ///
+    /// `fov_y_degrees` is the vertical field of view in degrees, in the open
+    /// interval (0, 180). `resolution` is the film size in pixels (width, height);
+    /// any aspect ratio is allowed.
+    pub fn new(
+        position: Vec3,
+        look_at: Vec3,
+        up_ref: Vec3,
+        fov_y_degrees: f32,
+        focal_length: f32,
+        resolution: UVec2,
+    ) -> Result<Self, CameraError> {
+        if !(fov_y_degrees > 0.0 && fov_y_degrees < 180.0) {
+            return Err(CameraError::FieldOfView(fov_y_degrees));
+        }
+        if !(focal_length > 0.0 && focal_length.is_finite()) {
+            return Err(CameraError::FocalLength(focal_length));
+        }
+        if resolution.x == 0 || resolution.y == 0 {
+            return Err(CameraError::Resolution(resolution.x, resolution.y));
+        }
+        let forward = (look_at - position)
+            .try_normalize()
+            .ok_or(CameraError::NoForward)?;
+        let right = forward
+            .cross(up_ref)
+            .try_normalize()
+            .filter(|r| r.cross(forward).length() > 1e-6)
+            .ok_or(CameraError::UpParallelToForward)?;
+        let up = right.cross(forward);
+        let fov_y = fov_y_degrees.to_radians();
+        let half_height = focal_length * (0.5 * fov_y).tan();
+        let aspect = resolution.x as f32 / resolution.y as f32;
+        Ok(Self {
+            position,
+            forward,
+            right,
+            up,
+            focal_length,
+            fov_y,
+            half_width: aspect * half_height,
+            half_height,
+            resolution,
+        })
+    }
+
+    /// The ray through continuous raster position `(x, y)`.
+    ///
+    /// Raster → NDC: `(x / width, y / height)` in [0,1]², then to [−1,1]² with y
+    /// flipped so that raster-down is world-down. The film point is
+    /// `position + f·forward + ndc.x·half_width·right + ndc.y·half_height·up`.
+    pub fn generate_ray(&self, x: f32, y: f32) -> CameraRay {
+        let ndc_x = 2.0 * x / self.resolution.x as f32 - 1.0;
+        let ndc_y = 1.0 - 2.0 * y / self.resolution.y as f32;
+        let on_film = self.focal_length * self.forward
+            + (ndc_x * self.half_width) * self.right
+            + (ndc_y * self.half_height) * self.up;
+        CameraRay {
+            origin: self.position,
+            direction: on_film.normalize(),
+        }
+    }
+
+    pub fn position(&self) -> Vec3 {
+        self.position
+    }
+    pub fn forward(&self) -> Vec3 {
+        self.forward
+    }
+    pub fn right(&self) -> Vec3 {
+        self.right
+    }
+    pub fn up(&self) -> Vec3 {
+        self.up
+    }
+    pub fn focal_length(&self) -> f32 {
+        self.focal_length
+    }
+    /// The vertical field of view in radians.
+    pub fn fov_y(&self) -> f32 {
+        self.fov_y
+    }
+    /// Film half extents in world units at the focal distance: (width, height).
+    pub fn film_half_extent(&self) -> (f32, f32) {
+        (self.half_width, self.half_height)
+    }
+    /// Film resolution in pixels (width, height).
+    pub fn resolution(&self) -> UVec2 {
+        self.resolution
+    }
+
+    /// The same camera with a different film resolution (aspect ratio follows).
+    pub fn with_resolution(&self, resolution: UVec2) -> Result<Self, CameraError> {
+        let look_at = self.position + self.forward;
+        Self::new(
+            self.position,
+            look_at,
+            self.up,
+            self.fov_y.to_degrees(),
+            self.focal_length,
+            resolution,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glint_snapfmt::vec3 as v3;
+    use std::fmt::Write;
+
+    fn course_set2(res: UVec2) -> Camera {
+        Camera::new(
+            Vec3::new(5.0, 3.0, 12.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            45.0,
+            1.0,
+            res,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn basis_and_corner_rays_of_a_4x3_film() {
+        let cam = course_set2(UVec2::new(4, 3));
+        let mut s = String::new();
+        writeln!(s, "forward {}", v3(cam.forward())).unwrap();
+        writeln!(s, "right   {}", v3(cam.right())).unwrap();
+        writeln!(s, "up      {}", v3(cam.up())).unwrap();
+        for (name, x, y) in [
+            ("top-left", 0.0, 0.0),
+            ("top-right", 4.0, 0.0),
+            ("bottom-left", 0.0, 3.0),
+            ("bottom-right", 4.0, 3.0),
+            ("centre", 2.0, 1.5),
+        ] {
+            let r = cam.generate_ray(x, y);
+            writeln!(s, "{name:<12} {} -> {}", v3(r.origin), v3(r.direction)).unwrap();
+        }
+        insta::assert_snapshot!(s);
+    }
+
+    #[test]
+    fn basis_is_orthonormal_and_right_handed() {
+        let cam = course_set2(UVec2::new(640, 480));
+        for v in [cam.forward(), cam.right(), cam.up()] {
+            assert!((v.length() - 1.0).abs() < 1e-6);
+        }
+        assert!(cam.forward().dot(cam.right()).abs() < 1e-6);
+        assert!(cam.forward().dot(cam.up()).abs() < 1e-6);
+        assert!((cam.right().cross(cam.up()) + cam.forward()).length() < 1e-6);
+    }
+
+    #[test]
+    fn corner_rays_span_the_field_of_view() {
+        let cam = course_set2(UVec2::new(300, 200));
+        let top = cam.generate_ray(150.0, 0.0).direction;
+        let bottom = cam.generate_ray(150.0, 200.0).direction;
+        let angle = top.angle_between(bottom).to_degrees();
+        assert!((angle - 45.0).abs() < 1e-3, "vertical fov was {angle}");
+        let left = cam.generate_ray(0.0, 100.0).direction;
+        let right = cam.generate_ray(300.0, 100.0).direction;
+        let expected = 2.0 * (1.5 * (22.5f32).to_radians().tan()).atan().to_degrees();
+        let got = left.angle_between(right).to_degrees();
+        assert!((got - expected).abs() < 1e-3);
+        assert!(top.dot(cam.up()) > 0.0 && left.dot(cam.right()) < 0.0);
+    }
+
+    #[test]
+    fn invalid_parameters_are_rejected() {
+        let ok = |fov, f, res: UVec2, up: Vec3| {
+            Camera::new(Vec3::ZERO, -Vec3::Z, up, fov, f, res).map(|_| ())
+        };
+        let res = UVec2::new(4, 4);
+        assert_eq!(
+            ok(0.0, 1.0, res, Vec3::Y),
+            Err(CameraError::FieldOfView(0.0))
+        );
+        assert_eq!(
+            ok(180.0, 1.0, res, Vec3::Y),
+            Err(CameraError::FieldOfView(180.0))
+        );
+        assert_eq!(
+            ok(45.0, 0.0, res, Vec3::Y),
+            Err(CameraError::FocalLength(0.0))
+        );
+        assert_eq!(
+            ok(45.0, 1.0, UVec2::new(0, 4), Vec3::Y),
+            Err(CameraError::Resolution(0, 4))
+        );
+        assert_eq!(
+            ok(45.0, 1.0, res, Vec3::Z),
+            Err(CameraError::UpParallelToForward)
+        );
+        assert_eq!(ok(45.0, 1.0, res, Vec3::Y), Ok(()));
+    }
+}

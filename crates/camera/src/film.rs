@@ -1,0 +1,281 @@
+//! The film: a grid of linear RGB radiance values and the writers that turn it
+//! into PNG (8-bit sRGB), OpenEXR (32-bit float, linear) or PFM (32-bit float, linear).
+
+use glam::{UVec2, Vec3};
+use std::io::{BufWriter, Seek, Write};
+use std::path::{Path, PathBuf};
+
+/// The on-disk formats a [`Film`] can be written in, chosen by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// 8-bit sRGB: the sRGB transfer curve is applied and values are clamped to [0, 1].
+    Png,
+    /// Linear 32-bit float RGB OpenEXR.
+    Exr,
+    /// Linear 32-bit float RGB Portable Float Map (little-endian, bottom row first).
+    Pfm,
+}
+
+impl ImageFormat {
+    /// The format named by `path`'s extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<Self, FilmError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("png") => Ok(Self::Png),
+            Some("exr") => Ok(Self::Exr),
+            Some("pfm") => Ok(Self::Pfm),
+            _ => Err(FilmError::UnknownFormat(path.to_path_buf())),
+        }
+    }
+}
+
+/// Why a film could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum FilmError {
+    #[error("{}: unknown output format; expected a .png, .exr or .pfm extension", .0.display())]
+    UnknownFormat(PathBuf),
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: could not encode the image: {message}", path.display())]
+    Encode { path: PathBuf, message: String },
+}
+
+/// Linear RGB radiance per pixel, stored row by row from the top-left pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    resolution: UVec2,
+    pixels: Vec<Vec3>,
+}
+
+impl Film {
+    /// A black film of `resolution` (width, height) pixels.
+    pub fn new(resolution: UVec2) -> Self {
+        let count = resolution.x as usize * resolution.y as usize;
+        Self {
+            resolution,
+            pixels: vec![Vec3::ZERO; count],
+        }
+    }
+
+    pub fn resolution(&self) -> UVec2 {
+        self.resolution
+    }
+
+    /// All pixels, row-major from the top-left corner.
+    pub fn pixels(&self) -> &[Vec3] {
+        &self.pixels
+    }
+
+    pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
+        self.pixels[self.index(x, y)]
+    }
+
+    pub fn set_pixel(&mut self, x: u32, y: u32, radiance: Vec3) {
+        let i = self.index(x, y);
+        self.pixels[i] = radiance;
+    }
+
+    fn index(&self, x: u32, y: u32) -> usize {
+        assert!(x < self.resolution.x && y < self.resolution.y);
+        y as usize * self.resolution.x as usize + x as usize
+    }
+
+    /// The film as 8-bit sRGB bytes (RGBRGB…), row-major from the top.
+    pub fn to_srgb8(&self) -> Vec<u8> {
+        self.pixels
+            .iter()
+            .flat_map(|p| p.to_array())
+            .map(linear_to_srgb8)
+            .collect()
+    }
+
+    /// Writes the film to `path` in the format its extension names.
+    ///
+    /// The image is written to a temporary file in the same directory and then
+    /// renamed over `path`, so a failed write never leaves a partial file and
+    /// never destroys what was at `path` before.
+    pub fn save(&self, path: &Path) -> Result<(), FilmError> {
+        let format = ImageFormat::from_path(path)?;
+        let io_err = |source| FilmError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let mut tmp = tempfile::Builder::new()
+            .prefix(".glint-")
+            .suffix(".partial")
+            .tempfile_in(dir)
+            .map_err(io_err)?;
+        {
+            let mut out = BufWriter::new(tmp.as_file_mut());
+            self.encode(format, &mut out, path)?;
+            out.flush().map_err(io_err)?;
+        }
+        tmp.as_file().sync_all().map_err(io_err)?;
+        tmp.persist(path).map_err(|e| io_err(e.error))?;
+        Ok(())
+    }
+
+    fn encode<W: Write + Seek>(
+        &self,
+        format: ImageFormat,
+        out: &mut W,
+        path: &Path,
+    ) -> Result<(), FilmError> {
+        let encode_err = |e: image::ImageError| FilmError::Encode {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        let (w, h) = (self.resolution.x, self.resolution.y);
+        match format {
+            ImageFormat::Png => image::RgbImage::from_raw(w, h, self.to_srgb8())
+                .expect("buffer matches resolution")
+                .write_to(out, image::ImageFormat::Png)
+                .map_err(encode_err),
+            ImageFormat::Exr => {
+                let data = self.pixels.iter().flat_map(|p| p.to_array()).collect();
+                image::Rgb32FImage::from_raw(w, h, data)
+                    .expect("buffer matches resolution")
+                    .write_to(out, image::ImageFormat::OpenExr)
+                    .map_err(encode_err)
+            }
+            ImageFormat::Pfm => self.write_pfm(out).map_err(|source| FilmError::Io {
+                path: path.to_path_buf(),
+                source,
+            }),
+        }
+    }
+
+    /// PFM: a text header `PF\nW H\n-1.0\n` (negative scale = little-endian),
+    /// then rows of RGB f32 from the bottom row up.
+    fn write_pfm<W: Write>(&self, out: &mut W) -> std::io::Result<()> {
+        write!(
+            out,
+            "PF\n{} {}\n-1.0\n",
+            self.resolution.x, self.resolution.y
+        )?;
+        for row in self.pixels.chunks(self.resolution.x as usize).rev() {
+            for value in row.iter().flat_map(|p| p.to_array()) {
+                out.write_all(&value.to_le_bytes())?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The sRGB opto-electronic transfer function (IEC 61966-2-1), clamped to
+/// [0, 1] and quantised to 8 bits with rounding. NaN maps to 0.
+pub fn linear_to_srgb8(linear: f32) -> u8 {
+    let c = if linear.is_nan() {
+        0.0
+    } else {
+        linear.clamp(0.0, 1.0)
+    };
+    let encoded = if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (encoded * 255.0 + 0.5) as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gradient() -> Film {
+        let mut film = Film::new(UVec2::new(3, 2));
+        for y in 0..2 {
+            for x in 0..3 {
+                film.set_pixel(x, y, Vec3::new(x as f32 * 0.5, y as f32, 0.25));
+            }
+        }
+        film
+    }
+
+    #[test]
+    fn srgb_curve_matches_known_values() {
+        assert_eq!(linear_to_srgb8(0.0), 0);
+        assert_eq!(linear_to_srgb8(1.0), 255);
+        assert_eq!(linear_to_srgb8(7.5), 255);
+        assert_eq!(linear_to_srgb8(-1.0), 0);
+        assert_eq!(linear_to_srgb8(f32::NAN), 0);
+        // 0.5 linear is 0.7354 in sRGB: 187.5 -> 188.
+        assert_eq!(linear_to_srgb8(0.5), 188);
+        assert_eq!(linear_to_srgb8(0.214_041_14), 128);
+        assert_eq!(linear_to_srgb8(0.002), 7);
+    }
+
+    #[test]
+    fn png_round_trips_through_the_image_crate() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.png");
+        gradient().save(&path).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (3, 2));
+        assert_eq!(img.get_pixel(1, 0).0, [188, 0, 137]);
+        assert_eq!(img.get_pixel(2, 1).0, [255, 255, 137]);
+    }
+
+    #[test]
+    fn exr_keeps_linear_floats() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.exr");
+        gradient().save(&path).unwrap();
+        let img = image::open(&path).unwrap().to_rgb32f();
+        assert_eq!(img.get_pixel(2, 1).0, [1.0, 1.0, 0.25]);
+        assert_eq!(img.get_pixel(1, 0).0, [0.5, 0.0, 0.25]);
+    }
+
+    #[test]
+    fn pfm_is_bottom_up_little_endian() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.pfm");
+        gradient().save(&path).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let header = b"PF\n3 2\n-1.0\n";
+        assert_eq!(&bytes[..header.len()], header);
+        let floats: Vec<f32> = bytes[header.len()..]
+            .chunks(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        assert_eq!(floats.len(), 18);
+        // First stored row is the bottom row (y = 1).
+        assert_eq!(&floats[..3], &[0.0, 1.0, 0.25]);
+        assert_eq!(&floats[9..12], &[0.0, 0.0, 0.25]);
+    }
+
+    #[test]
+    fn unknown_extension_is_rejected_before_anything_is_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.bmp");
+        assert!(matches!(
+            gradient().save(&path),
+            Err(FilmError::UnknownFormat(_))
+        ));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn failed_write_keeps_the_existing_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing_dir = dir.path().join("no-such-dir").join("out.png");
+        assert!(matches!(
+            gradient().save(&missing_dir),
+            Err(FilmError::Io { .. })
+        ));
+        let existing = dir.path().join("keep.png");
+        std::fs::write(&existing, b"precious").unwrap();
+        gradient().save(&existing).unwrap();
+        assert_ne!(std::fs::read(&existing).unwrap(), b"precious");
+    }
+}

@@ -1,0 +1,21 @@
+//! The first stage of Glint: a pinhole [`Camera`] that turns continuous raster
+//! coordinates into world-space rays, and the [`Film`] that collects the radiance
+//! those rays carry and writes it out as an image.
+//!
+//! # Conventions
+//! - World space is right-handed with y up; units are whatever the scene uses.
+//! - The vertical field of view is given in **degrees** ([`Camera::new`]) and kept
+//!   internally in radians.
+//! - Raster space: `(0, 0)` is the top-left corner of the top-left pixel, x grows
+//!   to the right and y downwards; pixel `(i, j)` has its centre at `(i + 0.5, j + 0.5)`.
+//! - [`Film`] stores **linear** RGB radiance as `f32`. Only the PNG writer applies
+//!   the sRGB transfer curve (and clamps); OpenEXR and PFM keep linear floats.
+//!
+//! This crate does not depend on the geometry stage: a camera ray is a plain
+//! [`CameraRay`] (origin and unit direction) that later stages wrap in their own type.
+
+mod camera;
+mod film;
+
+pub use camera::{Camera, CameraError, CameraRay};
+pub use film::{Film, FilmError, ImageFormat};

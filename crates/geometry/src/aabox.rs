@@ -1,0 +1,84 @@
+use crate::{Hit, Ray};
+use glam::{Vec2, Vec3};
+
+/// An axis-aligned box `[min, max]`, a closed solid seen from outside and inside.
+///
+/// Each face carries its own uv square, oriented as the faces of an OpenGL cube map
+/// (seen from the box's centre): see [`FACES`]. `dpdu`/`dpdv` follow from it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AaBox {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+/// A face's frame: outward axis and sign, then for u and v the axis they run
+/// along and its direction, so that `s = sign · q[axis]` for the box-local
+/// coordinate `q ∈ [−1, 1]³`, and `u = (s + 1)/2`. Order: +x −x +y −y +z −z.
+const FACES: [(usize, f32, (usize, f32), (usize, f32)); 6] = [
+    (0, 1.0, (2, -1.0), (1, -1.0)),
+    (0, -1.0, (2, 1.0), (1, -1.0)),
+    (1, 1.0, (0, 1.0), (2, 1.0)),
+    (1, -1.0, (0, 1.0), (2, -1.0)),
+    (2, 1.0, (0, 1.0), (1, -1.0)),
+    (2, -1.0, (0, -1.0), (1, -1.0)),
+];
+
+impl AaBox {
+    /// Returns `None` unless `min < max` on every axis.
+    pub fn new(min: Vec3, max: Vec3) -> Option<Self> {
+        min.cmplt(max).all().then_some(Self { min, max })
+    }
+
+    /// Slab test: the entry distance if the ray starts outside, else the exit distance.
+    pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        let inv = ray.direction.recip();
+        let t_a = (self.min - ray.origin) * inv;
+        let t_b = (self.max - ray.origin) * inv;
+        // NaN (0·∞ on a slab boundary) is dropped by min/max against the other slab.
+        let t_near = t_a.min(t_b).max_element();
+        let t_far = t_a.max(t_b).min_element();
+        if t_near > t_far {
+            return None;
+        }
+        [t_near, t_far].into_iter().find(|&t| t > 0.0 && t < t_max)
+    }
+
+    /// Index into [`FACES`] of the face that holds `p`.
+    fn face_of(&self, p: Vec3) -> usize {
+        let half = 0.5 * (self.max - self.min);
+        let q = (p - 0.5 * (self.min + self.max)) / half;
+        let axis = q.abs().max_position();
+        2 * axis + usize::from(q[axis] < 0.0)
+    }
+
+    pub fn surface_at(&self, ray: &Ray, t: f32) -> Hit {
+        let raw = ray.at(t);
+        let face = self.face_of(raw);
+        let (axis, sign, (ua, us), (va, vs)) = FACES[face];
+        let mut point = raw.clamp(self.min, self.max);
+        point[axis] = if sign > 0.0 {
+            self.max[axis]
+        } else {
+            self.min[axis]
+        };
+        let extent = self.max - self.min;
+        let q = 2.0 * (point - self.min) / extent - Vec3::ONE;
+        let mut normal = Vec3::ZERO;
+        normal[axis] = sign;
+        let mut dpdu = Vec3::ZERO;
+        dpdu[ua] = us * extent[ua];
+        let mut dpdv = Vec3::ZERO;
+        dpdv[va] = vs * extent[va];
+        Hit {
+            t,
+            point,
+            geometric_normal: normal,
+            shading_normal: normal,
+            uv: 0.5 * (Vec2::new(us * q[ua], vs * q[va]) + Vec2::ONE),
+            dpdu,
+            dpdv,
+            front_face: normal.dot(ray.direction) < 0.0,
+            shape: 0,
+        }
+    }
+}

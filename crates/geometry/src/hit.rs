@@ -1,0 +1,35 @@
+use glam::{Vec2, Vec3};
+
+/// Everything known about the closest point where a ray meets a surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter of the hit, in multiples of the ray's direction.
+    pub t: f32,
+    pub point: Vec3,
+    /// Unit normal of the surface as the shape defines it (outward or front side).
+    pub geometric_normal: Vec3,
+    /// Unit normal used for shading; equals the geometric normal for analytic shapes.
+    pub shading_normal: Vec3,
+    /// Surface parameterisation at the hit.
+    pub uv: Vec2,
+    /// ∂p/∂u: world-space change of the point per unit of u.
+    pub dpdu: Vec3,
+    /// ∂p/∂v: world-space change of the point per unit of v.
+    pub dpdv: Vec3,
+    /// Whether the ray arrived on the side the geometric normal points to.
+    pub front_face: bool,
+    /// Index of the shape in the collection that was queried.
+    pub shape: u32,
+}
+
+impl Hit {
+    /// The shading normal flipped, if need be, to face back along `direction`
+    /// (the side the ray came from).
+    pub fn facing_normal(&self, direction: Vec3) -> Vec3 {
+        if self.shading_normal.dot(direction) > 0.0 {
+            -self.shading_normal
+        } else {
+            self.shading_normal
+        }
+    }
+}

@@ -1,0 +1,37 @@
+//! The second stage of Glint: rays, the shapes they can hit, and the
+//! closest-hit and any-hit (shadow) queries over a collection of shapes.
+//!
+//! # Conventions
+//! - World space is right-handed with y up; `f32` throughout, glam vectors.
+//! - A [`Ray`] is `origin + t · direction` for `t > 0`; the direction need not be
+//!   unit length, and `t` is measured in multiples of it.
+//! - A [`Hit`] reports the shape's *geometric* normal as the shape defines it
+//!   (outward for spheres and boxes, the front side for flat shapes) together with
+//!   `front_face`, whether the ray arrived on that side. Shading code flips it as needed.
+//! - Flat shapes (parallelogram, plane) are one-sided unless built two-sided:
+//!   a one-sided shape is invisible from behind, for every kind of ray.
+//! - uv coordinates lie in [0, 1]² on bounded shapes; `dpdu` and `dpdv` are the
+//!   partial derivatives of the surface point with respect to them (world units per
+//!   unit of uv), the Jacobian later stages use for texture filtering.
+//! - New rays leaving a surface start at [`offset_ray_origin`], never at a fixed
+//!   epsilon: the offset scales with the magnitude of the hit point.
+
+mod aabox;
+mod hit;
+mod offset;
+mod parallelogram;
+mod plane;
+mod ray;
+mod shape;
+mod shape_list;
+mod sphere;
+
+pub use aabox::AaBox;
+pub use hit::Hit;
+pub use offset::{offset_ray_origin, spawn_ray, spawn_ray_to, SHADOW_EPSILON};
+pub use parallelogram::Parallelogram;
+pub use plane::Plane;
+pub use ray::Ray;
+pub use shape::Shape;
+pub use shape_list::ShapeList;
+pub use sphere::Sphere;

@@ -1,0 +1,106 @@
+use crate::{Hit, Ray};
+use glam::{Vec2, Vec3};
+
+/// The parallelogram `origin + α·edge1 + β·edge2`, `α, β ∈ [0, 1]`.
+///
+/// Its front side is the one `normal` points to; by default
+/// `normalize(edge1 × edge2)`. uv = (α, β), so `dpdu = edge1` and `dpdv = edge2`.
+/// A one-sided parallelogram is seen only from its front side.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Parallelogram {
+    origin: Vec3,
+    edge1: Vec3,
+    edge2: Vec3,
+    normal: Vec3,
+    two_sided: bool,
+    /// `(e1 × e2) / |e1 × e2|²`: turns cross products into the coordinates α, β.
+    w: Vec3,
+}
+
+impl Parallelogram {
+    /// A parallelogram whose front side is `normalize(edge1 × edge2)`.
+    /// Returns `None` if the edges are parallel or zero (no area).
+    pub fn new(origin: Vec3, edge1: Vec3, edge2: Vec3, two_sided: bool) -> Option<Self> {
+        let n = edge1.cross(edge2);
+        let area2 = n.length_squared();
+        let scale = edge1.length_squared() * edge2.length_squared();
+        if !(area2 > 1e-12 * scale) || !area2.is_finite() {
+            return None;
+        }
+        Some(Self {
+            origin,
+            edge1,
+            edge2,
+            normal: n.normalize(),
+            two_sided,
+            w: n / area2,
+        })
+    }
+
+    /// The same parallelogram with its front side turned to the side `towards`
+    /// points to (`towards` need only not be parallel to the surface).
+    pub fn facing(mut self, towards: Vec3) -> Self {
+        if self.normal.dot(towards) < 0.0 {
+            self.normal = -self.normal;
+        }
+        self
+    }
+
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+    pub fn edges(&self) -> (Vec3, Vec3) {
+        (self.edge1, self.edge2)
+    }
+    /// Unit normal of the front side.
+    pub fn normal(&self) -> Vec3 {
+        self.normal
+    }
+    pub fn area(&self) -> f32 {
+        self.edge1.cross(self.edge2).length()
+    }
+    pub fn center(&self) -> Vec3 {
+        self.origin + 0.5 * (self.edge1 + self.edge2)
+    }
+    /// The point with coordinates `(α, β)` ∈ [0,1]².
+    pub fn point_at(&self, ab: Vec2) -> Vec3 {
+        self.origin + ab.x * self.edge1 + ab.y * self.edge2
+    }
+
+    fn coordinates(&self, p: Vec3) -> Vec2 {
+        let local = p - self.origin;
+        Vec2::new(
+            self.w.dot(local.cross(self.edge2)),
+            self.w.dot(self.edge1.cross(local)),
+        )
+    }
+
+    pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        let denom = self.normal.dot(ray.direction);
+        if denom == 0.0 || (!self.two_sided && denom > 0.0) {
+            return None;
+        }
+        let t = self.normal.dot(self.origin - ray.origin) / denom;
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        let ab = self.coordinates(ray.at(t));
+        let inside = (0.0..=1.0).contains(&ab.x) && (0.0..=1.0).contains(&ab.y);
+        inside.then_some(t)
+    }
+
+    pub fn surface_at(&self, ray: &Ray, t: f32) -> Hit {
+        let uv = self.coordinates(ray.at(t)).clamp(Vec2::ZERO, Vec2::ONE);
+        Hit {
+            t,
+            point: self.point_at(uv),
+            geometric_normal: self.normal,
+            shading_normal: self.normal,
+            uv,
+            dpdu: self.edge1,
+            dpdv: self.edge2,
+            front_face: self.normal.dot(ray.direction) < 0.0,
+            shape: 0,
+        }
+    }
+}

@@ -1,0 +1,62 @@
+use crate::{Hit, Ray};
+use glam::{Vec2, Vec3};
+
+/// An infinite plane through `point` with unit `normal` (its front side).
+///
+/// Planar uv: `u = (p − point)·tangent`, `v = (p − point)·bitangent` in world units,
+/// with the orthonormal tangent frame of Duff et al., "Building an Orthonormal
+/// Basis, Revisited" (JCGT 2017). uv is not wrapped to [0, 1]: textures repeat.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plane {
+    point: Vec3,
+    normal: Vec3,
+    tangent: Vec3,
+    bitangent: Vec3,
+    two_sided: bool,
+}
+
+impl Plane {
+    /// Returns `None` if `normal` is zero or not finite.
+    pub fn new(point: Vec3, normal: Vec3, two_sided: bool) -> Option<Self> {
+        let normal = normal.try_normalize()?;
+        let (tangent, bitangent) = normal.any_orthonormal_pair();
+        Some(Self {
+            point,
+            normal,
+            tangent,
+            bitangent,
+            two_sided,
+        })
+    }
+
+    pub fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
+    pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        let denom = self.normal.dot(ray.direction);
+        if denom == 0.0 || (!self.two_sided && denom > 0.0) {
+            return None;
+        }
+        let t = self.normal.dot(self.point - ray.origin) / denom;
+        (t > 0.0 && t < t_max).then_some(t)
+    }
+
+    pub fn surface_at(&self, ray: &Ray, t: f32) -> Hit {
+        let hit_point = ray.at(t);
+        let local = hit_point - self.point;
+        // Project onto the plane to remove the error of o + t·d along the normal.
+        let point = hit_point - self.normal.dot(local) * self.normal;
+        Hit {
+            t,
+            point,
+            geometric_normal: self.normal,
+            shading_normal: self.normal,
+            uv: Vec2::new(local.dot(self.tangent), local.dot(self.bitangent)),
+            dpdu: self.tangent,
+            dpdv: self.bitangent,
+            front_face: self.normal.dot(ray.direction) < 0.0,
+            shape: 0,
+        }
+    }
+}

@@ -1,0 +1,79 @@
+use crate::{Hit, Ray};
+use glam::{Vec2, Vec3};
+use std::f32::consts::{PI, TAU};
+
+/// A sphere given by centre and radius.
+///
+/// uv: `u = φ / 2π` with `φ = atan2(−z, x)` about the y axis (u grows left to right
+/// seen from +z), `v = θ / π` with `θ` the polar angle from +y (v = 0 at the top).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+impl Sphere {
+    pub fn new(center: Vec3, radius: f32) -> Self {
+        Self { center, radius }
+    }
+
+    /// The smallest root of |o + t·d − c|² = r² in (0, t_max).
+    ///
+    /// The report's geometric method in the numerically careful form of Haines et
+    /// al., "Precision Improvements for Ray/Sphere Intersection", Ray Tracing Gems
+    /// (2019), ch. 7: with `f = o − c`, `b = f·d`, `a = d·d`, the discriminant is
+    /// `a·(r² − |f − (b/a)·d|²)` — the squared distance from the centre to the line
+    /// is computed directly rather than as a difference of large squares — and the
+    /// roots come from the stable pair `q = −(b + sign(b)·√disc)`, `t = c/q`, `t = q/a`.
+    pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        let f = ray.origin - self.center;
+        let d = ray.direction;
+        let a = d.length_squared();
+        let b = f.dot(d);
+        let r2 = self.radius * self.radius;
+        let perpendicular = f - (b / a) * d;
+        let disc = a * (r2 - perpendicular.length_squared());
+        if disc < 0.0 {
+            return None;
+        }
+        let c = f.length_squared() - r2;
+        let q = -(b + b.signum() * disc.sqrt());
+        let (t0, t1) = if q == 0.0 {
+            let h = (-c / a).max(0.0).sqrt();
+            (-h, h)
+        } else {
+            let (x, y) = (c / q, q / a);
+            (x.min(y), x.max(y))
+        };
+        [t0, t1].into_iter().find(|&t| t > 0.0 && t < t_max)
+    }
+
+    /// The surface record at ray parameter `t`, found by [`Self::hit_distance`].
+    /// The hit point is projected back onto the sphere to remove the error of `o + t·d`.
+    pub fn surface_at(&self, ray: &Ray, t: f32) -> Hit {
+        let n = (ray.at(t) - self.center).normalize();
+        let point = self.center + self.radius * n;
+        let theta = n.y.clamp(-1.0, 1.0).acos();
+        let mut phi = (-n.z).atan2(n.x);
+        if phi < 0.0 {
+            phi += TAU;
+        }
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        let (sin_theta, cos_theta) = theta.sin_cos();
+        let r = self.radius;
+        // p = c + r (sinθ cosφ, cosθ, −sinθ sinφ), u = φ/2π, v = θ/π.
+        let dpdu = TAU * r * Vec3::new(-sin_theta * sin_phi, 0.0, -sin_theta * cos_phi);
+        let dpdv = PI * r * Vec3::new(cos_theta * cos_phi, -sin_theta, -cos_theta * sin_phi);
+        Hit {
+            t,
+            point,
+            geometric_normal: n,
+            shading_normal: n,
+            uv: Vec2::new(phi / TAU, theta / PI),
+            dpdu,
+            dpdv,
+            front_face: n.dot(ray.direction) < 0.0,
+            shape: 0,
+        }
+    }
+}

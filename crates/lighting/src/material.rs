@@ -1,0 +1,151 @@
+use glam::{Vec2, Vec3};
+use glint_texture::Texture;
+
+/// Which specular lobe a [`PhongMaterial`] uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SpecularLobe {
+    /// `max(0, r·v)^s` with `r = 2(n·l)n − l`, the mirror direction of `l` (Phong 1975).
+    #[default]
+    Phong,
+    /// `max(0, n·h)^s` with `h = normalize(l + v)` (Blinn 1977).
+    BlinnPhong,
+}
+
+/// The course's Phong material.
+///
+/// For one light of color `L` in direction `l` it reflects
+/// `L · (kd · max(0, n·l) + ks · lobe(n, l, v))` towards `v`, and nothing at all
+/// when `n·l ≤ 0` (the light is behind the surface). The ambient term
+/// `ambient · kd` is added once by the integrator.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhongMaterial {
+    /// Diffuse reflectance `kd`.
+    pub diffuse: Texture,
+    /// Specular reflectance `ks`; `None` means "the diffuse color", as in the course.
+    pub specular: Option<Texture>,
+    /// Phong exponent `s`.
+    pub shininess: f32,
+    pub lobe: SpecularLobe,
+}
+
+impl PhongMaterial {
+    /// A material with the course's defaults: specular = diffuse, Phong lobe.
+    pub fn new(diffuse: impl Into<Texture>, shininess: f32) -> Self {
+        Self {
+            diffuse: diffuse.into(),
+            specular: None,
+            shininess,
+            lobe: SpecularLobe::Phong,
+        }
+    }
+
+    /// `(kd, ks)` at surface coordinates `uv`.
+    #[inline]
+    pub fn reflectances(&self, uv: Vec2) -> (Vec3, Vec3) {
+        let kd = self.diffuse.evaluate(uv);
+        let ks = match &self.specular {
+            Some(t) => t.evaluate(uv),
+            None => kd,
+        };
+        (kd, ks)
+    }
+
+    /// The fraction of a light's color reflected towards `v`, per channel:
+    /// `kd · n·l + ks · lobe`, or zero if the light is behind the surface.
+    #[inline]
+    pub fn reflect(&self, kd: Vec3, ks: Vec3, n: Vec3, l: Vec3, v: Vec3) -> Vec3 {
+        let n_dot_l = n.dot(l);
+        if n_dot_l <= 0.0 {
+            return Vec3::ZERO;
+        }
+        kd * n_dot_l + ks * self.specular_lobe(n, l, v, n_dot_l)
+    }
+
+    /// The scalar specular lobe for unit `n`, `l`, `v`.
+    #[inline]
+    pub fn specular_lobe(&self, n: Vec3, l: Vec3, v: Vec3, n_dot_l: f32) -> f32 {
+        let cosine = match self.lobe {
+            SpecularLobe::Phong => (2.0 * n_dot_l * n - l).dot(v),
+            SpecularLobe::BlinnPhong => match (l + v).try_normalize() {
+                Some(h) => n.dot(h),
+                None => 0.0,
+            },
+        };
+        if cosine <= 0.0 {
+            0.0
+        } else {
+            cosine.powf(self.shininess)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glint_snapfmt::vec3;
+    use glint_texture::Checkerboard;
+    use std::fmt::Write;
+
+    #[test]
+    fn phong_values_for_fixed_geometry() {
+        let n = Vec3::Y;
+        let v = Vec3::new(0.0, 1.0, 1.0).normalize();
+        let kd = Vec3::new(0.7, 0.5, 0.2);
+        let ks = Vec3::new(0.3, 0.3, 0.3);
+        let mut s = String::new();
+        for lobe in [SpecularLobe::Phong, SpecularLobe::BlinnPhong] {
+            for shininess in [1.0, 16.0, 120.0] {
+                let m = PhongMaterial {
+                    lobe,
+                    shininess,
+                    ..PhongMaterial::new(kd, shininess)
+                };
+                for deg in [-30.0f32, 0.0, 30.0, 45.0, 60.0, 89.0, 100.0] {
+                    let a = deg.to_radians();
+                    let l = Vec3::new(0.0, a.cos(), -a.sin());
+                    let out = m.reflect(kd, ks, n, l, v);
+                    writeln!(s, "{lobe:?} s={shininess} light at {deg}°: {}", vec3(out)).unwrap();
+                }
+            }
+        }
+        insta::assert_snapshot!(s);
+    }
+
+    #[test]
+    fn mirror_direction_gives_the_full_specular_peak() {
+        let m = PhongMaterial::new(Vec3::ZERO, 50.0);
+        let n = Vec3::Y;
+        let l = Vec3::new(1.0, 1.0, 0.0).normalize();
+        let v = Vec3::new(-1.0, 1.0, 0.0).normalize();
+        assert!((m.specular_lobe(n, l, v, n.dot(l)) - 1.0).abs() < 1e-5);
+        let blinn = PhongMaterial {
+            lobe: SpecularLobe::BlinnPhong,
+            ..m.clone()
+        };
+        assert!((blinn.specular_lobe(n, l, v, n.dot(l)) - 1.0).abs() < 1e-5);
+        // Away from the mirror direction the lobe falls off as cos^s.
+        let v2 = Vec3::new(0.0, 1.0, 0.0);
+        let expected = (45f32.to_radians().cos()).powf(50.0);
+        assert!((m.specular_lobe(n, l, v2, n.dot(l)) - expected).abs() < 1e-6);
+    }
+
+    #[test]
+    fn specular_defaults_to_the_diffuse_color_and_follows_textures() {
+        let checker = Checkerboard::new(Vec3::X, Vec3::Y, 2);
+        let m = PhongMaterial::new(checker, 10.0);
+        assert_eq!(m.reflectances(Vec2::new(0.1, 0.1)), (Vec3::X, Vec3::X));
+        assert_eq!(m.reflectances(Vec2::new(0.6, 0.1)), (Vec3::Y, Vec3::Y));
+        let m2 = PhongMaterial {
+            specular: Some(Texture::Constant(Vec3::ZERO)),
+            ..m
+        };
+        assert_eq!(m2.reflectances(Vec2::new(0.1, 0.1)), (Vec3::X, Vec3::ZERO));
+    }
+
+    #[test]
+    fn light_behind_the_surface_adds_nothing() {
+        let m = PhongMaterial::new(Vec3::ONE, 1.0);
+        let out = m.reflect(Vec3::ONE, Vec3::ONE, Vec3::Y, -Vec3::Y, Vec3::Y);
+        assert_eq!(out, Vec3::ZERO);
+    }
+}

@@ -1,1 +1,21 @@
+//! The integrator stage of Glint: the scene as the integrator sees it, the
+//! course's direct-lighting integrator, sample patterns, and the parallel,
+//! deterministic render loop.
+//!
+//! # Conventions
+//! - Radiance is **linear** RGB `f32`; the film is written by the camera crate.
+//! - Determinism: every random number a pixel uses comes from a generator seeded by
+//!   `(seed, pixel index, sample index)` ([`sampling::pixel_rng`]), never from a shared
+//!   generator, so the image is bit-identical for any thread count or tile order.
+//! - Work is split into square tiles ([`TILE_SIZE`]) rendered in parallel with rayon;
+//!   per-tile scratch buffers are allocated once per tile, never per ray.
 
+mod direct;
+mod render;
+pub mod sampling;
+mod scene;
+
+pub use direct::DirectIntegrator;
+pub use render::{render, RenderOutput, RenderSettings, RenderStats, SettingsError, TILE_SIZE};
+pub use sampling::SamplePattern;
+pub use scene::{Scene, SceneBuilder, SceneError, Surface};

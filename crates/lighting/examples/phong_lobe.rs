@@ -19,7 +19,13 @@ fn main() {
         ..phong.clone()
     };
     println!("light 45° from the normal, shininess {shininess}; the mirror direction is at +45°");
-    println!("{:>8} {:>10} {:>12}  diffuse n·l = {:.4}", "view °", "Phong", "Blinn-Phong", n.dot(l));
+    println!(
+        "{:>8} {:>10} {:>12}  diffuse n·l = {:.4}",
+        "view °",
+        "Phong",
+        "Blinn-Phong",
+        n.dot(l)
+    );
     for deg in (-80..=80).step_by(10) {
         let a = (deg as f32).to_radians();
         let v = Vec3::new(a.sin(), a.cos(), 0.0);

@@ -61,7 +61,10 @@ mod tests {
         assert_eq!(light.surface().normal(), -Vec3::Y);
         assert_eq!(light.sample_point(Vec2::ZERO), Vec3::new(-1.0, 5.9, -7.0));
         assert_eq!(light.sample_point(Vec2::ONE), Vec3::new(1.0, 5.9, -5.0));
-        assert_eq!(light.sample_point(Vec2::splat(0.5)), Vec3::new(0.0, 5.9, -6.0));
+        assert_eq!(
+            light.sample_point(Vec2::splat(0.5)),
+            Vec3::new(0.0, 5.9, -6.0)
+        );
         let p = light.sample_point(Vec2::splat(0.5));
         assert!(light.illuminates(p, Vec3::ZERO));
         assert!(!light.illuminates(p, Vec3::new(0.0, 6.0, -6.0)));

@@ -16,7 +16,11 @@ fn main() {
         let row: String = (0..samples)
             .map(|i| {
                 let uv = (Vec2::new(i as f32, j as f32) + 0.5) / samples as f32;
-                if texture.evaluate(uv).x > 0.5 { '#' } else { '.' }
+                if texture.evaluate(uv).x > 0.5 {
+                    '#'
+                } else {
+                    '.'
+                }
             })
             .collect();
         println!("{row}");

@@ -1,0 +1,139 @@
+use crate::sampling::SamplePattern;
+use crate::{Scene, Surface};
+use glam::{Vec2, Vec3};
+use glint_geometry::{spawn_ray_to, Hit, Ray};
+use glint_lighting::{AreaLight, Light, PhongMaterial};
+use rand_pcg::Pcg32;
+
+/// The direct-lighting integrator of the course report, section 2.5.
+///
+/// For a camera ray: a miss is black; a first hit on a light's front face is the
+/// light's color; otherwise the hit point reflects `ambient · kd` plus, for each
+/// light, the Phong reflection of every unoccluded light sample — one shadow ray per
+/// sample, the N samples of an area light averaged.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectIntegrator {
+    pub light_samples: u32,
+    pub light_pattern: SamplePattern,
+}
+
+/// Reusable per-thread state: the random stream of the current camera sample,
+/// a buffer for light sample positions, and ray counters.
+pub struct SampleContext {
+    pub rng: Pcg32,
+    pub light_points: Vec<Vec2>,
+    pub shadow_rays: u64,
+}
+
+impl SampleContext {
+    pub fn new(light_samples: u32) -> Self {
+        Self {
+            rng: crate::sampling::pixel_rng(0, 0, 0),
+            light_points: vec![Vec2::ZERO; light_samples as usize],
+            shadow_rays: 0,
+        }
+    }
+}
+
+impl DirectIntegrator {
+    /// Radiance arriving along `ray` (from the camera).
+    pub fn li(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
+        let Some(hit) = scene.shapes.closest_hit(ray, f32::INFINITY) else {
+            return Vec3::ZERO;
+        };
+        match scene.surfaces[hit.shape as usize] {
+            Surface::Emitter(light) => match &scene.lights[light as usize] {
+                Light::Area(area) => area.color,
+                Light::Point(_) => Vec3::ZERO,
+            },
+            Surface::Material(m) => self.shade(scene, &scene.materials[m as usize], &hit, ray, ctx),
+        }
+    }
+
+    fn shade(
+        &self,
+        scene: &Scene,
+        material: &PhongMaterial,
+        hit: &Hit,
+        ray: &Ray,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let (kd, ks) = material.reflectances(hit.uv);
+        let point = ShadingPoint {
+            hit,
+            material,
+            kd,
+            ks,
+            n: hit.facing_normal(ray.direction),
+            v: -ray.direction.normalize(),
+        };
+        let mut radiance = scene.ambient * kd;
+        for light in &scene.lights {
+            radiance += match light {
+                Light::Point(p) => p.color * point.unoccluded_reflection(scene, p.position, ctx),
+                Light::Area(area) => self.area_light(scene, &point, area, ctx),
+            };
+        }
+        radiance
+    }
+
+    /// The average over the light's samples of the Phong reflection of each
+    /// visible sample, times the light's color.
+    fn area_light(
+        &self,
+        scene: &Scene,
+        point: &ShadingPoint,
+        light: &AreaLight,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let mut samples = std::mem::take(&mut ctx.light_points);
+        self.light_pattern.fill(&mut ctx.rng, &mut samples);
+        let mut sum = Vec3::ZERO;
+        for &u in &samples {
+            let position = light.sample_point(u);
+            if light.illuminates(position, point.hit.point) {
+                sum += point.unoccluded_reflection(scene, position, ctx);
+            }
+        }
+        ctx.light_points = samples;
+        light.color * sum / self.light_samples as f32
+    }
+}
+
+/// A surface point being shaded: the hit, its material and reflectances, and the
+/// unit normal `n` (on the viewer's side) and direction `v` towards the viewer.
+struct ShadingPoint<'a> {
+    hit: &'a Hit,
+    material: &'a PhongMaterial,
+    kd: Vec3,
+    ks: Vec3,
+    n: Vec3,
+    v: Vec3,
+}
+
+impl ShadingPoint<'_> {
+    /// Phong reflection towards `v` of a unit light at `position`, or zero if the
+    /// light is behind the surface or a shadow ray finds it occluded. The shadow ray
+    /// is only traced when the light could contribute.
+    fn unoccluded_reflection(
+        &self,
+        scene: &Scene,
+        position: Vec3,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let Some(l) = (position - self.hit.point).try_normalize() else {
+            return Vec3::ZERO;
+        };
+        let reflected = self.material.reflect(self.kd, self.ks, self.n, l, self.v);
+        if reflected == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        let (shadow, t_max) = spawn_ray_to(self.hit, position);
+        ctx.shadow_rays += 1;
+        if scene.shapes.any_hit(&shadow, t_max) {
+            Vec3::ZERO
+        } else {
+            reflected
+        }
+    }
+}

@@ -1,0 +1,109 @@
+use glam::Vec3;
+use glint_camera::Camera;
+use glint_geometry::{Shape, ShapeList};
+use glint_lighting::{AreaLight, Light, PhongMaterial, PointLight};
+
+/// What a shape is to the integrator: a reflecting surface or an emitter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Surface {
+    /// Shaded with the material at this index of [`Scene::materials`].
+    Material(u32),
+    /// The visible face of the light at this index of [`Scene::lights`].
+    Emitter(u32),
+}
+
+/// The scene as the integrator sees it: a camera, shapes in one flat list with a
+/// [`Surface`] per shape, materials, lights and an ambient term.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub camera: Camera,
+    pub shapes: ShapeList,
+    /// `surfaces[i]` describes `shapes.shapes()[i]`.
+    pub surfaces: Vec<Surface>,
+    pub materials: Vec<PhongMaterial>,
+    pub lights: Vec<Light>,
+    /// Ambient light; a hit surface reflects `ambient · kd` regardless of shadows.
+    pub ambient: Vec3,
+}
+
+/// Why a scene could not be assembled.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    #[error("shape {shape} refers to material {material}, but only {count} materials exist")]
+    UnknownMaterial {
+        shape: usize,
+        material: u32,
+        count: usize,
+    },
+}
+
+/// Assembles a [`Scene`] piece by piece; area lights add their emitting surface
+/// to the shape list themselves.
+#[derive(Clone, Debug, Default)]
+pub struct SceneBuilder {
+    shapes: ShapeList,
+    surfaces: Vec<Surface>,
+    materials: Vec<PhongMaterial>,
+    lights: Vec<Light>,
+    ambient: Vec3,
+}
+
+impl SceneBuilder {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a material and returns the index shapes refer to it by.
+    pub fn material(&mut self, material: PhongMaterial) -> u32 {
+        self.materials.push(material);
+        (self.materials.len() - 1) as u32
+    }
+
+    /// Adds a shape made of material `material`.
+    pub fn shape(&mut self, shape: impl Into<Shape>, material: u32) -> &mut Self {
+        self.shapes.push(shape);
+        self.surfaces.push(Surface::Material(material));
+        self
+    }
+
+    pub fn point_light(&mut self, light: PointLight) -> &mut Self {
+        self.lights.push(Light::Point(light));
+        self
+    }
+
+    /// Adds an area light, visible to camera rays through its emitting surface.
+    pub fn area_light(&mut self, light: AreaLight) -> &mut Self {
+        self.shapes.push(*light.surface());
+        self.surfaces
+            .push(Surface::Emitter(self.lights.len() as u32));
+        self.lights.push(Light::Area(light));
+        self
+    }
+
+    pub fn ambient(&mut self, ambient: Vec3) -> &mut Self {
+        self.ambient = ambient;
+        self
+    }
+
+    pub fn build(self, camera: Camera) -> Result<Scene, SceneError> {
+        for (shape, surface) in self.surfaces.iter().enumerate() {
+            if let Surface::Material(material) = *surface {
+                if material as usize >= self.materials.len() {
+                    return Err(SceneError::UnknownMaterial {
+                        shape,
+                        material,
+                        count: self.materials.len(),
+                    });
+                }
+            }
+        }
+        Ok(Scene {
+            camera,
+            shapes: self.shapes,
+            surfaces: self.surfaces,
+            materials: self.materials,
+            lights: self.lights,
+            ambient: self.ambient,
+        })
+    }
+}

@@ -1,1 +1,52 @@
+//! The scene stage of Glint: the TOML scene file format, its validation, and
+//! loading a file into the integrator's [`Scene`](glint_integrator::Scene) and
+//! [`RenderSettings`](glint_integrator::RenderSettings).
+//!
+//! # Conventions
+//! - The file's units and frame are the renderer's: right-handed, y up, linear RGB.
+//! - Angles in the file are in **degrees** (the camera's `fov`).
+//! - Every error is one [`SceneError`] that names the file, the 1-based line and
+//!   column, and the dotted path of the field (`sphere[2].radius`); array indices
+//!   count from 0, in file order. Unknown keys, non-finite numbers and out-of-range
+//!   values are all errors, never silently accepted.
+//!
+//! The format is documented key by key in the repository README ("Scene format").
 
+mod build;
+mod error;
+mod format;
+mod values;
+
+pub use build::SceneDescription;
+pub use error::SceneError;
+pub use values::{parse_resolution_parts, MAX_RESOLUTION};
+
+use std::path::Path;
+
+/// Reads and validates the scene file at `path`.
+pub fn load(path: &Path) -> Result<SceneDescription, SceneError> {
+    let source = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(&source, &path.display().to_string())
+}
+
+/// Parses and validates scene text; `file` names it in error messages.
+pub fn parse(source: &str, file: &str) -> Result<SceneDescription, SceneError> {
+    let deserializer = toml::de::Deserializer::parse(source)
+        .map_err(|e| error::invalid(file, source, e.span(), None, e.message()))?;
+    let scene_file: format::SceneFile =
+        serde_path_to_error::deserialize(deserializer).map_err(|e| {
+            // `Spanned` wraps values in a private struct; keep it out of the path.
+            let path = e
+                .path()
+                .to_string()
+                .replace(".$__serde_spanned_private_value", "");
+            let field = (path != ".").then_some(path);
+            let inner = e.into_inner();
+            error::invalid(file, source, inner.span(), field, inner.message())
+        })?;
+    build::build(scene_file)
+        .map_err(|p| error::invalid(file, source, Some(p.span), Some(p.field), &p.message))
+}

@@ -1,0 +1,239 @@
+//! From the file as read to the integrator's scene: name resolution and the
+//! checks that involve more than one value.
+
+use crate::error::Problem;
+use crate::format::*;
+use glam::Vec3;
+use glint_camera::{Camera, CameraError};
+use glint_geometry::{AaBox, Parallelogram, Plane, Sphere};
+use glint_integrator::{RenderSettings, Scene, SceneBuilder};
+use glint_lighting::{AreaLight, PhongMaterial, PointLight};
+use glint_texture::{Checkerboard, Texture};
+use std::collections::BTreeMap;
+use toml::Spanned;
+
+/// A scene ready to render, with the render settings its file asks for.
+#[derive(Clone, Debug)]
+pub struct SceneDescription {
+    pub scene: Scene,
+    pub settings: RenderSettings,
+}
+
+pub(crate) fn build(file: SceneFile) -> Result<SceneDescription, Problem> {
+    let settings = settings(&file.render)?;
+    let camera = camera(&file.camera, file.render.resolution.0)?;
+    let textures = textures(&file.textures);
+    let mut builder = SceneBuilder::new();
+    let mut material_ids = BTreeMap::new();
+    for (name, table) in &file.materials {
+        let material = material(name, table, &textures)?;
+        material_ids.insert(name.as_str(), builder.material(material));
+    }
+    let lookup = |field: String, name: &Spanned<String>| {
+        material_ids
+            .get(name.get_ref().as_str())
+            .copied()
+            .ok_or_else(|| {
+                let known: Vec<_> = material_ids.keys().map(|k| format!("\"{k}\"")).collect();
+                Problem::new(
+                    name.span(),
+                    field,
+                    format!(
+                        "no material named \"{}\" (defined: {})",
+                        name.get_ref(),
+                        if known.is_empty() {
+                            "none".into()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                )
+            })
+    };
+
+    for (i, s) in file.sphere.iter().enumerate() {
+        let m = lookup(format!("sphere[{i}].material"), &s.material)?;
+        builder.shape(Sphere::new(s.center.0, s.radius.0), m);
+    }
+    for (i, p) in file.parallelogram.iter().enumerate() {
+        let field = format!("parallelogram[{i}]");
+        let m = lookup(format!("{field}.material"), &p.material)?;
+        let shape = Parallelogram::new(p.origin.0, p.edge1.get_ref().0, p.edge2.0, p.two_sided)
+            .ok_or_else(|| no_area(&field, &p.edge1))?;
+        let front = front_side(&field, shape.normal(), p.normal.as_ref())?;
+        builder.shape(shape.facing(front), m);
+    }
+    for (i, p) in file.plane.iter().enumerate() {
+        let m = lookup(format!("plane[{i}].material"), &p.material)?;
+        let plane = Plane::new(p.point.0, p.normal.0, p.two_sided).expect("normal is non-zero");
+        builder.shape(plane, m);
+    }
+    for (i, b) in file.boxes.iter().enumerate() {
+        let field = format!("box[{i}]");
+        let m = lookup(format!("{field}.material"), &b.material)?;
+        let aabox = AaBox::new(b.min.0, b.max.get_ref().0).ok_or_else(|| {
+            Problem::new(
+                b.max.span(),
+                format!("{field}.max"),
+                "expected max to be greater than min on every axis",
+            )
+        })?;
+        builder.shape(aabox, m);
+    }
+    for p in &file.point_light {
+        builder.point_light(PointLight {
+            position: p.position.0,
+            color: p.color.0,
+        });
+    }
+    for (i, a) in file.area_light.iter().enumerate() {
+        let field = format!("area_light[{i}]");
+        let light = AreaLight::new(a.center.0, a.edge1.get_ref().0, a.edge2.0, a.color.0)
+            .ok_or_else(|| no_area(&field, &a.edge1))?;
+        let front = front_side(&field, light.surface().normal(), a.normal.as_ref())?;
+        builder.area_light(light.facing(front));
+    }
+    builder.ambient(file.ambient.0);
+    let scene = builder
+        .build(camera)
+        .expect("material ids were resolved above");
+    Ok(SceneDescription { scene, settings })
+}
+
+fn no_area(field: &str, edge1: &Spanned<crate::values::Point>) -> Problem {
+    Problem::new(
+        edge1.span(),
+        format!("{field}.edge1"),
+        "edge1 and edge2 are parallel or zero, so the shape has no area",
+    )
+}
+
+/// The front side of a flat shape: its `normal` key if given (which must be
+/// perpendicular to the edges), else `edge1 × edge2`.
+fn front_side(
+    field: &str,
+    cross: Vec3,
+    normal: Option<&Spanned<crate::values::Direction>>,
+) -> Result<Vec3, Problem> {
+    let Some(normal) = normal else {
+        return Ok(cross);
+    };
+    let n = normal.get_ref().0.normalize();
+    if n.dot(cross).abs() < 0.999 {
+        return Err(Problem::new(
+            normal.span(),
+            format!("{field}.normal"),
+            format!(
+                "expected a normal perpendicular to edge1 and edge2, i.e. along ±[{}, {}, {}]",
+                cross.x, cross.y, cross.z
+            ),
+        ));
+    }
+    Ok(n)
+}
+
+fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> {
+    let settings = RenderSettings {
+        spp: render.spp.get_ref().0,
+        pixel_pattern: render.pixel_sampler.get_ref().0,
+        light_samples: render.light_samples.get_ref().0,
+        light_pattern: render.light_sampler.get_ref().0,
+        seed: render.seed,
+        threads: None,
+    };
+    for (field, count, sampler) in [
+        ("render.spp", &render.spp, &render.pixel_sampler),
+        (
+            "render.light_samples",
+            &render.light_samples,
+            &render.light_sampler,
+        ),
+    ] {
+        let n = count.get_ref().0;
+        if !sampler.get_ref().0.supports(n) {
+            // Point at the count if the file set it, else at the sampler.
+            let span = if count.span().is_empty() {
+                sampler.span()
+            } else {
+                count.span()
+            };
+            return Err(Problem::new(
+                span,
+                field,
+                format!("the grid sampler needs a perfect square (1, 4, 9, 16, …), got {n}"),
+            ));
+        }
+    }
+    Ok(settings)
+}
+
+fn camera(table: &Spanned<CameraTable>, resolution: glam::UVec2) -> Result<Camera, Problem> {
+    let c = table.get_ref();
+    Camera::new(
+        c.position.0,
+        c.look_at.0,
+        c.up.0,
+        c.fov.0,
+        c.focal_length.0,
+        resolution,
+    )
+    .map_err(|e| {
+        let field = match e {
+            CameraError::NoForward => "camera.look_at",
+            CameraError::UpParallelToForward => "camera.up",
+            CameraError::FieldOfView(_) => "camera.fov",
+            CameraError::FocalLength(_) => "camera.focal_length",
+            CameraError::Resolution(..) => "render.resolution",
+        };
+        Problem::new(table.span(), field, e.to_string())
+    })
+}
+
+fn textures(tables: &BTreeMap<String, TextureTable>) -> BTreeMap<&str, Texture> {
+    tables
+        .iter()
+        .map(|(name, table)| {
+            let texture = match table {
+                TextureTable::Checkerboard(c) => {
+                    Checkerboard::new(c.colors[0].0, c.colors[1].0, c.checks.0).into()
+                }
+            };
+            (name.as_str(), texture)
+        })
+        .collect()
+}
+
+fn material(
+    name: &str,
+    table: &MaterialTable,
+    textures: &BTreeMap<&str, Texture>,
+) -> Result<PhongMaterial, Problem> {
+    let input = |key: &str, value: &Spanned<ColorOrTexture>| match value.get_ref() {
+        ColorOrTexture::Color(c) => Ok(Texture::Constant(c.0)),
+        ColorOrTexture::Texture(t) => textures.get(t.as_str()).cloned().ok_or_else(|| {
+            let known: Vec<_> = textures.keys().map(|k| format!("\"{k}\"")).collect();
+            Problem::new(
+                value.span(),
+                format!("materials.{name}.{key}"),
+                format!(
+                    "no texture named \"{t}\" (defined: {})",
+                    if known.is_empty() {
+                        "none".into()
+                    } else {
+                        known.join(", ")
+                    }
+                ),
+            )
+        }),
+    };
+    Ok(PhongMaterial {
+        diffuse: input("diffuse", &table.diffuse)?,
+        specular: table
+            .specular
+            .as_ref()
+            .map(|s| input("specular", s))
+            .transpose()?,
+        shininess: table.shininess.0,
+        lobe: table.lobe.map(|l| l.0).unwrap_or_default(),
+    })
+}

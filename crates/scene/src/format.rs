@@ -1,0 +1,203 @@
+//! The TOML scene file, as read: one struct per table, unknown keys refused.
+//! Defaults here are the documented defaults of the format (README, "Scene format").
+
+use crate::values::*;
+use serde::de::{self, Deserializer, Visitor};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt;
+use toml::Spanned;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Ambient light added as `ambient · kd` at every shaded point.
+    #[serde(default = "black")]
+    pub ambient: Color,
+    pub camera: Spanned<CameraTable>,
+    #[serde(default)]
+    pub render: RenderTable,
+    #[serde(default)]
+    pub textures: BTreeMap<String, TextureTable>,
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialTable>,
+    #[serde(default)]
+    pub sphere: Vec<SphereTable>,
+    #[serde(default)]
+    pub parallelogram: Vec<ParallelogramTable>,
+    #[serde(default)]
+    pub plane: Vec<PlaneTable>,
+    #[serde(default, rename = "box")]
+    pub boxes: Vec<BoxTable>,
+    #[serde(default)]
+    pub point_light: Vec<PointLightTable>,
+    #[serde(default)]
+    pub area_light: Vec<AreaLightTable>,
+}
+
+fn black() -> Color {
+    Color(glam::Vec3::ZERO)
+}
+fn white() -> Color {
+    Color(glam::Vec3::ONE)
+}
+fn y_up() -> Direction {
+    Direction(glam::Vec3::Y)
+}
+fn unit_focal_length() -> Positive {
+    Positive(1.0)
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraTable {
+    pub position: Point,
+    pub look_at: Point,
+    #[serde(default = "y_up")]
+    pub up: Direction,
+    /// Vertical field of view in degrees.
+    pub fov: FieldOfView,
+    #[serde(default = "unit_focal_length")]
+    pub focal_length: Positive,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RenderTable {
+    pub resolution: Resolution,
+    pub spp: Spanned<Count>,
+    pub pixel_sampler: Spanned<Pattern>,
+    pub light_samples: Spanned<Count>,
+    pub light_sampler: Spanned<Pattern>,
+    pub seed: u64,
+}
+
+impl Default for RenderTable {
+    fn default() -> Self {
+        let settings = glint_integrator::RenderSettings::default();
+        Self {
+            resolution: Resolution(glam::UVec2::new(512, 512)),
+            spp: Spanned::new(0..0, Count(settings.spp)),
+            pixel_sampler: Spanned::new(0..0, Pattern(settings.pixel_pattern)),
+            light_samples: Spanned::new(0..0, Count(settings.light_samples)),
+            light_sampler: Spanned::new(0..0, Pattern(settings.light_pattern)),
+            seed: settings.seed,
+        }
+    }
+}
+
+/// A named texture: one key naming its kind, e.g. `checkerboard = { … }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+pub enum TextureTable {
+    Checkerboard(CheckerboardTable),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckerboardTable {
+    /// The colors of even and odd checks.
+    pub colors: [Color; 2],
+    /// Checks along each side of the uv square.
+    pub checks: Count,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialTable {
+    pub diffuse: Spanned<ColorOrTexture>,
+    pub specular: Option<Spanned<ColorOrTexture>>,
+    #[serde(default = "unit_shininess")]
+    pub shininess: NonNegative,
+    pub lobe: Option<Lobe>,
+}
+
+fn unit_shininess() -> NonNegative {
+    NonNegative(1.0)
+}
+
+/// A material input: a constant `[r, g, b]` or the name of a texture.
+#[derive(Debug)]
+pub enum ColorOrTexture {
+    Color(Color),
+    Texture(String),
+}
+
+impl<'de> serde::Deserialize<'de> for ColorOrTexture {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = ColorOrTexture;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a color [r, g, b] or the name of a texture")
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Self::Value, E> {
+                Ok(ColorOrTexture::Texture(v.to_owned()))
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+                Color::deserialize(de::value::SeqAccessDeserializer::new(seq))
+                    .map(ColorOrTexture::Color)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereTable {
+    pub center: Point,
+    pub radius: Positive,
+    pub material: Spanned<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParallelogramTable {
+    pub origin: Point,
+    pub edge1: Spanned<Point>,
+    pub edge2: Point,
+    /// Which side is the front; must be perpendicular to both edges.
+    pub normal: Option<Spanned<Direction>>,
+    #[serde(default)]
+    pub two_sided: bool,
+    pub material: Spanned<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneTable {
+    pub point: Point,
+    pub normal: Direction,
+    #[serde(default)]
+    pub two_sided: bool,
+    pub material: Spanned<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxTable {
+    pub min: Point,
+    pub max: Spanned<Point>,
+    pub material: Spanned<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLightTable {
+    pub position: Point,
+    #[serde(default = "white")]
+    pub color: Color,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AreaLightTable {
+    pub center: Point,
+    pub edge1: Spanned<Point>,
+    pub edge2: Point,
+    /// Which side emits; must be perpendicular to both edges.
+    pub normal: Option<Spanned<Direction>>,
+    #[serde(default = "white")]
+    pub color: Color,
+}

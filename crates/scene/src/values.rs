@@ -1,0 +1,188 @@
+//! Value types of the scene format that validate themselves while they are read,
+//! so that a bad number is reported at its own line and column.
+
+use glam::{UVec2, Vec3};
+use glint_integrator::SamplePattern;
+use glint_lighting::SpecularLobe;
+use serde::de::{self, Deserialize, Deserializer, Visitor};
+use std::fmt;
+
+/// Largest accepted film side, in pixels: bounds the memory a scene can ask for.
+pub const MAX_RESOLUTION: u32 = 16384;
+
+/// Any TOML number (integer or float) as f32; anything else is refused with a
+/// message that says a number was expected.
+struct Number(f32);
+
+impl<'de> Deserialize<'de> for Number {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = Number;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number")
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Number, E> {
+                Ok(Number(v as f32))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Number, E> {
+                Ok(Number(v as f32))
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Number, E> {
+                Ok(Number(v as f32))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+fn finite<E: de::Error>(v: f32) -> Result<f32, E> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(E::custom(format!("expected a finite number, got {v}")))
+    }
+}
+
+fn number<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    finite(Number::deserialize(d)?.0)
+}
+
+fn vector<'de, D: Deserializer<'de>>(d: D) -> Result<Vec3, D::Error> {
+    let items = Vec::<Number>::deserialize(d)?;
+    if items.len() != 3 {
+        return Err(de::Error::custom(format!(
+            "expected 3 numbers [x, y, z], got {}",
+            items.len()
+        )));
+    }
+    Ok(Vec3::new(
+        finite(items[0].0)?,
+        finite(items[1].0)?,
+        finite(items[2].0)?,
+    ))
+}
+
+macro_rules! validated {
+    ($(#[$doc:meta])* $name:ident($inner:ty) via $read:ident, |$v:ident| $ok:expr, $expected:literal) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct $name(pub $inner);
+
+        impl<'de> Deserialize<'de> for $name {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                let $v = $read(d)?;
+                if $ok {
+                    Ok($name($v))
+                } else {
+                    Err(de::Error::custom(format!(concat!("expected ", $expected, ", got {}"), $v)))
+                }
+            }
+        }
+    };
+}
+
+validated!(
+    /// A finite number greater than zero.
+    Positive(f32) via number, |v| v > 0.0, "a number greater than 0"
+);
+validated!(
+    /// A finite number of at least zero.
+    NonNegative(f32) via number, |v| v >= 0.0, "a number of at least 0"
+);
+validated!(
+    /// A point or offset `[x, y, z]` of finite numbers.
+    Point(Vec3) via vector, |v| true, "[x, y, z]"
+);
+validated!(
+    /// A direction `[x, y, z]`: finite and not zero.
+    Direction(Vec3) via vector, |v| v.length_squared() > 0.0, "a non-zero direction [x, y, z]"
+);
+validated!(
+    /// A linear RGB color `[r, g, b]` with no negative component.
+    Color(Vec3) via vector, |v| v.min_element() >= 0.0, "a color [r, g, b] with components of at least 0"
+);
+validated!(
+    /// A vertical field of view in degrees, strictly between 0 and 180.
+    FieldOfView(f32) via number, |v| v > 0.0 && v < 180.0, "a field of view in degrees strictly between 0 and 180"
+);
+
+/// A count of at least 1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Count(pub u32);
+
+impl<'de> Deserialize<'de> for Count {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        match u32::deserialize(d)? {
+            0 => Err(de::Error::custom(
+                "expected a whole number of at least 1, got 0",
+            )),
+            n => Ok(Count(n)),
+        }
+    }
+}
+
+/// A film resolution `[width, height]`, each from 1 to [`MAX_RESOLUTION`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Resolution(pub UVec2);
+
+impl<'de> Deserialize<'de> for Resolution {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let [w, h] = <[u32; 2]>::deserialize(d)?;
+        parse_resolution_parts(w, h)
+            .map(Resolution)
+            .map_err(de::Error::custom)
+    }
+}
+
+/// Checks a resolution's sides; shared by the file format and the command line.
+pub fn parse_resolution_parts(w: u32, h: u32) -> Result<UVec2, String> {
+    if (1..=MAX_RESOLUTION).contains(&w) && (1..=MAX_RESOLUTION).contains(&h) {
+        Ok(UVec2::new(w, h))
+    } else {
+        Err(format!(
+            "expected a resolution [width, height] with each side from 1 to {MAX_RESOLUTION}, got [{w}, {h}]"
+        ))
+    }
+}
+
+/// Reads one of a fixed set of names.
+fn named<'de, D: Deserializer<'de>, T>(
+    d: D,
+    names: &[&str],
+    parse: impl Fn(&str) -> Option<T>,
+) -> Result<T, D::Error> {
+    let name = String::deserialize(d)?;
+    parse(&name).ok_or_else(|| {
+        let list = names.iter().map(|n| format!("\"{n}\"")).collect::<Vec<_>>();
+        de::Error::custom(format!(
+            "expected one of {}, got \"{name}\"",
+            list.join(", ")
+        ))
+    })
+}
+
+/// A sample pattern name: `"grid"`, `"random"` or `"stratified"`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pattern(pub SamplePattern);
+
+impl<'de> Deserialize<'de> for Pattern {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        named(d, &SamplePattern::NAMES, SamplePattern::from_name).map(Pattern)
+    }
+}
+
+/// A specular lobe name: `"phong"` or `"blinn-phong"`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lobe(pub SpecularLobe);
+
+impl<'de> Deserialize<'de> for Lobe {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        named(d, &["phong", "blinn-phong"], |n| match n {
+            "phong" => Some(SpecularLobe::Phong),
+            "blinn-phong" => Some(SpecularLobe::BlinnPhong),
+            _ => None,
+        })
+        .map(Lobe)
+    }
+}

@@ -18,4 +18,4 @@ mod camera;
 mod film;
 
 pub use camera::{Camera, CameraError, CameraRay};
-pub use film::{Film, FilmError, ImageFormat};
+pub use film::{linear_to_srgb8, Film, FilmError, ImageFormat};

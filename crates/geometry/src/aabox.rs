@@ -7,14 +7,17 @@ use glam::{Vec2, Vec3};
 /// (seen from the box's centre): see [`FACES`]. `dpdu`/`dpdv` follow from it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AaBox {
-    pub min: Vec3,
-    pub max: Vec3,
+    min: Vec3,
+    max: Vec3,
 }
+
+/// How a face's uv runs: the box axis it follows and the direction along it.
+type FaceAxis = (usize, f32);
 
 /// A face's frame: outward axis and sign, then for u and v the axis they run
 /// along and its direction, so that `s = sign · q[axis]` for the box-local
 /// coordinate `q ∈ [−1, 1]³`, and `u = (s + 1)/2`. Order: +x −x +y −y +z −z.
-const FACES: [(usize, f32, (usize, f32), (usize, f32)); 6] = [
+const FACES: [(usize, f32, FaceAxis, FaceAxis); 6] = [
     (0, 1.0, (2, -1.0), (1, -1.0)),
     (0, -1.0, (2, 1.0), (1, -1.0)),
     (1, 1.0, (0, 1.0), (2, 1.0)),
@@ -27,6 +30,13 @@ impl AaBox {
     /// Returns `None` unless `min < max` on every axis.
     pub fn new(min: Vec3, max: Vec3) -> Option<Self> {
         min.cmplt(max).all().then_some(Self { min, max })
+    }
+
+    pub fn min(&self) -> Vec3 {
+        self.min
+    }
+    pub fn max(&self) -> Vec3 {
+        self.max
     }
 
     /// Slab test: the entry distance if the ray starts outside, else the exit distance.

@@ -24,7 +24,7 @@ impl Parallelogram {
         let n = edge1.cross(edge2);
         let area2 = n.length_squared();
         let scale = edge1.length_squared() * edge2.length_squared();
-        if !(area2 > 1e-12 * scale) || !area2.is_finite() {
+        if area2.is_nan() || area2 <= 1e-12 * scale || !area2.is_finite() {
             return None;
         }
         Some(Self {

@@ -29,6 +29,10 @@ impl Plane {
         })
     }
 
+    /// A point on the plane.
+    pub fn point(&self) -> Vec3 {
+        self.point
+    }
     pub fn normal(&self) -> Vec3 {
         self.normal
     }

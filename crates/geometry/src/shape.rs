@@ -69,7 +69,10 @@ mod tests {
 
     fn shapes() -> Vec<(&'static str, Shape)> {
         vec![
-            ("sphere", Sphere::new(Vec3::new(0.0, 0.0, -5.0), 1.5).into()),
+            (
+                "sphere",
+                Sphere::new(Vec3::new(0.0, 0.0, -5.0), 1.5).unwrap().into(),
+            ),
             (
                 "parallelogram",
                 Parallelogram::new(
@@ -152,13 +155,13 @@ mod tests {
 
     #[test]
     fn hit_points_lie_on_the_surface_and_t_matches() {
-        let sphere = Sphere::new(Vec3::new(0.3, -0.2, -7.0), 2.0);
+        let sphere = Sphere::new(Vec3::new(0.3, -0.2, -7.0), 2.0).unwrap();
         for i in 0..200 {
             let a = i as f32 * 0.37;
             let d = Vec3::new(0.3 + 0.2 * a.sin(), -0.2 + 0.2 * a.cos(), -7.0);
             let ray = Ray::new(Vec3::ZERO, d);
             let h = Shape::from(sphere).intersect(&ray, f32::INFINITY).unwrap();
-            let dist = (h.point - sphere.center).length();
+            let dist = (h.point - sphere.center()).length();
             assert!((dist - 2.0).abs() < 2e-6, "off surface by {}", dist - 2.0);
             assert!((ray.at(h.t) - h.point).length() < 1e-4);
             assert!(h.front_face);
@@ -169,10 +172,10 @@ mod tests {
     fn sphere_far_from_origin_keeps_precision() {
         // A small sphere 10^4 units away: the naive b² − 4ac loses the hit entirely
         // or misplaces it by far more than the radius' ULP budget.
-        let sphere = Sphere::new(Vec3::new(0.0, 0.0, -1.0e4), 0.01);
+        let sphere = Sphere::new(Vec3::new(0.0, 0.0, -1.0e4), 0.01).unwrap();
         let ray = Ray::new(Vec3::ZERO, Vec3::new(0.0, 0.0099 / 1.0e4, -1.0));
         let h = Shape::from(sphere).intersect(&ray, f32::INFINITY).unwrap();
-        let dist = (h.point - sphere.center).length();
+        let dist = (h.point - sphere.center()).length();
         assert!((dist - 0.01).abs() < 1e-6, "radius error {}", dist - 0.01);
     }
 

@@ -73,8 +73,8 @@ mod tests {
 
     fn scene() -> ShapeList {
         let mut list = ShapeList::new();
-        list.push(Sphere::new(Vec3::new(0.0, 0.0, -10.0), 1.0));
-        list.push(Sphere::new(Vec3::new(0.0, 0.0, -5.0), 1.0));
+        list.push(Sphere::new(Vec3::new(0.0, 0.0, -10.0), 1.0).unwrap());
+        list.push(Sphere::new(Vec3::new(0.0, 0.0, -5.0), 1.0).unwrap());
         list.push(Plane::new(Vec3::new(0.0, 0.0, -20.0), Vec3::Z, false).unwrap());
         list
     }

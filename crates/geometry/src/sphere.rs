@@ -8,13 +8,21 @@ use std::f32::consts::{PI, TAU};
 /// seen from +z), `v = θ / π` with `θ` the polar angle from +y (v = 0 at the top).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
-    pub center: Vec3,
-    pub radius: f32,
+    center: Vec3,
+    radius: f32,
 }
 
 impl Sphere {
-    pub fn new(center: Vec3, radius: f32) -> Self {
-        Self { center, radius }
+    /// Returns `None` unless `radius` is positive and finite.
+    pub fn new(center: Vec3, radius: f32) -> Option<Self> {
+        (radius > 0.0 && radius.is_finite()).then_some(Self { center, radius })
+    }
+
+    pub fn center(&self) -> Vec3 {
+        self.center
+    }
+    pub fn radius(&self) -> f32 {
+        self.radius
     }
 
     /// The smallest root of |o + t·d − c|² = r² in (0, t_max).

@@ -15,7 +15,7 @@ mod render;
 pub mod sampling;
 mod scene;
 
-pub use direct::DirectIntegrator;
+pub use direct::{DirectIntegrator, SampleContext};
 pub use render::{render, RenderOutput, RenderSettings, RenderStats, SettingsError, TILE_SIZE};
 pub use sampling::SamplePattern;
 pub use scene::{Scene, SceneBuilder, SceneError, Surface};

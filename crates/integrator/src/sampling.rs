@@ -83,7 +83,7 @@ fn fill_latin_hypercube(rng: &mut Pcg32, out: &mut [Vec2]) {
     }
     // Fisher–Yates on the y coordinates pairs the columns with random rows.
     for i in (1..n).rev() {
-        let j = (rng.next_u32() as u64 * (i as u64 + 1) >> 32) as usize;
+        let j = ((rng.next_u32() as u64 * (i as u64 + 1)) >> 32) as usize;
         let (yi, yj) = (out[i].y, out[j].y);
         out[i].y = yj;
         out[j].y = yi;
@@ -121,7 +121,7 @@ pub const PIXEL_STREAM: u64 = u64::MAX;
 /// and of the order in which pixels are rendered.
 pub fn pixel_rng(seed: u64, pixel: u64, sample: u64) -> Pcg32 {
     let state = mix64(mix64(mix64(seed) ^ pixel) ^ sample);
-    Pcg32::new(state, 0xa02b_dbf7_bb3c_0a7)
+    Pcg32::new(state, 0x0a02_bdbf_7bb3_c0a7)
 }
 
 #[cfg(test)]

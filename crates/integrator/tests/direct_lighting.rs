@@ -101,7 +101,7 @@ fn shadowed_points_get_ambient_only_and_misses_are_black() {
     let m = b.material(diffuse(KD));
     b.shape(Plane::new(Vec3::ZERO, Vec3::Y, false).unwrap(), m)
         // A large sphere between the light and the plane's centre of view.
-        .shape(Sphere::new(Vec3::new(0.0, 1.5, -2.0), 0.5), m)
+        .shape(Sphere::new(Vec3::new(0.0, 1.5, -2.0), 0.5).unwrap(), m)
         .point_light(PointLight {
             position: Vec3::new(0.0, 5.0, -2.0),
             color: Vec3::ONE,
@@ -145,7 +145,7 @@ fn box_with_area_light(resolution: UVec2) -> Scene {
     )
     .unwrap();
     b.shape(floor, gray)
-        .shape(Sphere::new(Vec3::new(0.0, -1.0, -5.0), 1.0), gray)
+        .shape(Sphere::new(Vec3::new(0.0, -1.0, -5.0), 1.0).unwrap(), gray)
         .area_light(
             AreaLight::new(
                 Vec3::new(0.0, 2.0, -5.0),

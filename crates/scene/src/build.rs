@@ -53,7 +53,8 @@ pub(crate) fn build(file: SceneFile) -> Result<SceneDescription, Problem> {
 
     for (i, s) in file.sphere.iter().enumerate() {
         let m = lookup(format!("sphere[{i}].material"), &s.material)?;
-        builder.shape(Sphere::new(s.center.0, s.radius.0), m);
+        let sphere = Sphere::new(s.center.0, s.radius.0).expect("radius read as positive");
+        builder.shape(sphere, m);
     }
     for (i, p) in file.parallelogram.iter().enumerate() {
         let field = format!("parallelogram[{i}]");

@@ -168,25 +168,25 @@ fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> {
     Ok(settings)
 }
 
-fn camera(table: &Spanned<CameraTable>, resolution: glam::UVec2) -> Result<Camera, Problem> {
-    let c = table.get_ref();
+fn camera(c: &CameraTable, resolution: glam::UVec2) -> Result<Camera, Problem> {
     Camera::new(
         c.position.0,
-        c.look_at.0,
-        c.up.0,
+        c.look_at.get_ref().0,
+        c.up.get_ref().0,
         c.fov.0,
         c.focal_length.0,
         resolution,
     )
     .map_err(|e| {
-        let field = match e {
-            CameraError::NoForward => "camera.look_at",
-            CameraError::UpParallelToForward => "camera.up",
-            CameraError::FieldOfView(_) => "camera.fov",
-            CameraError::FocalLength(_) => "camera.focal_length",
-            CameraError::Resolution(..) => "render.resolution",
+        // fov, focal length and resolution were range-checked while reading.
+        let (field, span) = match e {
+            CameraError::UpParallelToForward if !c.up.span().is_empty() => {
+                ("camera.up", c.up.span())
+            }
+            CameraError::UpParallelToForward => ("camera.look_at", c.look_at.span()),
+            _ => ("camera.look_at", c.look_at.span()),
         };
-        Problem::new(table.span(), field, e.to_string())
+        Problem::new(span, field, e.to_string())
     })
 }
 

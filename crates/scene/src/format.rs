@@ -14,7 +14,7 @@ pub struct SceneFile {
     /// Ambient light added as `ambient · kd` at every shaded point.
     #[serde(default = "black")]
     pub ambient: Color,
-    pub camera: Spanned<CameraTable>,
+    pub camera: CameraTable,
     #[serde(default)]
     pub render: RenderTable,
     #[serde(default)]
@@ -41,8 +41,8 @@ fn black() -> Color {
 fn white() -> Color {
     Color(glam::Vec3::ONE)
 }
-fn y_up() -> Direction {
-    Direction(glam::Vec3::Y)
+fn y_up() -> Spanned<Direction> {
+    Spanned::new(0..0, Direction(glam::Vec3::Y))
 }
 fn unit_focal_length() -> Positive {
     Positive(1.0)
@@ -52,9 +52,9 @@ fn unit_focal_length() -> Positive {
 #[serde(deny_unknown_fields)]
 pub struct CameraTable {
     pub position: Point,
-    pub look_at: Point,
+    pub look_at: Spanned<Point>,
     #[serde(default = "y_up")]
-    pub up: Direction,
+    pub up: Spanned<Direction>,
     /// Vertical field of view in degrees.
     pub fov: FieldOfView,
     #[serde(default = "unit_focal_length")]

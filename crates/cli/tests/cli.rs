@@ -1,0 +1,192 @@
+//! The `glint` binary as a user runs it: outputs, exit statuses, error lines.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn glint(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("glint runs")
+}
+
+fn scene(name: &str) -> String {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../../scenes/{name}.toml"));
+    p.to_str().unwrap().to_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+const SMALL: [&str; 6] = [
+    "--resolution",
+    "24x24",
+    "--spp",
+    "4",
+    "--light-samples",
+    "4",
+];
+
+#[test]
+fn renders_png_exr_and_pfm_and_prints_a_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    for ext in ["png", "exr", "pfm"] {
+        let out = format!("set1.{ext}");
+        let o = glint(
+            &[&["render", &scene("cornell-set1"), "-o", &out], &SMALL[..]].concat(),
+            dir.path(),
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        let summary = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            summary.starts_with(&format!("wrote {out}: 24x24, 4 spp, 4 light samples")),
+            "{summary}"
+        );
+        assert!(summary.contains("rays/s"));
+        assert!(std::fs::metadata(dir.path().join(&out)).unwrap().len() > 100);
+    }
+    // No temporary files are left behind.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
+}
+
+#[test]
+fn default_output_is_the_scene_name_as_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = glint(
+        &[&["render", &scene("point-light")], &SMALL[..]].concat(),
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.path().join("point-light.png").is_file());
+}
+
+#[test]
+fn one_and_two_threads_write_identical_files() {
+    let dir = tempfile::tempdir().unwrap();
+    for threads in ["1", "2"] {
+        let out = format!("t{threads}.pfm");
+        let args = [
+            "render",
+            &scene("cornell-set3"),
+            "-o",
+            &out,
+            "--threads",
+            threads,
+            "--sampler",
+            "random",
+        ];
+        let o = glint(&[&args[..], &SMALL[..]].concat(), dir.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let a = std::fs::read(dir.path().join("t1.pfm")).unwrap();
+    let b = std::fs::read(dir.path().join("t2.pfm")).unwrap();
+    assert_eq!(a, b);
+}
+
+fn assert_input_error(o: &Output, expected: &str) {
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(o));
+    let err = stderr(o);
+    assert_eq!(err.lines().count(), 1, "not one line: {err}");
+    assert!(err.contains(expected), "{err}");
+    assert!(!err.contains("panicked") && !err.contains("backtrace"));
+}
+
+#[test]
+fn bad_input_gives_one_line_exit_2_and_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, body: &str| std::fs::write(dir.path().join(name), body).unwrap();
+    write("syntax.toml", "[camera\nfov = 45\n");
+    write(
+        "invalid.toml",
+        "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfov = 270\n",
+    );
+    let cases = [
+        ("missing.toml", "missing.toml: cannot read the scene file"),
+        ("syntax.toml", "syntax.toml:1:8: unclosed table"),
+        (
+            "invalid.toml",
+            "invalid.toml:4:7: camera.fov: expected a field of view",
+        ),
+    ];
+    for (file, expected) in cases {
+        let o = glint(&["render", file, "-o", "out.png"], dir.path());
+        assert_input_error(&o, expected);
+    }
+    let o = glint(
+        &["render", &scene("point-light"), "-o", "out.bmp"],
+        dir.path(),
+    );
+    assert_input_error(&o, "unknown output format");
+    let o = glint(
+        &[
+            "render",
+            &scene("point-light"),
+            "--spp",
+            "5",
+            "--sampler",
+            "grid",
+        ],
+        dir.path(),
+    );
+    assert_input_error(&o, "perfect square");
+    let o = glint(
+        &["render", &scene("point-light"), "-o", "no/dir/out.png"],
+        dir.path(),
+    );
+    assert_input_error(&o, "does not exist");
+    let o = glint(
+        &["render", &scene("point-light"), "--threads", "0"],
+        dir.path(),
+    );
+    assert_input_error(&o, "threads must be at least 1");
+    // Usage errors come from clap, also with status 2.
+    let o = glint(&["render", "--no-such-flag"], dir.path());
+    assert_eq!(o.status.code(), Some(2));
+    let o = glint(
+        &["render", &scene("point-light"), "--resolution", "0x5"],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2));
+    // Nothing was written by any failed run.
+    let files: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(files.len(), 2, "{files:?}");
+}
+
+#[test]
+fn a_failed_run_leaves_an_existing_output_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("keep.png"), b"precious").unwrap();
+    std::fs::write(dir.path().join("bad.toml"), "[camera]\nfov = 45\n").unwrap();
+    let o = glint(&["render", "bad.toml", "-o", "keep.png"], dir.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        std::fs::read(dir.path().join("keep.png")).unwrap(),
+        b"precious"
+    );
+}
+
+#[test]
+fn help_documents_every_flag() {
+    let o = glint(&["render", "--help"], Path::new("."));
+    assert!(o.status.success());
+    let help = String::from_utf8_lossy(&o.stdout);
+    for flag in [
+        "--output",
+        "--spp",
+        "--light-samples",
+        "--sampler",
+        "--light-sampler",
+        "--threads",
+        "--seed",
+        "--resolution",
+    ] {
+        assert!(help.contains(flag), "{flag} undocumented");
+    }
+    let o = glint(&["--help"], Path::new("."));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("render"));
+}

@@ -1,0 +1,158 @@
+//! The shipped scenes load, describe what the course describes, and render
+//! reproducibly.
+
+use glam::{UVec2, Vec3};
+use glint_integrator::{render, RenderSettings, SamplePattern, Surface};
+use glint_lighting::Light;
+use glint_scene::{load, SceneDescription};
+use glint_snapfmt::sig5;
+use glint_tests::{scene_path, shipped_scenes};
+use std::fmt::Write;
+
+fn cornell(set: u32) -> SceneDescription {
+    load(&scene_path(&format!("cornell-set{set}"))).unwrap()
+}
+
+#[test]
+fn every_shipped_scene_loads() {
+    let names = shipped_scenes();
+    for expected in [
+        "cornell-set1",
+        "cornell-set2",
+        "cornell-set3",
+        "point-light",
+    ] {
+        assert!(names.iter().any(|n| n == expected), "{expected} missing");
+    }
+    for name in names {
+        let d = load(&scene_path(&name)).unwrap_or_else(|e| panic!("{e}"));
+        assert!(d.settings.validate().is_ok(), "{name}");
+        assert!(!d.scene.lights.is_empty(), "{name} has no light");
+    }
+}
+
+#[test]
+fn cornell_sets_match_the_course_numbers() {
+    let sets = [
+        (
+            Vec3::new(0.0, 0.0, 10.0),
+            Vec3::new(0.0, 5.9, -6.0),
+            Vec3::ONE,
+        ),
+        (
+            Vec3::new(5.0, 3.0, 12.0),
+            Vec3::new(3.0, 5.9, -6.0),
+            Vec3::new(0.9, 0.8, 0.0),
+        ),
+        (
+            Vec3::new(0.0, -4.0, 15.0),
+            Vec3::new(-3.0, 5.9, -6.0),
+            Vec3::new(0.0, 0.9, 0.7),
+        ),
+    ];
+    for (i, (eye, light_centre, light_color)) in sets.into_iter().enumerate() {
+        let d = cornell(i as u32 + 1);
+        let s = &d.scene;
+        assert_eq!(s.camera.position(), eye);
+        assert!((s.camera.fov_y().to_degrees() - 45.0).abs() < 1e-4);
+        assert_eq!(s.ambient, Vec3::splat(0.1));
+        assert_eq!(s.shapes.len(), 5 + 4 + 1, "walls, spheres, light");
+        let emitters = s
+            .surfaces
+            .iter()
+            .filter(|x| matches!(x, Surface::Emitter(_)))
+            .count();
+        assert_eq!(emitters, 1);
+        let Light::Area(light) = &s.lights[0] else {
+            panic!("set {} light is not an area light", i + 1)
+        };
+        assert_eq!(light.color, light_color);
+        assert_eq!(light.surface().center(), light_centre);
+        assert_eq!(light.surface().normal(), -Vec3::Y);
+        assert!((light.surface().area() - 4.0).abs() < 1e-6);
+    }
+    // The three sets share everything but camera and light.
+    let (a, b) = (cornell(1).scene, cornell(3).scene);
+    assert_eq!(a.materials, b.materials);
+    assert_eq!(a.shapes.shapes()[..9], b.shapes.shapes()[..9]);
+}
+
+/// A 16×16 render of Set1 with the course's grid patterns (4 spp, 4 light
+/// samples), every pixel's RGB locked to five significant digits.
+#[test]
+fn cornell_set1_16x16_render_snapshot() {
+    let d = cornell(1);
+    let camera = d.scene.camera.with_resolution(UVec2::new(16, 16)).unwrap();
+    let scene = glint_integrator::Scene { camera, ..d.scene };
+    let settings = RenderSettings {
+        spp: 4,
+        pixel_pattern: SamplePattern::Grid,
+        light_samples: 4,
+        light_pattern: SamplePattern::Grid,
+        ..d.settings
+    };
+    let film = render(&scene, &settings, &|_, _| {}).unwrap().film;
+    let mut s = String::new();
+    for y in 0..16 {
+        for x in 0..16 {
+            let p = film.pixel(x, y);
+            writeln!(s, "({x:2},{y:2}) {} {} {}", sig5(p.x), sig5(p.y), sig5(p.z)).unwrap();
+        }
+    }
+    insta::assert_snapshot!(s);
+}
+
+#[test]
+fn cornell_set1_renders_the_course_picture() {
+    // Coarse properties of the picture, at 64×64: the walls' colors and the
+    // light's own color where the camera sees it.
+    let d = cornell(1);
+    let camera = d.scene.camera.with_resolution(UVec2::new(64, 64)).unwrap();
+    let scene = glint_integrator::Scene { camera, ..d.scene };
+    let settings = RenderSettings {
+        spp: 4,
+        light_samples: 4,
+        ..d.settings
+    };
+    let film = render(&scene, &settings, &|_, _| {}).unwrap().film;
+    let left_wall = film.pixel(2, 52);
+    let right_wall = film.pixel(61, 52);
+    let back_wall = film.pixel(32, 40);
+    // Lit walls reflect more than the ambient term alone (0.1 · kd).
+    assert!(
+        left_wall.x > 0.12 && left_wall.y == 0.0 && left_wall.z == 0.0,
+        "{left_wall}"
+    );
+    assert!(
+        right_wall.y > 0.12 && right_wall.x == 0.0 && right_wall.z == 0.0,
+        "{right_wall}"
+    );
+    assert!(back_wall.x > 0.084 && back_wall.x == back_wall.y && back_wall.y == back_wall.z);
+    // The light's square is seen in its own color (white) near the top centre.
+    let light_pixels = (0..12)
+        .flat_map(|y| (24..40).map(move |x| (x, y)))
+        .filter(|&(x, y)| film.pixel(x, y) == Vec3::ONE)
+        .count();
+    assert!(light_pixels >= 4, "light covers {light_pixels} pixels");
+}
+
+#[test]
+fn shipped_scene_renders_identically_on_1_and_2_threads() {
+    let d = cornell(2);
+    let camera = d.scene.camera.with_resolution(UVec2::new(48, 40)).unwrap();
+    let scene = glint_integrator::Scene { camera, ..d.scene };
+    let at = |threads| {
+        let settings = RenderSettings {
+            spp: 4,
+            light_samples: 3,
+            light_pattern: SamplePattern::Random,
+            threads: Some(threads),
+            ..d.settings.clone()
+        };
+        render(&scene, &settings, &|_, _| {})
+            .unwrap()
+            .film
+            .to_srgb8()
+    };
+    assert_eq!(at(1), at(2));
+}

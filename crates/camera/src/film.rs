@@ -110,11 +110,21 @@ impl Film {
             Some(p) if !p.as_os_str().is_empty() => p,
             _ => Path::new("."),
         };
-        let mut tmp = tempfile::Builder::new()
-            .prefix(".glint-")
-            .suffix(".partial")
-            .tempfile_in(dir)
-            .map_err(io_err)?;
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(".glint-").suffix(".partial");
+        // Temporary files are owner-only by default; the image should get the
+        // permissions of the file it replaces, or those of any new file (umask).
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let mut tmp = builder.tempfile_in(dir).map_err(io_err)?;
+        if let Ok(existing) = std::fs::metadata(path) {
+            tmp.as_file()
+                .set_permissions(existing.permissions())
+                .map_err(io_err)?;
+        }
         {
             let mut out = BufWriter::new(tmp.as_file_mut());
             self.encode(format, &mut out, path)?;
@@ -263,6 +273,32 @@ mod tests {
             Err(FilmError::UnknownFormat(_))
         ));
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn written_files_get_ordinary_permissions_and_keep_existing_ones() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let fresh = dir.path().join("fresh.png");
+        gradient().save(&fresh).unwrap();
+        let mode = std::fs::metadata(&fresh).unwrap().permissions().mode() & 0o777;
+        // Whatever the umask, a new image is readable by its owner and not owner-only
+        // by accident of the temporary file (which is created 0600).
+        assert_eq!(mode & 0o600, 0o600);
+        let umask_allows_group_read = {
+            let probe = dir.path().join("probe");
+            std::fs::write(&probe, b"").unwrap();
+            std::fs::metadata(&probe).unwrap().permissions().mode() & 0o040 != 0
+        };
+        assert_eq!(mode & 0o040 != 0, umask_allows_group_read);
+
+        let existing = dir.path().join("existing.pfm");
+        std::fs::write(&existing, b"old").unwrap();
+        std::fs::set_permissions(&existing, std::fs::Permissions::from_mode(0o640)).unwrap();
+        gradient().save(&existing).unwrap();
+        let mode = std::fs::metadata(&existing).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o640);
     }
 
     #[test]

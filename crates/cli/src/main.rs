@@ -146,6 +146,7 @@ fn render(args: &RenderArgs) -> Result<(), Failure> {
     let SceneDescription {
         mut scene,
         mut settings,
+        ..
     } = glint_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
     apply_overrides(args, &mut settings);
     if let Some(resolution) = args.resolution {

@@ -17,6 +17,8 @@ use toml::Spanned;
 pub struct SceneDescription {
     pub scene: Scene,
     pub settings: RenderSettings,
+    /// `material_names[i]` is the file's name for `scene.materials[i]`.
+    pub material_names: Vec<String>,
 }
 
 pub(crate) fn build(file: SceneFile) -> Result<SceneDescription, Problem> {
@@ -98,7 +100,12 @@ pub(crate) fn build(file: SceneFile) -> Result<SceneDescription, Problem> {
     let scene = builder
         .build(camera)
         .expect("material ids were resolved above");
-    Ok(SceneDescription { scene, settings })
+    let material_names = file.materials.keys().cloned().collect();
+    Ok(SceneDescription {
+        scene,
+        settings,
+        material_names,
+    })
 }
 
 fn no_area(field: &str, edge1: &Spanned<crate::values::Point>) -> Problem {

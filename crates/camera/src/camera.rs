@@ -69,11 +69,14 @@ impl Camera {
         let forward = (look_at - position)
             .try_normalize()
             .ok_or(CameraError::NoForward)?;
-        let right = forward
-            .cross(up_ref)
+        // |forward × up| is the sine of the angle between them; below ~0.06° the
+        // roll of the camera would be decided by rounding noise.
+        let right = up_ref
             .try_normalize()
-            .filter(|r| r.cross(forward).length() > 1e-6)
-            .ok_or(CameraError::UpParallelToForward)?;
+            .map(|up| forward.cross(up))
+            .filter(|r| r.length() > 1e-3)
+            .ok_or(CameraError::UpParallelToForward)?
+            .normalize();
         let up = right.cross(forward);
         let fov_y = fov_y_degrees.to_radians();
         let half_height = focal_length * (0.5 * fov_y).tan();
@@ -136,17 +139,18 @@ impl Camera {
         self.resolution
     }
 
-    /// The same camera with a different film resolution (aspect ratio follows).
+    /// The same camera with a different film resolution: the basis and the
+    /// vertical field of view are kept, the horizontal extent follows the aspect ratio.
     pub fn with_resolution(&self, resolution: UVec2) -> Result<Self, CameraError> {
-        let look_at = self.position + self.forward;
-        Self::new(
-            self.position,
-            look_at,
-            self.up,
-            self.fov_y.to_degrees(),
-            self.focal_length,
+        if resolution.x == 0 || resolution.y == 0 {
+            return Err(CameraError::Resolution(resolution.x, resolution.y));
+        }
+        let aspect = resolution.x as f32 / resolution.y as f32;
+        Ok(Self {
             resolution,
-        )
+            half_width: aspect * self.half_height,
+            ..self.clone()
+        })
     }
 }
 
@@ -241,5 +245,32 @@ mod tests {
             Err(CameraError::UpParallelToForward)
         );
         assert_eq!(ok(45.0, 1.0, res, Vec3::Y), Ok(()));
+        // Nearly parallel up vectors (here off by rounding noise) are refused too.
+        let dir = Vec3::new(0.3, 0.7, 1.1);
+        let near = Camera::new(Vec3::ZERO, dir, dir + Vec3::splat(1e-7), 45.0, 1.0, res);
+        assert_eq!(near.map(|_| ()), Err(CameraError::UpParallelToForward));
+    }
+
+    #[test]
+    fn a_new_resolution_keeps_the_view_even_far_from_the_origin() {
+        let far = Vec3::new(3.0e7, -2.0e7, 1.0e7);
+        let cam = Camera::new(
+            far,
+            far + Vec3::new(0.3, 0.1, -1.0),
+            Vec3::Y,
+            40.0,
+            1.0,
+            UVec2::new(8, 8),
+        )
+        .unwrap();
+        let wide = cam.with_resolution(UVec2::new(16, 8)).unwrap();
+        assert_eq!(
+            (wide.forward(), wide.right(), wide.up()),
+            (cam.forward(), cam.right(), cam.up())
+        );
+        assert_eq!(wide.film_half_extent().0, 2.0 * cam.film_half_extent().0);
+        assert_eq!(wide.film_half_extent().1, cam.film_half_extent().1);
+        assert_eq!(wide.generate_ray(8.0, 4.0), cam.generate_ray(4.0, 4.0));
+        assert!(cam.with_resolution(UVec2::new(0, 3)).is_err());
     }
 }

@@ -72,6 +72,11 @@ impl Film {
         &self.pixels
     }
 
+    /// All pixels, mutable, row-major from the top-left corner.
+    pub fn pixels_mut(&mut self) -> &mut [Vec3] {
+        &mut self.pixels
+    }
+
     pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
         self.pixels[self.index(x, y)]
     }

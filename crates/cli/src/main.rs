@@ -112,22 +112,25 @@ enum Failure {
     Input(String),
     /// Anything else (I/O while writing, thread start-up). Exit status 1.
     Other(String),
+    /// A bug; the panic hook has already printed it. Exit status 1.
+    Panicked,
 }
 
 fn main() -> ExitCode {
+    // A panic is a bug, never a reaction to input: report it on one line and
+    // exit with status 1 (caught below) instead of Rust's 101 and a backtrace hint.
     std::panic::set_hook(Box::new(|info| {
-        eprintln!("glint: internal error (please report): {info}");
+        let message = info.to_string().replace('\n', " ");
+        eprintln!("glint: internal error (please report): {message}");
     }));
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
-        Err(e) => {
-            let _ = e.print();
-            return ExitCode::from(e.exit_code().clamp(0, 255) as u8);
-        }
+        Err(e) => return usage_error(e),
     };
-    let result = match cli.command {
-        Command::Render(args) => render(&args),
-    };
+    let result = std::panic::catch_unwind(|| match &cli.command {
+        Command::Render(args) => render(args),
+    })
+    .unwrap_or(Err(Failure::Panicked));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(message)) => {
@@ -138,10 +141,26 @@ fn main() -> ExitCode {
             eprintln!("glint: error: {message}");
             ExitCode::from(1)
         }
+        Err(Failure::Panicked) => ExitCode::from(1),
     }
 }
 
+/// Help and version go to stdout in full; a usage error is one line on stderr
+/// (clap's first line, which names the problem) with exit status 2.
+fn usage_error(e: clap::Error) -> ExitCode {
+    if !e.use_stderr() {
+        let _ = e.print();
+        return ExitCode::SUCCESS;
+    }
+    let rendered = e.render().to_string();
+    let first = rendered.lines().next().unwrap_or("invalid usage");
+    let problem = first.strip_prefix("error: ").unwrap_or(first);
+    eprintln!("glint: error: {problem} (see glint --help)");
+    ExitCode::from(2)
+}
+
 fn render(args: &RenderArgs) -> Result<(), Failure> {
+    let start = std::time::Instant::now();
     let output = output_path(args)?;
     let SceneDescription {
         mut scene,
@@ -179,12 +198,13 @@ fn render(args: &RenderArgs) -> Result<(), Failure> {
     let stats = rendered.stats;
     let resolution = rendered.film.resolution();
     println!(
-        "wrote {}: {}x{}, {} spp, {} light samples, {:.2} s, {} rays ({:.2} M rays/s)",
+        "wrote {}: {}x{}, {} spp, {} light samples, {:.2} s wall ({:.2} s rendering), {} rays ({:.2} M rays/s)",
         output.display(),
         resolution.x,
         resolution.y,
         settings.spp,
         settings.light_samples,
+        start.elapsed().as_secs_f64(),
         stats.elapsed.as_secs_f64(),
         stats.rays(),
         stats.rays_per_second() / 1e6,
@@ -192,8 +212,9 @@ fn render(args: &RenderArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The output path, checked before any rendering: a known extension and an
-/// existing directory.
+/// The output path, checked before any rendering: a known extension, an existing
+/// directory, and one we may create files in (probed with a temporary file that
+/// is removed at once, so an interrupted render leaves nothing behind).
 fn output_path(args: &RenderArgs) -> Result<PathBuf, Failure> {
     let path = match &args.output {
         Some(p) => p.clone(),
@@ -219,6 +240,15 @@ fn output_path(args: &RenderArgs) -> Result<PathBuf, Failure> {
             path.display()
         )));
     }
+    tempfile::Builder::new()
+        .prefix(".glint-probe-")
+        .tempfile_in(dir.unwrap_or(Path::new(".")))
+        .map_err(|e| {
+            Failure::Input(format!(
+                "{}: cannot write to the output directory: {e}",
+                path.display()
+            ))
+        })?;
     Ok(path)
 }
 

@@ -40,13 +40,21 @@ impl AaBox {
     }
 
     /// Slab test: the entry distance if the ray starts outside, else the exit distance.
+    ///
+    /// An axis the ray runs parallel to (direction component ±0) gives no slab
+    /// interval: the ray is inside that slab for every t, or never. Handling it
+    /// explicitly avoids 0·∞ = NaN when the origin lies on the slab's boundary.
     pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        let parallel = ray.direction.cmpeq(Vec3::ZERO);
+        let inside = ray.origin.cmpge(self.min) & ray.origin.cmple(self.max);
+        if (parallel & !inside).any() {
+            return None;
+        }
         let inv = ray.direction.recip();
         let t_a = (self.min - ray.origin) * inv;
         let t_b = (self.max - ray.origin) * inv;
-        // NaN (0·∞ on a slab boundary) is dropped by min/max against the other slab.
-        let t_near = t_a.min(t_b).max_element();
-        let t_far = t_a.max(t_b).min_element();
+        let t_near = Vec3::select(parallel, Vec3::NEG_INFINITY, t_a.min(t_b)).max_element();
+        let t_far = Vec3::select(parallel, Vec3::INFINITY, t_a.max(t_b)).min_element();
         if t_near > t_far {
             return None;
         }

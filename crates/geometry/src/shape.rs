@@ -216,6 +216,37 @@ mod tests {
     }
 
     #[test]
+    fn axis_parallel_rays_hit_or_miss_a_box_consistently() {
+        let b = Shape::from(AaBox::new(-Vec3::ONE, Vec3::ONE).unwrap());
+        for axis in 0..3 {
+            for sign in [-1.0f32, 1.0] {
+                let mut dir = Vec3::ZERO;
+                dir[axis] = -sign;
+                let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+                for (ou, ow, hits) in [
+                    (0.0, 0.0, true),
+                    (1.0, 0.0, true),  // grazing the face at +1
+                    (-1.0, 0.0, true), // grazing the face at −1
+                    (1.0, -1.0, true), // along an edge
+                    (1.5, 0.0, false),
+                    (0.0, -1.01, false),
+                ] {
+                    let mut origin = Vec3::ZERO;
+                    origin[axis] = 5.0 * sign;
+                    origin[u] = ou;
+                    origin[w] = ow;
+                    let got = b.hit_distance(&Ray::new(origin, dir), f32::INFINITY);
+                    assert_eq!(
+                        got,
+                        hits.then_some(4.0),
+                        "axis {axis} sign {sign} at {origin}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn t_max_limits_hits() {
         for (name, shape) in shapes() {
             let ray = Ray::new(Vec3::ZERO, Vec3::new(0.0, -0.1, -1.0));

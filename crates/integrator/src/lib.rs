@@ -7,8 +7,9 @@
 //! - Determinism: every random number a pixel uses comes from a generator seeded by
 //!   `(seed, pixel index, sample index)` ([`sampling::pixel_rng`]), never from a shared
 //!   generator, so the image is bit-identical for any thread count or tile order.
-//! - Work is split into square tiles ([`TILE_SIZE`]) rendered in parallel with rayon;
-//!   per-tile scratch buffers are allocated once per tile, never per ray.
+//! - Work is split into tiles of [`TILE_SIZE`] full rows, rendered in parallel with
+//!   rayon straight into the film; scratch buffers are allocated once per tile,
+//!   never per ray.
 
 mod direct;
 mod render;
@@ -16,6 +17,9 @@ pub mod sampling;
 mod scene;
 
 pub use direct::{DirectIntegrator, SampleContext};
-pub use render::{render, RenderOutput, RenderSettings, RenderStats, SettingsError, TILE_SIZE};
+pub use render::{
+    render, RenderOutput, RenderSettings, RenderStats, SampleCount, SettingsError, MAX_SAMPLES,
+    MAX_THREADS, TILE_SIZE,
+};
 pub use sampling::SamplePattern;
 pub use scene::{Scene, SceneBuilder, SceneError, Surface};

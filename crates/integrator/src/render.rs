@@ -1,13 +1,23 @@
 use crate::direct::SampleContext;
 use crate::sampling::{pixel_rng, SamplePattern, PIXEL_STREAM};
 use crate::{DirectIntegrator, Scene};
-use glam::{UVec2, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use glint_camera::Film;
+use glint_geometry::Ray;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-/// Side of the square tiles the image is split into for parallel rendering.
+/// Height in rows of the tiles (full-width bands) the image is split into for
+/// parallel rendering.
 pub const TILE_SIZE: u32 = 16;
+
+/// The most worker threads a render accepts.
+pub const MAX_THREADS: usize = 1024;
+
+/// The most samples per pixel, and per light, a render accepts: each worker keeps
+/// a buffer of that many sample positions, so the bound keeps memory bounded.
+pub const MAX_SAMPLES: u32 = 1 << 20;
 
 /// How to render: samples per pixel and per light, their patterns, the seed of
 /// every random stream, and the number of threads.
@@ -37,15 +47,35 @@ impl Default for RenderSettings {
     }
 }
 
+/// Which sample count a [`SettingsError`] is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampleCount {
+    /// Camera samples per pixel (`spp`).
+    PerPixel,
+    /// Samples per area light per camera sample.
+    PerLight,
+}
+
+impl std::fmt::Display for SampleCount {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(match self {
+            SampleCount::PerPixel => "spp",
+            SampleCount::PerLight => "light samples",
+        })
+    }
+}
+
 /// Settings that cannot be rendered.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SettingsError {
     #[error("{what} must be at least 1")]
-    Zero { what: &'static str },
+    Zero { what: SampleCount },
+    #[error("{what} is {count}, more than the limit of {MAX_SAMPLES}")]
+    TooMany { what: SampleCount, count: u32 },
     #[error("{what} is {count}, but the grid pattern needs a perfect square (1, 4, 9, 16, …)")]
-    GridNotSquare { what: &'static str, count: u32 },
-    #[error("threads must be at least 1")]
-    ZeroThreads,
+    GridNotSquare { what: SampleCount, count: u32 },
+    #[error("threads must be from 1 to {MAX_THREADS}, got {0}")]
+    Threads(usize),
     #[error("could not start the worker threads: {0}")]
     ThreadPool(String),
 }
@@ -54,18 +84,25 @@ impl RenderSettings {
     /// Checks that the counts are positive and fit their patterns.
     pub fn validate(&self) -> Result<(), SettingsError> {
         for (what, count, pattern) in [
-            ("spp", self.spp, self.pixel_pattern),
-            ("light samples", self.light_samples, self.light_pattern),
+            (SampleCount::PerPixel, self.spp, self.pixel_pattern),
+            (
+                SampleCount::PerLight,
+                self.light_samples,
+                self.light_pattern,
+            ),
         ] {
             if count == 0 {
                 return Err(SettingsError::Zero { what });
+            }
+            if count > MAX_SAMPLES {
+                return Err(SettingsError::TooMany { what, count });
             }
             if !pattern.supports(count) {
                 return Err(SettingsError::GridNotSquare { what, count });
             }
         }
-        if self.threads == Some(0) {
-            return Err(SettingsError::ZeroThreads);
+        if let Some(n) = self.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
+            return Err(SettingsError::Threads(n));
         }
         Ok(())
     }
@@ -96,32 +133,12 @@ pub struct RenderOutput {
     pub stats: RenderStats,
 }
 
-/// A rectangle of pixels `[min, max)`.
-#[derive(Clone, Copy, Debug)]
-struct Tile {
-    min: UVec2,
-    max: UVec2,
-}
-
-fn tiles(resolution: UVec2) -> Vec<Tile> {
-    let mut tiles = Vec::new();
-    for y in (0..resolution.y).step_by(TILE_SIZE as usize) {
-        for x in (0..resolution.x).step_by(TILE_SIZE as usize) {
-            let min = UVec2::new(x, y);
-            tiles.push(Tile {
-                min,
-                max: (min + TILE_SIZE).min(resolution),
-            });
-        }
-    }
-    tiles
-}
-
 /// Renders `scene` with the direct integrator, in parallel over tiles.
 ///
-/// `on_tile_done(done, total)` is called after each tile (from worker threads), for
-/// progress reporting. The result does not depend on the thread count or on the
-/// order tiles finish in.
+/// Tiles are bands of [`TILE_SIZE`] full rows, rendered straight into the film
+/// (no second copy of the image). `on_tile_done(done, total)` is called after each
+/// tile (from worker threads), for progress reporting. The result does not depend
+/// on the thread count or on the order tiles finish in.
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
@@ -149,61 +166,55 @@ fn render_on_current_pool(
         light_samples: settings.light_samples,
         light_pattern: settings.light_pattern,
     };
-    let tiles = tiles(resolution);
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    let rendered: Vec<(Vec<Vec3>, u64)> = tiles
-        .par_iter()
-        .map(|tile| {
-            let result = render_tile(scene, settings, &integrator, *tile);
-            let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            on_tile_done(finished, tiles.len());
-            result
-        })
-        .collect();
-
     let mut film = Film::new(resolution);
-    let mut stats = RenderStats::default();
-    for (tile, (pixels, shadow_rays)) in tiles.iter().zip(rendered) {
-        let width = tile.max.x - tile.min.x;
-        for (i, radiance) in pixels.into_iter().enumerate() {
-            let x = tile.min.x + i as u32 % width;
-            let y = tile.min.y + i as u32 / width;
-            film.set_pixel(x, y, radiance);
-        }
-        stats.shadow_rays += shadow_rays;
-    }
-    stats.camera_rays = resolution.x as u64 * resolution.y as u64 * settings.spp as u64;
-    stats.elapsed = start.elapsed();
+    let band = (TILE_SIZE * resolution.x) as usize;
+    let total = film.pixels().len().div_ceil(band);
+    let done = AtomicUsize::new(0);
+    let shadow_rays: u64 = film
+        .pixels_mut()
+        .par_chunks_mut(band)
+        .enumerate()
+        .map(|(i, pixels)| {
+            let first_row = i as u32 * TILE_SIZE;
+            let rays = render_rows(scene, settings, &integrator, first_row, pixels);
+            on_tile_done(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+            rays
+        })
+        .sum();
+    let stats = RenderStats {
+        camera_rays: resolution.x as u64 * resolution.y as u64 * settings.spp as u64,
+        shadow_rays,
+        elapsed: start.elapsed(),
+    };
     RenderOutput { film, stats }
 }
 
-/// The tile's pixels in row-major order, and the shadow rays it traced.
-fn render_tile(
+/// Renders the rows starting at `first_row` into `pixels` (whole rows, row-major);
+/// returns the number of shadow rays traced.
+fn render_rows(
     scene: &Scene,
     settings: &RenderSettings,
     integrator: &DirectIntegrator,
-    tile: Tile,
-) -> (Vec<Vec3>, u64) {
-    let width = scene.camera.resolution().x as u64;
-    let size = tile.max - tile.min;
-    let mut pixels = Vec::with_capacity((size.x * size.y) as usize);
+    first_row: u32,
+    pixels: &mut [Vec3],
+) -> u64 {
+    let width = scene.camera.resolution().x;
     let mut pixel_samples = vec![Vec2::ZERO; settings.spp as usize];
     let mut ctx = SampleContext::new(settings.light_samples);
-    for y in tile.min.y..tile.max.y {
-        for x in tile.min.x..tile.max.x {
-            let pixel = y as u64 * width + x as u64;
-            let mut rng = pixel_rng(settings.seed, pixel, PIXEL_STREAM);
-            settings.pixel_pattern.fill(&mut rng, &mut pixel_samples);
-            let mut sum = Vec3::ZERO;
-            for (sample, offset) in pixel_samples.iter().enumerate() {
-                ctx.rng = pixel_rng(settings.seed, pixel, sample as u64);
-                let raster = Vec2::new(x as f32, y as f32) + *offset;
-                let camera_ray = scene.camera.generate_ray(raster.x, raster.y);
-                let ray = glint_geometry::Ray::new(camera_ray.origin, camera_ray.direction);
-                sum += integrator.li(scene, &ray, &mut ctx);
-            }
-            pixels.push(sum / settings.spp as f32);
+    for (offset, radiance) in pixels.iter_mut().enumerate() {
+        let (x, y) = (offset as u32 % width, first_row + offset as u32 / width);
+        let pixel = y as u64 * width as u64 + x as u64;
+        let mut rng = pixel_rng(settings.seed, pixel, PIXEL_STREAM);
+        settings.pixel_pattern.fill(&mut rng, &mut pixel_samples);
+        let mut sum = Vec3::ZERO;
+        for (sample, jitter) in pixel_samples.iter().enumerate() {
+            ctx.rng = pixel_rng(settings.seed, pixel, sample as u64);
+            let raster = Vec2::new(x as f32, y as f32) + *jitter;
+            let camera_ray = scene.camera.generate_ray(raster.x, raster.y);
+            let ray = Ray::new(camera_ray.origin, camera_ray.direction);
+            sum += integrator.li(scene, &ray, &mut ctx);
         }
+        *radiance = sum / settings.spp as f32;
     }
-    (pixels, ctx.shadow_rays)
+    ctx.shadow_rays
 }

@@ -46,8 +46,11 @@ impl SamplePattern {
         n > 0 && (self != Self::Grid || exact_sqrt(n).is_some())
     }
 
-    /// Fills `out` with `out.len()` points of this pattern. The caller guarantees
-    /// [`Self::supports`]`(out.len())`.
+    /// Fills `out` with `out.len()` points of this pattern.
+    ///
+    /// # Panics
+    /// If the pattern does not [support](Self::supports) `out.len()` points (a grid
+    /// of a non-square count); [`crate::RenderSettings::validate`] rules this out.
     pub fn fill(self, rng: &mut Pcg32, out: &mut [Vec2]) {
         let n = out.len() as u32;
         match (self, exact_sqrt(n)) {
@@ -61,8 +64,8 @@ impl SamplePattern {
 }
 
 fn exact_sqrt(n: u32) -> Option<u32> {
-    let k = (n as f64).sqrt().round() as u32;
-    (k * k == n).then_some(k)
+    let k = (n as f64).sqrt().round() as u64;
+    (k * k == n as u64).then_some(k as u32)
 }
 
 /// Cell `(i, j)` of a `k × k` grid gets the point `((i, j) + offset) / k`.
@@ -145,6 +148,8 @@ mod tests {
         assert!(SamplePattern::Grid.supports(9));
         assert!(SamplePattern::Stratified.supports(8));
         assert!(!SamplePattern::Random.supports(0));
+        assert!(!SamplePattern::Grid.supports(u32::MAX));
+        assert!(SamplePattern::Grid.supports(65535 * 65535));
     }
 
     #[test]

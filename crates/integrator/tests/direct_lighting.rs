@@ -288,6 +288,14 @@ fn invalid_settings_are_refused() {
             threads: Some(0),
             ..Default::default()
         },
+        RenderSettings {
+            spp: u32::MAX,
+            ..Default::default()
+        },
+        RenderSettings {
+            light_samples: glint_integrator::MAX_SAMPLES + 1,
+            ..Default::default()
+        },
     ] {
         assert!(render(&scene, &bad, &|_, _| {}).is_err(), "{bad:?}");
     }

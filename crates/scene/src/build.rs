@@ -6,7 +6,7 @@ use crate::format::*;
 use glam::Vec3;
 use glint_camera::{Camera, CameraError};
 use glint_geometry::{AaBox, Parallelogram, Plane, Sphere};
-use glint_integrator::{RenderSettings, Scene, SceneBuilder};
+use glint_integrator::{RenderSettings, SampleCount, Scene, SceneBuilder, SettingsError};
 use glint_lighting::{AreaLight, PhongMaterial, PointLight};
 use glint_texture::{Checkerboard, Texture};
 use std::collections::BTreeMap;
@@ -68,7 +68,8 @@ pub(crate) fn build(file: SceneFile) -> Result<SceneDescription, Problem> {
     }
     for (i, p) in file.plane.iter().enumerate() {
         let m = lookup(format!("plane[{i}].material"), &p.material)?;
-        let plane = Plane::new(p.point.0, p.normal.0, p.two_sided).expect("normal is non-zero");
+        // `Direction` guarantees a normal that normalizes.
+        let plane = Plane::new(p.point.0, p.normal.0, p.two_sided).expect("normalizable normal");
         builder.shape(plane, m);
     }
     for (i, b) in file.boxes.iter().enumerate() {
@@ -149,29 +150,31 @@ fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> {
         seed: render.seed,
         threads: None,
     };
-    for (field, count, sampler) in [
-        ("render.spp", &render.spp, &render.pixel_sampler),
-        (
-            "render.light_samples",
-            &render.light_samples,
-            &render.light_sampler,
-        ),
-    ] {
-        let n = count.get_ref().0;
-        if !sampler.get_ref().0.supports(n) {
-            // Point at the count if the file set it, else at the sampler.
-            let span = if count.span().is_empty() {
-                sampler.span()
-            } else {
-                count.span()
-            };
-            return Err(Problem::new(
-                span,
-                field,
-                format!("the grid sampler needs a perfect square (1, 4, 9, 16, …), got {n}"),
-            ));
-        }
-    }
+    settings.validate().map_err(|e| {
+        let (field, count, sampler) = match e {
+            SettingsError::Zero { what }
+            | SettingsError::TooMany { what, .. }
+            | SettingsError::GridNotSquare { what, .. } => match what {
+                SampleCount::PerPixel => ("render.spp", &render.spp, &render.pixel_sampler),
+                SampleCount::PerLight => (
+                    "render.light_samples",
+                    &render.light_samples,
+                    &render.light_sampler,
+                ),
+            },
+            // The file sets no thread count, so these cannot come from it.
+            SettingsError::Threads(_) | SettingsError::ThreadPool(_) => {
+                return Problem::new(0..0, "render", e.to_string());
+            }
+        };
+        // Point at the count if the file set it, else at the sampler.
+        let span = if count.span().is_empty() {
+            sampler.span()
+        } else {
+            count.span()
+        };
+        Problem::new(span, field, e.to_string())
+    })?;
     Ok(settings)
 }
 

@@ -10,6 +10,10 @@ use std::fmt;
 /// Largest accepted film side, in pixels: bounds the memory a scene can ask for.
 pub const MAX_RESOLUTION: u32 = 16384;
 
+/// Largest accepted magnitude of any number in a scene. Beyond it f32 geometry
+/// loses all precision (a ULP of 1e12 is 65536) and squares overflow to infinity.
+pub const MAX_MAGNITUDE: f32 = 1e12;
+
 /// Any TOML number (integer or float) as f32; anything else is refused with a
 /// message that says a number was expected.
 struct Number(f32);
@@ -37,10 +41,14 @@ impl<'de> Deserialize<'de> for Number {
 }
 
 fn finite<E: de::Error>(v: f32) -> Result<f32, E> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
+    if !v.is_finite() {
         Err(E::custom(format!("expected a finite number, got {v}")))
+    } else if v.abs() > MAX_MAGNITUDE {
+        Err(E::custom(format!(
+            "expected a number of magnitude at most {MAX_MAGNITUDE:e}, got {v:e}"
+        )))
+    } else {
+        Ok(v)
     }
 }
 
@@ -96,7 +104,7 @@ validated!(
 );
 validated!(
     /// A direction `[x, y, z]`: finite and not zero.
-    Direction(Vec3) via vector, |v| v.length_squared() > 0.0, "a non-zero direction [x, y, z]"
+    Direction(Vec3) via vector, |v| v.try_normalize().is_some(), "a non-zero direction [x, y, z]"
 );
 validated!(
     /// A linear RGB color `[r, g, b]` with no negative component.

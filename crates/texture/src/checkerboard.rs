@@ -3,8 +3,9 @@ use glam::{Vec2, Vec3};
 /// `checks × checks` squares over the unit uv square, alternating two colors.
 ///
 /// The check containing `uv` is `(⌊u·N⌋, ⌊v·N⌋)`; it takes `colors[0]` when the sum
-/// of its indices is even and `colors[1]` when odd. The pattern repeats with
-/// period 1 in u and v, so it is seamless on infinite planes.
+/// of its indices is even and `colors[1]` when odd. With an even `checks` the
+/// pattern repeats with period 1 in u and v (seamless across the sphere's u = 0
+/// seam and between plane tiles); with an odd count, the period is 2.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkerboard {
     pub colors: [Vec3; 2],
@@ -22,8 +23,9 @@ impl Checkerboard {
     #[inline]
     pub fn evaluate(&self, uv: Vec2) -> Vec3 {
         let cell = (uv * self.checks as f32).floor();
-        // f32 → i64 saturates, and rem_euclid keeps negative cells alternating.
-        let parity = (cell.x as i64 + cell.y as i64).rem_euclid(2);
+        // f32 → i64 saturates (NaN → 0); the low bit gives the parity of negative
+        // cells too (two's complement), and xor cannot overflow.
+        let parity = ((cell.x as i64) ^ (cell.y as i64)) & 1;
         self.colors[parity as usize]
     }
 }
@@ -45,6 +47,19 @@ mod tests {
         for i in 0..50 {
             let uv = Vec2::new(i as f32 * 0.0173, i as f32 * 0.0311);
             assert_eq!(c.evaluate(uv), c.evaluate(uv + Vec2::X));
+        }
+    }
+
+    #[test]
+    fn huge_and_nan_uv_do_not_panic() {
+        let c = Checkerboard::new(Vec3::ZERO, Vec3::ONE, 8);
+        for uv in [
+            Vec2::splat(1e30),
+            Vec2::new(-1e30, 1e30),
+            Vec2::splat(f32::NAN),
+        ] {
+            let color = c.evaluate(uv);
+            assert!(color == Vec3::ZERO || color == Vec3::ONE);
         }
     }
 

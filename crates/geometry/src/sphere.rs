@@ -36,15 +36,20 @@ impl Sphere {
     pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
         let f = ray.origin - self.center;
         let d = ray.direction;
-        let a = d.length_squared();
         let b = f.dot(d);
         let r2 = self.radius * self.radius;
+        let c = f.length_squared() - r2;
+        // Outside the sphere (c > 0) and moving away (b > 0): both roots are
+        // negative. Most rays against most spheres end here, before any division.
+        if c > 0.0 && b > 0.0 {
+            return None;
+        }
+        let a = d.length_squared();
         let perpendicular = f - (b / a) * d;
         let disc = a * (r2 - perpendicular.length_squared());
         if disc < 0.0 {
             return None;
         }
-        let c = f.length_squared() - r2;
         let q = -(b + b.signum() * disc.sqrt());
         let (t0, t1) = if q == 0.0 {
             let h = (-c / a).max(0.0).sqrt();

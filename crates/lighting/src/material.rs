@@ -73,6 +73,10 @@ impl PhongMaterial {
         };
         if cosine <= 0.0 {
             0.0
+        } else if self.shininess.fract() == 0.0 && self.shininess <= 1024.0 {
+            // Integral exponents (the usual case) by repeated squaring: several
+            // times faster than powf, and as accurate to a few ULPs.
+            cosine.powi(self.shininess as i32)
         } else {
             cosine.powf(self.shininess)
         }

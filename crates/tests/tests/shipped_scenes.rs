@@ -2,6 +2,7 @@
 //! reproducibly.
 
 use glam::{UVec2, Vec3};
+use glint_camera::Film;
 use glint_integrator::{render, RenderSettings, SamplePattern, Surface};
 use glint_lighting::Light;
 use glint_scene::{load, SceneDescription};
@@ -11,6 +12,27 @@ use std::fmt::Write;
 
 fn cornell(set: u32) -> SceneDescription {
     load(&scene_path(&format!("cornell-set{set}"))).unwrap()
+}
+
+/// Renders a loaded scene at another resolution, with its settings changed by `tweak`.
+fn render_at(
+    d: &SceneDescription,
+    width: u32,
+    height: u32,
+    tweak: impl FnOnce(&mut RenderSettings),
+) -> Film {
+    let camera = d
+        .scene
+        .camera
+        .with_resolution(UVec2::new(width, height))
+        .unwrap();
+    let scene = glint_integrator::Scene {
+        camera,
+        ..d.scene.clone()
+    };
+    let mut settings = d.settings.clone();
+    tweak(&mut settings);
+    render(&scene, &settings, &|_, _| {}).unwrap().film
 }
 
 #[test]
@@ -81,17 +103,10 @@ fn cornell_sets_match_the_course_numbers() {
 /// samples), every pixel's RGB locked to five significant digits.
 #[test]
 fn cornell_set1_16x16_render_snapshot() {
-    let d = cornell(1);
-    let camera = d.scene.camera.with_resolution(UVec2::new(16, 16)).unwrap();
-    let scene = glint_integrator::Scene { camera, ..d.scene };
-    let settings = RenderSettings {
-        spp: 4,
-        pixel_pattern: SamplePattern::Grid,
-        light_samples: 4,
-        light_pattern: SamplePattern::Grid,
-        ..d.settings
-    };
-    let film = render(&scene, &settings, &|_, _| {}).unwrap().film;
+    let film = render_at(&cornell(1), 16, 16, |s| {
+        (s.spp, s.pixel_pattern) = (4, SamplePattern::Grid);
+        (s.light_samples, s.light_pattern) = (4, SamplePattern::Grid);
+    });
     let mut s = String::new();
     for y in 0..16 {
         for x in 0..16 {
@@ -106,15 +121,7 @@ fn cornell_set1_16x16_render_snapshot() {
 fn cornell_set1_renders_the_course_picture() {
     // Coarse properties of the picture, at 64×64: the walls' colors and the
     // light's own color where the camera sees it.
-    let d = cornell(1);
-    let camera = d.scene.camera.with_resolution(UVec2::new(64, 64)).unwrap();
-    let scene = glint_integrator::Scene { camera, ..d.scene };
-    let settings = RenderSettings {
-        spp: 4,
-        light_samples: 4,
-        ..d.settings
-    };
-    let film = render(&scene, &settings, &|_, _| {}).unwrap().film;
+    let film = render_at(&cornell(1), 64, 64, |s| (s.spp, s.light_samples) = (4, 4));
     let left_wall = film.pixel(2, 52);
     let right_wall = film.pixel(61, 52);
     let back_wall = film.pixel(32, 40);
@@ -139,17 +146,12 @@ fn cornell_set1_renders_the_course_picture() {
 #[test]
 fn shipped_scene_renders_bit_identically_on_1_and_4_threads() {
     let d = cornell(2);
-    let camera = d.scene.camera.with_resolution(UVec2::new(48, 40)).unwrap();
-    let scene = glint_integrator::Scene { camera, ..d.scene };
     let at = |threads| {
-        let settings = RenderSettings {
-            spp: 4,
-            light_samples: 3,
-            light_pattern: SamplePattern::Random,
-            threads: Some(threads),
-            ..d.settings.clone()
-        };
-        let film = render(&scene, &settings, &|_, _| {}).unwrap().film;
+        let film = render_at(&d, 48, 40, |s| {
+            (s.spp, s.light_samples) = (4, 3);
+            s.light_pattern = SamplePattern::Random;
+            s.threads = Some(threads);
+        });
         let bits = film
             .pixels()
             .iter()

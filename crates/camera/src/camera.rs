@@ -9,6 +9,16 @@ pub struct CameraRay {
     pub direction: Vec3,
 }
 
+/// A camera ray with the directions of the rays one pixel to the right (`dx`) and
+/// one pixel down (`dy`): the ray differentials of Igehy (1999) and pbrt-v4
+/// section 10.1.1. A pinhole camera's three rays share one origin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraRayDifferential {
+    pub ray: CameraRay,
+    pub dx_direction: Vec3,
+    pub dy_direction: Vec3,
+}
+
 /// Why a camera could not be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum CameraError {
@@ -108,6 +118,16 @@ impl Camera {
         CameraRay {
             origin: self.position,
             direction: on_film.normalize(),
+        }
+    }
+
+    /// The ray through raster position `(x, y)` with its differentials: the rays
+    /// through `(x + 1, y)` and `(x, y + 1)`.
+    pub fn generate_ray_differential(&self, x: f32, y: f32) -> CameraRayDifferential {
+        CameraRayDifferential {
+            ray: self.generate_ray(x, y),
+            dx_direction: self.generate_ray(x + 1.0, y).direction,
+            dy_direction: self.generate_ray(x, y + 1.0).direction,
         }
     }
 

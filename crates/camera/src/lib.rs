@@ -17,5 +17,5 @@
 mod camera;
 mod film;
 
-pub use camera::{Camera, CameraError, CameraRay};
+pub use camera::{Camera, CameraError, CameraRay, CameraRayDifferential};
 pub use film::{linear_to_srgb8, Film, FilmError, ImageFormat};

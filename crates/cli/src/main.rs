@@ -8,8 +8,9 @@
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::UVec2;
 use glint_camera::ImageFormat;
-use glint_integrator::{RenderSettings, SamplePattern};
+use glint_integrator::{Aov, RenderSettings, SamplePattern};
 use glint_scene::SceneDescription;
+use glint_texture::TextureFilter;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -72,6 +73,42 @@ struct RenderArgs {
     /// Film size in pixels, e.g. 640x480 (overrides render.resolution)
     #[arg(long, value_name = "WxH", value_parser = parse_resolution)]
     resolution: Option<UVec2>,
+
+    /// Filter for every image texture (overrides each texture's `filter`)
+    #[arg(long, value_name = "FILTER")]
+    texture_filter: Option<Filter>,
+
+    /// Write this buffer instead of the shaded image: raw values in .exr/.pfm,
+    /// false color in .png (normals as 0.5·n + 0.5, uv as its fractional part,
+    /// depth as gray from near to far, MIP level as a blue-green-red ramp)
+    #[arg(long, value_name = "BUFFER")]
+    aov: Option<AovName>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Filter {
+    /// The texel under the point, full resolution
+    Nearest,
+    /// Bilinear at full resolution
+    Bilinear,
+    /// Bilinear in the two MIP levels around the footprint, blended
+    Trilinear,
+    /// Elliptically weighted average over the footprint (anisotropic)
+    Ewa,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum AovName {
+    /// Surface texture coordinates (u, v, 0)
+    Uv,
+    /// The MIP level the diffuse texture is read at
+    MipLevel,
+    /// Shading normal
+    Normal,
+    /// Distance from the camera
+    Depth,
+    /// Filtered diffuse color
+    Albedo,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -168,6 +205,9 @@ fn render(args: &RenderArgs) -> Result<(), Failure> {
         ..
     } = glint_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
     apply_overrides(args, &mut settings);
+    if let Some(filter) = args.texture_filter {
+        scene.override_texture_filter(texture_filter(filter));
+    }
     if let Some(resolution) = args.resolution {
         scene.camera = scene
             .camera
@@ -190,13 +230,17 @@ fn render(args: &RenderArgs) -> Result<(), Failure> {
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
-    rendered
-        .film
-        .save(&output)
+    let film = match settings.aov {
+        Some(aov) if ImageFormat::from_path(&output).ok() == Some(ImageFormat::Png) => {
+            aov.false_color(&rendered.film)
+        }
+        _ => rendered.film,
+    };
+    film.save(&output)
         .map_err(|e| Failure::Other(e.to_string()))?;
 
     let stats = rendered.stats;
-    let resolution = rendered.film.resolution();
+    let resolution = film.resolution();
     println!(
         "wrote {}: {}x{}, {} spp, {} light samples, {:.2} s wall ({:.2} s rendering), {} rays ({:.2} M rays/s)",
         output.display(),
@@ -270,6 +314,24 @@ fn apply_overrides(args: &RenderArgs, settings: &mut RenderSettings) {
     }
     if args.threads.is_some() {
         settings.threads = args.threads;
+    }
+    if let Some(aov) = args.aov {
+        settings.aov = Some(match aov {
+            AovName::Uv => Aov::Uv,
+            AovName::MipLevel => Aov::MipLevel,
+            AovName::Normal => Aov::Normal,
+            AovName::Depth => Aov::Depth,
+            AovName::Albedo => Aov::Albedo,
+        });
+    }
+}
+
+fn texture_filter(filter: Filter) -> TextureFilter {
+    match filter {
+        Filter::Nearest => TextureFilter::Nearest,
+        Filter::Bilinear => TextureFilter::Bilinear,
+        Filter::Trilinear => TextureFilter::Trilinear,
+        Filter::Ewa => TextureFilter::Ewa,
     }
 }
 

@@ -3,8 +3,9 @@ use glam::{Vec2, Vec3};
 
 /// An axis-aligned box `[min, max]`, a closed solid seen from outside and inside.
 ///
-/// Each face carries its own uv square, oriented as the faces of an OpenGL cube map
-/// (seen from the box's centre): see [`FACES`]. `dpdu`/`dpdv` follow from it.
+/// Each face carries its own uv square, upright as seen from outside the box: on the
+/// four side faces u runs to the viewer's right and v up (+y); on the top face v
+/// runs towards −z, on the bottom face towards +z (see [`FACES`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AaBox {
     min: Vec3,
@@ -18,12 +19,12 @@ type FaceAxis = (usize, f32);
 /// along and its direction, so that `s = sign · q[axis]` for the box-local
 /// coordinate `q ∈ [−1, 1]³`, and `u = (s + 1)/2`. Order: +x −x +y −y +z −z.
 const FACES: [(usize, f32, FaceAxis, FaceAxis); 6] = [
-    (0, 1.0, (2, -1.0), (1, -1.0)),
-    (0, -1.0, (2, 1.0), (1, -1.0)),
-    (1, 1.0, (0, 1.0), (2, 1.0)),
-    (1, -1.0, (0, 1.0), (2, -1.0)),
-    (2, 1.0, (0, 1.0), (1, -1.0)),
-    (2, -1.0, (0, -1.0), (1, -1.0)),
+    (0, 1.0, (2, -1.0), (1, 1.0)),
+    (0, -1.0, (2, 1.0), (1, 1.0)),
+    (1, 1.0, (0, 1.0), (2, -1.0)),
+    (1, -1.0, (0, 1.0), (2, 1.0)),
+    (2, 1.0, (0, 1.0), (1, 1.0)),
+    (2, -1.0, (0, -1.0), (1, 1.0)),
 ];
 
 impl AaBox {

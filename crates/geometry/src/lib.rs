@@ -10,13 +10,15 @@
 //!   `front_face`, whether the ray arrived on that side. Shading code flips it as needed.
 //! - Flat shapes (parallelogram, plane) are one-sided unless built two-sided:
 //!   a one-sided shape is invisible from behind, for every kind of ray.
-//! - uv coordinates lie in [0, 1]² on bounded shapes; `dpdu` and `dpdv` are the
+//! - uv coordinates lie in [0, 1]² on bounded shapes, with v increasing "upwards"
+//!   (towards +y on spheres and box sides), as in pbrt; `dpdu` and `dpdv` are the
 //!   partial derivatives of the surface point with respect to them (world units per
 //!   unit of uv), the Jacobian later stages use for texture filtering.
 //! - New rays leaving a surface start at [`offset_ray_origin`], never at a fixed
 //!   epsilon: the offset scales with the magnitude of the hit point.
 
 mod aabox;
+mod differentials;
 mod hit;
 mod offset;
 mod parallelogram;
@@ -27,6 +29,7 @@ mod shape_list;
 mod sphere;
 
 pub use aabox::AaBox;
+pub use differentials::{RayDifferential, SurfaceDifferentials};
 pub use hit::Hit;
 pub use offset::{offset_ray_origin, spawn_ray, spawn_ray_to, SHADOW_EPSILON};
 pub use parallelogram::Parallelogram;

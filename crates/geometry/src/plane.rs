@@ -3,20 +3,23 @@ use glam::{Vec2, Vec3};
 
 /// An infinite plane through `point` with unit `normal` (its front side).
 ///
-/// Planar uv: `u = (p − point)·tangent`, `v = (p − point)·bitangent` in world units,
-/// with the orthonormal tangent frame of Duff et al., "Building an Orthonormal
-/// Basis, Revisited" (JCGT 2017). uv is not wrapped to [0, 1]: textures repeat.
+/// Planar uv: `u = (p − point)·tangent / tile`, `v = (p − point)·bitangent / tile`,
+/// so one unit of uv spans `tile` world units, with the orthonormal tangent frame of
+/// Duff et al., "Building an Orthonormal Basis, Revisited" (JCGT 2017). uv is not
+/// wrapped to [0, 1]: textures repeat across the plane.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Plane {
     point: Vec3,
     normal: Vec3,
     tangent: Vec3,
     bitangent: Vec3,
+    tile: f32,
     two_sided: bool,
 }
 
 impl Plane {
-    /// Returns `None` if `normal` is zero or not finite.
+    /// A plane with one uv unit per world unit. Returns `None` if `normal` is zero
+    /// or not finite.
     pub fn new(point: Vec3, normal: Vec3, two_sided: bool) -> Option<Self> {
         let normal = normal.try_normalize()?;
         let (tangent, bitangent) = normal.any_orthonormal_pair();
@@ -25,8 +28,15 @@ impl Plane {
             normal,
             tangent,
             bitangent,
+            tile: 1.0,
             two_sided,
         })
+    }
+
+    /// The same plane with one uv unit spanning `tile` world units. `None` unless
+    /// `tile` is positive and finite.
+    pub fn with_tile_size(self, tile: f32) -> Option<Self> {
+        (tile > 0.0 && tile.is_finite()).then_some(Self { tile, ..self })
     }
 
     /// A point on the plane.
@@ -56,9 +66,9 @@ impl Plane {
             point,
             geometric_normal: self.normal,
             shading_normal: self.normal,
-            uv: Vec2::new(local.dot(self.tangent), local.dot(self.bitangent)),
-            dpdu: self.tangent,
-            dpdv: self.bitangent,
+            uv: Vec2::new(local.dot(self.tangent), local.dot(self.bitangent)) / self.tile,
+            dpdu: self.tangent * self.tile,
+            dpdv: self.bitangent * self.tile,
             front_face: self.normal.dot(ray.direction) < 0.0,
             shape: 0,
         }

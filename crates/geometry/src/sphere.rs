@@ -5,7 +5,8 @@ use std::f32::consts::{PI, TAU};
 /// A sphere given by centre and radius.
 ///
 /// uv: `u = φ / 2π` with `φ = atan2(−z, x)` about the y axis (u grows left to right
-/// seen from +z), `v = θ / π` with `θ` the polar angle from +y (v = 0 at the top).
+/// seen from +z), `v = 1 − θ / π` with `θ` the polar angle from +y (v = 0 at the
+/// bottom pole, 1 at the top).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
     center: Vec3,
@@ -74,15 +75,15 @@ impl Sphere {
         let (sin_phi, cos_phi) = phi.sin_cos();
         let (sin_theta, cos_theta) = theta.sin_cos();
         let r = self.radius;
-        // p = c + r (sinθ cosφ, cosθ, −sinθ sinφ), u = φ/2π, v = θ/π.
+        // p = c + r (sinθ cosφ, cosθ, −sinθ sinφ), u = φ/2π, v = 1 − θ/π.
         let dpdu = TAU * r * Vec3::new(-sin_theta * sin_phi, 0.0, -sin_theta * cos_phi);
-        let dpdv = PI * r * Vec3::new(cos_theta * cos_phi, -sin_theta, -cos_theta * sin_phi);
+        let dpdv = -PI * r * Vec3::new(cos_theta * cos_phi, -sin_theta, -cos_theta * sin_phi);
         Hit {
             t,
             point,
             geometric_normal: n,
             shading_normal: n,
-            uv: Vec2::new(phi / TAU, theta / PI),
+            uv: Vec2::new(phi / TAU, 1.0 - theta / PI),
             dpdu,
             dpdv,
             front_face: n.dot(ray.direction) < 0.0,

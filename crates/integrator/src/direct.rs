@@ -1,8 +1,9 @@
 use crate::sampling::SamplePattern;
 use crate::{Scene, Surface};
 use glam::{Vec2, Vec3};
-use glint_geometry::{spawn_ray_to, Hit, Ray};
+use glint_geometry::{spawn_ray_to, Hit, Ray, RayDifferential};
 use glint_lighting::{AreaLight, Light, PhongMaterial};
+use glint_texture::TexCoord;
 use rand_pcg::Pcg32;
 
 /// The direct-lighting integrator of the course report, section 2.5.
@@ -36,8 +37,15 @@ impl SampleContext {
 }
 
 impl DirectIntegrator {
-    /// Radiance arriving along `ray` (from the camera).
-    pub fn li(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
+    /// Radiance arriving along `ray` (from the camera), whose pixel footprint is
+    /// given by the ray differentials `diff`.
+    pub fn li(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        diff: &RayDifferential,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
         let Some(hit) = scene.shapes.closest_hit(ray, f32::INFINITY) else {
             return Vec3::ZERO;
         };
@@ -46,7 +54,11 @@ impl DirectIntegrator {
                 Light::Area(area) => area.color,
                 Light::Point(_) => Vec3::ZERO,
             },
-            Surface::Material(m) => self.shade(scene, &scene.materials[m as usize], &hit, ray, ctx),
+            Surface::Material(m) => {
+                let material = &scene.materials[m as usize];
+                let tc = texture_footprint(material, &hit, diff);
+                self.shade(scene, material, &hit, ray, &tc, ctx)
+            }
         }
     }
 
@@ -56,9 +68,10 @@ impl DirectIntegrator {
         material: &PhongMaterial,
         hit: &Hit,
         ray: &Ray,
+        tc: &TexCoord,
         ctx: &mut SampleContext,
     ) -> Vec3 {
-        let (kd, ks) = material.reflectances(hit.uv);
+        let (kd, ks) = material.reflectances(tc);
         let point = ShadingPoint {
             hit,
             material,
@@ -97,6 +110,20 @@ impl DirectIntegrator {
         }
         ctx.light_points = samples;
         light.color * sum / self.light_samples as f32
+    }
+}
+
+/// The texture lookup at `hit`: with the pixel's footprint from the ray
+/// differentials if the material filters over one, else just the point.
+fn texture_footprint(material: &PhongMaterial, hit: &Hit, diff: &RayDifferential) -> TexCoord {
+    if !material.uses_footprint() {
+        return TexCoord::point(hit.uv);
+    }
+    let d = hit.differentials(diff);
+    TexCoord {
+        uv: hit.uv,
+        duvdx: d.duvdx,
+        duvdy: d.duvdy,
     }
 }
 

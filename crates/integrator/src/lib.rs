@@ -11,11 +11,13 @@
 //!   rayon straight into the film; scratch buffers are allocated once per tile,
 //!   never per ray.
 
+mod aov;
 mod direct;
 mod render;
 pub mod sampling;
 mod scene;
 
+pub use aov::Aov;
 pub use direct::{DirectIntegrator, SampleContext};
 pub use render::{
     render, RenderOutput, RenderSettings, RenderStats, SampleCount, SettingsError, MAX_SAMPLES,

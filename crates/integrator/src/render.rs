@@ -1,9 +1,9 @@
 use crate::direct::SampleContext;
 use crate::sampling::{pixel_rng, SamplePattern, PIXEL_STREAM};
-use crate::{DirectIntegrator, Scene};
+use crate::{Aov, DirectIntegrator, Scene};
 use glam::{Vec2, Vec3};
 use glint_camera::Film;
-use glint_geometry::Ray;
+use glint_geometry::{Ray, RayDifferential};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -32,6 +32,8 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Worker threads; `None` uses one per core.
     pub threads: Option<usize>,
+    /// Write this buffer instead of radiance.
+    pub aov: Option<Aov>,
 }
 
 impl Default for RenderSettings {
@@ -43,6 +45,7 @@ impl Default for RenderSettings {
             light_pattern: SamplePattern::Stratified,
             seed: 0,
             threads: None,
+            aov: None,
         }
     }
 }
@@ -201,6 +204,9 @@ fn render_rows(
     let width = scene.camera.resolution().x;
     let mut pixel_samples = vec![Vec2::ZERO; settings.spp as usize];
     let mut ctx = SampleContext::new(settings.light_samples);
+    // Each of spp samples stands for 1/√spp of the pixel's width (pbrt-v4 scales
+    // differentials the same way, never below 1/8).
+    let footprint_scale = (1.0 / (settings.spp as f32).sqrt()).max(0.125);
     for (offset, radiance) in pixels.iter_mut().enumerate() {
         let (x, y) = (offset as u32 % width, first_row + offset as u32 / width);
         let pixel = y as u64 * width as u64 + x as u64;
@@ -210,11 +216,26 @@ fn render_rows(
         for (sample, jitter) in pixel_samples.iter().enumerate() {
             ctx.rng = pixel_rng(settings.seed, pixel, sample as u64);
             let raster = Vec2::new(x as f32, y as f32) + *jitter;
-            let camera_ray = scene.camera.generate_ray(raster.x, raster.y);
-            let ray = Ray::new(camera_ray.origin, camera_ray.direction);
-            sum += integrator.li(scene, &ray, &mut ctx);
+            let (ray, diff) = camera_ray(scene, raster, footprint_scale);
+            sum += match settings.aov {
+                None => integrator.li(scene, &ray, &diff, &mut ctx),
+                Some(aov) => aov.evaluate(scene, &ray, &diff),
+            };
         }
         *radiance = sum / settings.spp as f32;
     }
     ctx.shadow_rays
+}
+
+/// The camera ray through `raster`, with differentials shrunk to `scale` pixels.
+fn camera_ray(scene: &Scene, raster: Vec2, scale: f32) -> (Ray, RayDifferential) {
+    let c = scene.camera.generate_ray_differential(raster.x, raster.y);
+    let d = c.ray.direction;
+    let diff = RayDifferential {
+        rx_origin: c.ray.origin,
+        rx_direction: d + scale * (c.dx_direction - d),
+        ry_origin: c.ray.origin,
+        ry_direction: d + scale * (c.dy_direction - d),
+    };
+    (Ray::new(c.ray.origin, d), diff)
 }

@@ -2,6 +2,7 @@ use glam::Vec3;
 use glint_camera::Camera;
 use glint_geometry::{Shape, ShapeList};
 use glint_lighting::{AreaLight, Light, PhongMaterial, PointLight};
+use glint_texture::{Texture, TextureFilter};
 
 /// What a shape is to the integrator: a reflecting surface or an emitter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -24,6 +25,21 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Ambient light; a hit surface reflects `ambient · kd` regardless of shadows.
     pub ambient: Vec3,
+}
+
+impl Scene {
+    /// Sets the filter of every image texture the materials use (the command
+    /// line's `--texture-filter`). Procedural textures keep their own filtering.
+    pub fn override_texture_filter(&mut self, filter: TextureFilter) {
+        for material in &mut self.materials {
+            let textures = std::iter::once(&mut material.diffuse).chain(material.specular.as_mut());
+            for texture in textures {
+                if let Texture::Image(image) = texture {
+                    image.filter = filter;
+                }
+            }
+        }
+    }
 }
 
 /// Why a scene could not be assembled.

@@ -13,7 +13,7 @@ mod material;
 mod point_light;
 
 pub use area_light::AreaLight;
-pub use material::{PhongMaterial, SpecularLobe};
+pub use material::{PhongMaterial, SpecularLobe, UvTransform};
 pub use point_light::PointLight;
 
 /// Every kind of light, as one enum (no virtual calls in the shading loop).

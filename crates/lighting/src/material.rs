@@ -1,5 +1,34 @@
 use glam::{Vec2, Vec3};
-use glint_texture::Texture;
+use glint_texture::{TexCoord, Texture};
+
+/// A per-material change of texture coordinates: `uv' = uv · scale + offset`
+/// (so `scale = [4, 4]` repeats a texture four times across a surface).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    pub scale: Vec2,
+    pub offset: Vec2,
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        Self {
+            scale: Vec2::ONE,
+            offset: Vec2::ZERO,
+        }
+    }
+}
+
+impl UvTransform {
+    /// `tc` in the transformed coordinates; derivatives scale with the uv.
+    #[inline]
+    pub fn apply(&self, tc: &TexCoord) -> TexCoord {
+        TexCoord {
+            uv: tc.uv * self.scale + self.offset,
+            duvdx: tc.duvdx * self.scale,
+            duvdy: tc.duvdy * self.scale,
+        }
+    }
+}
 
 /// Which specular lobe a [`PhongMaterial`] uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -26,6 +55,8 @@ pub struct PhongMaterial {
     /// Phong exponent `s`.
     pub shininess: f32,
     pub lobe: SpecularLobe,
+    /// Applied to the surface's uv before any texture lookup.
+    pub uv_transform: UvTransform,
 }
 
 impl PhongMaterial {
@@ -36,18 +67,31 @@ impl PhongMaterial {
             specular: None,
             shininess,
             lobe: SpecularLobe::Phong,
+            uv_transform: UvTransform::default(),
         }
     }
 
-    /// `(kd, ks)` at surface coordinates `uv`.
+    /// `(kd, ks)` filtered over the footprint `tc` (surface uv and its derivatives).
     #[inline]
-    pub fn reflectances(&self, uv: Vec2) -> (Vec3, Vec3) {
-        let kd = self.diffuse.evaluate(uv);
+    pub fn reflectances(&self, tc: &TexCoord) -> (Vec3, Vec3) {
+        let tc = self.uv_transform.apply(tc);
+        let kd = self.diffuse.evaluate(&tc);
         let ks = match &self.specular {
-            Some(t) => t.evaluate(uv),
+            Some(t) => t.evaluate(&tc),
             None => kd,
         };
         (kd, ks)
+    }
+
+    /// Whether any of the material's textures filter over a footprint, so the
+    /// integrator only computes ray differentials at hits that need them.
+    pub fn uses_footprint(&self) -> bool {
+        self.diffuse.uses_footprint() || self.specular.as_ref().is_some_and(Texture::uses_footprint)
+    }
+
+    /// The pyramid level the diffuse texture reads at `tc` (for the mip-level AOV).
+    pub fn diffuse_mip_level(&self, tc: &TexCoord) -> f32 {
+        self.diffuse.mip_level(&self.uv_transform.apply(tc))
     }
 
     /// The fraction of a light's color reflected towards `v`, per channel:
@@ -137,13 +181,32 @@ mod tests {
     fn specular_defaults_to_the_diffuse_color_and_follows_textures() {
         let checker = Checkerboard::new(Vec3::X, Vec3::Y, 2);
         let m = PhongMaterial::new(checker, 10.0);
-        assert_eq!(m.reflectances(Vec2::new(0.1, 0.1)), (Vec3::X, Vec3::X));
-        assert_eq!(m.reflectances(Vec2::new(0.6, 0.1)), (Vec3::Y, Vec3::Y));
+        let at = |u: f32, v: f32| TexCoord::point(Vec2::new(u, v));
+        assert_eq!(m.reflectances(&at(0.1, 0.1)), (Vec3::X, Vec3::X));
+        assert_eq!(m.reflectances(&at(0.6, 0.1)), (Vec3::Y, Vec3::Y));
         let m2 = PhongMaterial {
             specular: Some(Texture::Constant(Vec3::ZERO)),
+            ..m.clone()
+        };
+        assert_eq!(m2.reflectances(&at(0.1, 0.1)), (Vec3::X, Vec3::ZERO));
+        // uv scale 2 repeats the 2x2 checker: u = 0.3 lands in the second check.
+        let tiled = PhongMaterial {
+            uv_transform: UvTransform {
+                scale: Vec2::splat(2.0),
+                offset: Vec2::ZERO,
+            },
+            ..m.clone()
+        };
+        assert_eq!(tiled.reflectances(&at(0.3, 0.1)).0, Vec3::Y);
+        let shifted = PhongMaterial {
+            uv_transform: UvTransform {
+                scale: Vec2::ONE,
+                offset: Vec2::new(0.5, 0.0),
+            },
             ..m
         };
-        assert_eq!(m2.reflectances(Vec2::new(0.1, 0.1)), (Vec3::X, Vec3::ZERO));
+        assert_eq!(shifted.reflectances(&at(0.1, 0.1)).0, Vec3::Y);
+        assert!(!shifted.uses_footprint());
     }
 
     #[test]

@@ -7,9 +7,14 @@ use glam::Vec3;
 use glint_camera::{Camera, CameraError};
 use glint_geometry::{AaBox, Parallelogram, Plane, Sphere};
 use glint_integrator::{RenderSettings, SampleCount, Scene, SceneBuilder, SettingsError};
-use glint_lighting::{AreaLight, PhongMaterial, PointLight};
-use glint_texture::{Checkerboard, Texture};
-use std::collections::BTreeMap;
+use glint_lighting::{AreaLight, PhongMaterial, PointLight, UvTransform};
+use glint_texture::{load_image, Checkerboard, ImageTexture, Texture, TextureImage};
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Largest side of a generated texture image, in texels.
+const MAX_TEXTURE_SIDE: u32 = 16384;
 use toml::Spanned;
 
 /// A scene ready to render, with the render settings its file asks for.
@@ -21,10 +26,10 @@ pub struct SceneDescription {
     pub material_names: Vec<String>,
 }
 
-pub(crate) fn build(file: SceneFile) -> Result<SceneDescription, Problem> {
+pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription, Problem> {
     let settings = settings(&file.render)?;
     let camera = camera(&file.camera, file.render.resolution.0)?;
-    let textures = textures(&file.textures);
+    let textures = textures(&file.textures, base_dir)?;
     let mut builder = SceneBuilder::new();
     let mut material_ids = BTreeMap::new();
     for (name, table) in &file.materials {
@@ -69,7 +74,9 @@ pub(crate) fn build(file: SceneFile) -> Result<SceneDescription, Problem> {
     for (i, p) in file.plane.iter().enumerate() {
         let m = lookup(format!("plane[{i}].material"), &p.material)?;
         // `Direction` guarantees a normal that normalizes.
-        let plane = Plane::new(p.point.0, p.normal.0, p.two_sided).expect("normalizable normal");
+        let plane = Plane::new(p.point.0, p.normal.0, p.two_sided)
+            .and_then(|plane| plane.with_tile_size(p.tile_size.0))
+            .expect("normalizable normal, positive tile size");
         builder.shape(plane, m);
     }
     for (i, b) in file.boxes.iter().enumerate() {
@@ -149,6 +156,7 @@ fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> {
         light_pattern: render.light_sampler.get_ref().0,
         seed: render.seed,
         threads: None,
+        aov: None,
     };
     settings.validate().map_err(|e| {
         let (field, count, sampler) = match e {
@@ -200,18 +208,58 @@ fn camera(c: &CameraTable, resolution: glam::UVec2) -> Result<Camera, Problem> {
     })
 }
 
-fn textures(tables: &BTreeMap<String, TextureTable>) -> BTreeMap<&str, Texture> {
-    tables
-        .iter()
-        .map(|(name, table)| {
-            let texture = match table {
-                TextureTable::Checkerboard(c) => {
-                    Checkerboard::new(c.colors[0].0, c.colors[1].0, c.checks.0).into()
+/// Every named texture, with image files read from `base_dir` once each.
+fn textures<'a>(
+    tables: &'a BTreeMap<String, TextureTable>,
+    base_dir: &Path,
+) -> Result<BTreeMap<&'a str, Texture>, Problem> {
+    let mut images: HashMap<PathBuf, Arc<TextureImage>> = HashMap::new();
+    let mut textures = BTreeMap::new();
+    for (name, table) in tables {
+        let texture = match table {
+            TextureTable::Checkerboard(c) => Texture::Checkerboard(Checkerboard {
+                analytic: c.filter.0,
+                ..Checkerboard::new(c.colors[0].0, c.colors[1].0, c.checks.0)
+            }),
+            TextureTable::CheckerImage(c) => {
+                let per_check = c.pixels_per_check.get_ref().0;
+                let side = c.checks.0 as u64 * per_check as u64;
+                if side > MAX_TEXTURE_SIDE as u64 {
+                    return Err(Problem::new(
+                        c.pixels_per_check.span(),
+                        format!("textures.{name}.checker_image.pixels_per_check"),
+                        format!(
+                            "checks × pixels_per_check is {side}, more than the largest image side {MAX_TEXTURE_SIDE}"
+                        ),
+                    ));
                 }
-            };
-            (name.as_str(), texture)
-        })
-        .collect()
+                let checker = Checkerboard::new(c.colors[0].0, c.colors[1].0, c.checks.0);
+                let image = TextureImage::new(checker.to_image(per_check));
+                Texture::Image(ImageTexture::new(image, c.wrap.0, c.filter.0))
+            }
+            TextureTable::Image(i) => {
+                let path = base_dir.join(i.file.get_ref());
+                let image = match images.get(&path) {
+                    Some(image) => image.clone(),
+                    None => {
+                        let loaded = load_image(&path).map_err(|e| {
+                            Problem::new(
+                                i.file.span(),
+                                format!("textures.{name}.image.file"),
+                                e.to_string(),
+                            )
+                        })?;
+                        let image = TextureImage::new(loaded);
+                        images.insert(path, image.clone());
+                        image
+                    }
+                };
+                Texture::Image(ImageTexture::new(image, i.wrap.0, i.filter.0))
+            }
+        };
+        textures.insert(name.as_str(), texture);
+    }
+    Ok(textures)
 }
 
 fn material(
@@ -246,5 +294,9 @@ fn material(
             .transpose()?,
         shininess: table.shininess.0,
         lobe: table.lobe.map(|l| l.0).unwrap_or_default(),
+        uv_transform: UvTransform {
+            scale: table.uv_scale.0,
+            offset: table.uv_offset.0,
+        },
     })
 }

@@ -91,6 +91,8 @@ impl Default for RenderTable {
 #[serde(deny_unknown_fields, rename_all = "snake_case")]
 pub enum TextureTable {
     Checkerboard(CheckerboardTable),
+    CheckerImage(CheckerImageTable),
+    Image(ImageTable),
 }
 
 #[derive(Debug, Deserialize)]
@@ -100,6 +102,48 @@ pub struct CheckerboardTable {
     pub colors: [Color; 2],
     /// Checks along each side of the uv square.
     pub checks: Count,
+    #[serde(default = "point_filter")]
+    pub filter: CheckerFilter,
+}
+
+fn point_filter() -> CheckerFilter {
+    CheckerFilter(false)
+}
+
+/// The course's checkerboard as an image texture (so it is MIP-mapped).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckerImageTable {
+    pub colors: [Color; 2],
+    pub checks: Count,
+    #[serde(default = "course_pixels_per_check")]
+    pub pixels_per_check: Spanned<Count>,
+    #[serde(default = "repeat")]
+    pub wrap: Wrap,
+    #[serde(default = "trilinear")]
+    pub filter: Filter,
+}
+
+fn course_pixels_per_check() -> Spanned<Count> {
+    Spanned::new(0..0, Count(32))
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageTable {
+    /// Path of the image, relative to the scene file.
+    pub file: Spanned<String>,
+    #[serde(default = "repeat")]
+    pub wrap: Wrap,
+    #[serde(default = "trilinear")]
+    pub filter: Filter,
+}
+
+fn repeat() -> Wrap {
+    Wrap(glint_texture::WrapMode::Repeat)
+}
+fn trilinear() -> Filter {
+    Filter(glint_texture::TextureFilter::Trilinear)
 }
 
 #[derive(Debug, Deserialize)]
@@ -110,6 +154,17 @@ pub struct MaterialTable {
     #[serde(default = "unit_shininess")]
     pub shininess: NonNegative,
     pub lobe: Option<Lobe>,
+    #[serde(default = "unit_scale")]
+    pub uv_scale: UvScale,
+    #[serde(default = "zero_offset")]
+    pub uv_offset: UvPair,
+}
+
+fn unit_scale() -> UvScale {
+    UvScale(glam::Vec2::ONE)
+}
+fn zero_offset() -> UvPair {
+    UvPair(glam::Vec2::ZERO)
 }
 
 fn unit_shininess() -> NonNegative {
@@ -169,6 +224,9 @@ pub struct ParallelogramTable {
 pub struct PlaneTable {
     pub point: Point,
     pub normal: Direction,
+    /// World units spanned by one unit of uv.
+    #[serde(default = "unit_focal_length")]
+    pub tile_size: Positive,
     #[serde(default)]
     pub two_sided: bool,
     pub material: Spanned<String>,

@@ -23,17 +23,25 @@ pub use values::{parse_resolution_parts, MAX_RESOLUTION};
 
 use std::path::Path;
 
-/// Reads and validates the scene file at `path`.
+/// Reads and validates the scene file at `path`, and the assets it names
+/// (paths relative to the scene file's directory).
 pub fn load(path: &Path) -> Result<SceneDescription, SceneError> {
     let source = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
         path: path.to_path_buf(),
         source,
     })?;
-    parse(&source, &path.display().to_string())
+    let base_dir = path.parent().unwrap_or(Path::new(""));
+    parse_in(&source, &path.display().to_string(), base_dir)
 }
 
-/// Parses and validates scene text; `file` names it in error messages.
+/// Parses and validates scene text; `file` names it in error messages, and asset
+/// paths are taken relative to the current directory.
 pub fn parse(source: &str, file: &str) -> Result<SceneDescription, SceneError> {
+    parse_in(source, file, Path::new(""))
+}
+
+/// Parses and validates scene text whose asset paths are relative to `base_dir`.
+pub fn parse_in(source: &str, file: &str, base_dir: &Path) -> Result<SceneDescription, SceneError> {
     let deserializer = toml::de::Deserializer::parse(source)
         .map_err(|e| error::invalid(file, source, e.span(), None, e.message()))?;
     let scene_file: format::SceneFile =
@@ -47,6 +55,6 @@ pub fn parse(source: &str, file: &str) -> Result<SceneDescription, SceneError> {
             let inner = e.into_inner();
             error::invalid(file, source, inner.span(), field, inner.message())
         })?;
-    build::build(scene_file)
+    build::build(scene_file, base_dir)
         .map_err(|p| error::invalid(file, source, Some(p.span), Some(p.field), &p.message))
 }

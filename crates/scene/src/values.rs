@@ -4,6 +4,7 @@
 use glam::{UVec2, Vec3};
 use glint_integrator::SamplePattern;
 use glint_lighting::SpecularLobe;
+use glint_texture::{TextureFilter, WrapMode};
 use serde::de::{self, Deserialize, Deserializer, Visitor};
 use std::fmt;
 
@@ -54,6 +55,17 @@ fn finite<E: de::Error>(v: f32) -> Result<f32, E> {
 
 fn number<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
     finite(Number::deserialize(d)?.0)
+}
+
+fn pair<'de, D: Deserializer<'de>>(d: D) -> Result<glam::Vec2, D::Error> {
+    let items = Vec::<Number>::deserialize(d)?;
+    if items.len() != 2 {
+        return Err(de::Error::custom(format!(
+            "expected 2 numbers [u, v], got {}",
+            items.len()
+        )));
+    }
+    Ok(glam::Vec2::new(finite(items[0].0)?, finite(items[1].0)?))
 }
 
 fn vector<'de, D: Deserializer<'de>>(d: D) -> Result<Vec3, D::Error> {
@@ -109,6 +121,14 @@ validated!(
 validated!(
     /// A linear RGB color `[r, g, b]` with no negative component.
     Color(Vec3) via vector, |v| v.min_element() >= 0.0, "a color [r, g, b] with components of at least 0"
+);
+validated!(
+    /// A pair of finite numbers `[u, v]`.
+    UvPair(glam::Vec2) via pair, |v| true, "[u, v]"
+);
+validated!(
+    /// A pair `[u, v]` with no zero component (a uv scale).
+    UvScale(glam::Vec2) via pair, |v| v.x != 0.0 && v.y != 0.0, "a scale [u, v] with no zero component"
 );
 validated!(
     /// A vertical field of view in degrees, strictly between 0 and 180.
@@ -192,5 +212,40 @@ impl<'de> Deserialize<'de> for Lobe {
             _ => None,
         })
         .map(Lobe)
+    }
+}
+
+/// A wrap mode name: `"repeat"`, `"clamp"` or `"mirror"`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wrap(pub WrapMode);
+
+impl<'de> Deserialize<'de> for Wrap {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        named(d, &WrapMode::NAMES, WrapMode::from_name).map(Wrap)
+    }
+}
+
+/// An image filter name: `"nearest"`, `"bilinear"`, `"trilinear"` or `"ewa"`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Filter(pub TextureFilter);
+
+impl<'de> Deserialize<'de> for Filter {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        named(d, &TextureFilter::NAMES, TextureFilter::from_name).map(Filter)
+    }
+}
+
+/// The procedural checkerboard's filter: `"point"` or `"analytic"` (`true`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CheckerFilter(pub bool);
+
+impl<'de> Deserialize<'de> for CheckerFilter {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        named(d, &["point", "analytic"], |n| match n {
+            "point" => Some(false),
+            "analytic" => Some(true),
+            _ => None,
+        })
+        .map(CheckerFilter)
     }
 }

@@ -6,12 +6,27 @@
 //! - uv comes from the geometry stage: [0, 1]² on bounded shapes, world units on
 //!   infinite planes. Procedural patterns repeat outside [0, 1]².
 //! - Textures are a closed `enum`, evaluated by `match`: no virtual call per lookup.
+//! - Image texture coordinates are `st = (u, 1 − v)` (v grows up the surface, image
+//!   rows grow down), so images appear upright; [0, 1]² is one copy of the image.
+//!   Image files are decoded once: 8/16-bit as sRGB, float formats as linear.
+//! - MIP-map pyramids are built lazily, only for textures sampled with a filter
+//!   that reads them (trilinear, EWA), and shared by every texture of the same image.
 
 mod checkerboard;
+mod image;
+mod image_texture;
+mod io;
+mod mipmap;
+mod texcoord;
 
+pub use crate::image::{Image, WrapMode};
 pub use checkerboard::Checkerboard;
+pub use image_texture::{ImageTexture, TextureFilter, TextureImage};
+pub use io::{load_image, srgb_to_linear, ImageLoadError};
+pub use mipmap::MipMap;
+pub use texcoord::TexCoord;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 /// A color that may vary over a surface.
 #[derive(Clone, Debug, PartialEq)]
@@ -20,15 +35,36 @@ pub enum Texture {
     Constant(Vec3),
     /// The course's checkerboard of two colors.
     Checkerboard(Checkerboard),
+    /// An image, filtered over the pixel's footprint.
+    Image(ImageTexture),
 }
 
 impl Texture {
-    /// The color at surface coordinates `uv`.
+    /// The color over the footprint described by `tc`.
     #[inline]
-    pub fn evaluate(&self, uv: Vec2) -> Vec3 {
+    pub fn evaluate(&self, tc: &TexCoord) -> Vec3 {
         match self {
             Texture::Constant(c) => *c,
-            Texture::Checkerboard(c) => c.evaluate(uv),
+            Texture::Checkerboard(c) => c.evaluate_filtered(tc),
+            Texture::Image(t) => t.evaluate(tc),
+        }
+    }
+
+    /// Whether [`Self::evaluate`] uses the footprint (`duvdx`, `duvdy`) at all, so
+    /// callers can skip computing it.
+    pub fn uses_footprint(&self) -> bool {
+        match self {
+            Texture::Constant(_) => false,
+            Texture::Checkerboard(c) => c.analytic,
+            Texture::Image(t) => t.filter.uses_pyramid(),
+        }
+    }
+
+    /// The pyramid level a lookup at `tc` reads (0 where there is no pyramid).
+    pub fn mip_level(&self, tc: &TexCoord) -> f32 {
+        match self {
+            Texture::Image(t) => t.mip_level(tc),
+            _ => 0.0,
         }
     }
 

@@ -1,0 +1,145 @@
+//! How big a pixel is on a surface: ray differentials carried to a hit point.
+//!
+//! pbrt-v4 section 10.1 (after Igehy, "Tracing Ray Differentials", SIGGRAPH 1999):
+//! the offset rays are intersected with the tangent plane at the hit, giving
+//! ∂p/∂x and ∂p/∂y; ∂(u,v)/∂x and ∂(u,v)/∂y then follow from
+//! `∂p/∂x = ∂p/∂u · ∂u/∂x + ∂p/∂v · ∂v/∂x`, solved in the least-squares sense.
+
+use crate::Hit;
+use glam::{Vec2, Vec3};
+
+/// The rays one pixel step away from a main ray, in x and in y.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayDifferential {
+    pub rx_origin: Vec3,
+    pub rx_direction: Vec3,
+    pub ry_origin: Vec3,
+    pub ry_direction: Vec3,
+}
+
+/// The change of surface position and uv per pixel step in x and y.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SurfaceDifferentials {
+    pub dpdx: Vec3,
+    pub dpdy: Vec3,
+    /// (∂u/∂x, ∂v/∂x)
+    pub duvdx: Vec2,
+    /// (∂u/∂y, ∂v/∂y)
+    pub duvdy: Vec2,
+}
+
+/// Larger uv derivatives are clamped: they arise only at grazing angles, where
+/// they would otherwise overflow the filters downstream.
+const MAX_UV_DERIVATIVE: f32 = 1e8;
+
+impl Hit {
+    /// The footprint of the pixel whose ray differentials are `diff` at this hit.
+    pub fn differentials(&self, diff: &RayDifferential) -> SurfaceDifferentials {
+        let n = self.geometric_normal;
+        let on_tangent_plane = |origin: Vec3, direction: Vec3| {
+            let t = n.dot(self.point - origin) / n.dot(direction);
+            let p = origin + t * direction;
+            if p.is_finite() {
+                p - self.point
+            } else {
+                Vec3::ZERO
+            }
+        };
+        let dpdx = on_tangent_plane(diff.rx_origin, diff.rx_direction);
+        let dpdy = on_tangent_plane(diff.ry_origin, diff.ry_direction);
+        SurfaceDifferentials {
+            dpdx,
+            dpdy,
+            duvdx: self.uv_change(dpdx),
+            duvdy: self.uv_change(dpdy),
+        }
+    }
+
+    /// The (du, dv) whose `du·dpdu + dv·dpdv` best approximates `dp` (normal equations).
+    fn uv_change(&self, dp: Vec3) -> Vec2 {
+        let (a00, a01, a11) = (
+            self.dpdu.length_squared(),
+            self.dpdu.dot(self.dpdv),
+            self.dpdv.length_squared(),
+        );
+        let det = a00 * a11 - a01 * a01;
+        let inv_det = if det.abs() > 0.0 && (1.0 / det).is_finite() {
+            1.0 / det
+        } else {
+            return Vec2::ZERO;
+        };
+        let (b0, b1) = (self.dpdu.dot(dp), self.dpdv.dot(dp));
+        let duv = Vec2::new(a11 * b0 - a01 * b1, a00 * b1 - a01 * b0) * inv_det;
+        if duv.is_finite() {
+            duv.clamp(
+                Vec2::splat(-MAX_UV_DERIVATIVE),
+                Vec2::splat(MAX_UV_DERIVATIVE),
+            )
+        } else {
+            Vec2::ZERO
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Plane, Ray, RayDifferential, Shape};
+    use glam::{Vec2, Vec3};
+
+    fn ground_hit_from(height: f32, tilt: f32) -> (crate::Hit, RayDifferential) {
+        let plane = Shape::from(Plane::new(Vec3::ZERO, Vec3::Y, false).unwrap());
+        let origin = Vec3::new(0.0, height, 0.0);
+        let d = Vec3::new(0.0, -1.0, -tilt).normalize();
+        // Offsets on a film plane perpendicular to d, as a camera makes them.
+        let (right, up) = (Vec3::X, Vec3::X.cross(d));
+        let step = 0.01;
+        let diff = RayDifferential {
+            rx_origin: origin,
+            rx_direction: (d + step * right).normalize(),
+            ry_origin: origin,
+            ry_direction: (d + step * up).normalize(),
+        };
+        (
+            plane
+                .intersect(&Ray::new(origin, d), f32::INFINITY)
+                .unwrap(),
+            diff,
+        )
+    }
+
+    #[test]
+    fn footprint_grows_with_distance_and_obliquity() {
+        let (near, dn) = ground_hit_from(1.0, 0.0);
+        let (far, df) = ground_hit_from(4.0, 0.0);
+        let fx_near = near.differentials(&dn).dpdx.length();
+        let fx_far = far.differentials(&df).dpdx.length();
+        // Straight down: the footprint scales with height.
+        assert!((fx_far / fx_near - 4.0).abs() < 1e-3, "{fx_near} {fx_far}");
+        let (oblique, d_obl) = ground_hit_from(1.0, 2.0);
+        let s = oblique.differentials(&d_obl);
+        // Seen at incidence θ (cos θ = 1/√5 here), the footprint stretches by
+        // about 1/cos θ along the tilt.
+        let stretch = s.dpdy.length() / s.dpdx.length();
+        assert!((stretch / 5f32.sqrt() - 1.0).abs() < 0.05, "{stretch}");
+    }
+
+    #[test]
+    fn uv_derivatives_solve_the_tangent_plane_system() {
+        let (hit, diff) = ground_hit_from(2.0, 0.5);
+        let s = hit.differentials(&diff);
+        for (dp, duv) in [(s.dpdx, s.duvdx), (s.dpdy, s.duvdy)] {
+            let rebuilt = duv.x * hit.dpdu + duv.y * hit.dpdv;
+            assert!((rebuilt - dp).length() < 1e-5 * dp.length().max(1e-3));
+        }
+    }
+
+    #[test]
+    fn grazing_rays_give_finite_footprints() {
+        let (mut hit, mut diff) = ground_hit_from(1.0, 1e6);
+        diff.ry_direction = Vec3::new(0.0, 0.0, -1.0);
+        let s = hit.differentials(&diff);
+        assert!(s.dpdy.is_finite() && s.duvdy.is_finite());
+        hit.dpdv = hit.dpdu; // degenerate parameterisation
+        assert_eq!(hit.differentials(&diff).duvdx, Vec2::ZERO);
+    }
+}

@@ -1,0 +1,102 @@
+//! Arbitrary output variables: per-pixel buffers other than radiance, for
+//! studying a stage (texture coordinates, MIP level, normals, depth, albedo).
+
+use crate::{Scene, Surface};
+use glam::Vec3;
+use glint_camera::Film;
+use glint_geometry::{Ray, RayDifferential};
+use glint_lighting::Light;
+use glint_texture::TexCoord;
+
+/// What a render writes instead of radiance. Misses write 0 in every AOV.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Aov {
+    /// `(u, v, 0)`: the surface's own uv at the first hit.
+    Uv,
+    /// `(l, l, l)`: the continuous MIP level the diffuse texture is read at
+    /// (0 for textures without a pyramid).
+    MipLevel,
+    /// The shading normal at the first hit, components in [−1, 1].
+    Normal,
+    /// `(d, d, d)`: the distance from the camera to the first hit.
+    Depth,
+    /// The filtered diffuse reflectance `kd` (a light's color where a light is hit).
+    Albedo,
+}
+
+impl Aov {
+    pub const NAMES: [&'static str; 5] = ["uv", "mip-level", "normal", "depth", "albedo"];
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "uv" => Some(Self::Uv),
+            "mip-level" => Some(Self::MipLevel),
+            "normal" => Some(Self::Normal),
+            "depth" => Some(Self::Depth),
+            "albedo" => Some(Self::Albedo),
+            _ => None,
+        }
+    }
+
+    /// The value of this AOV along a camera ray.
+    pub fn evaluate(self, scene: &Scene, ray: &Ray, diff: &RayDifferential) -> Vec3 {
+        let Some(hit) = scene.shapes.closest_hit(ray, f32::INFINITY) else {
+            return Vec3::ZERO;
+        };
+        let material = match scene.surfaces[hit.shape as usize] {
+            Surface::Material(m) => Some(&scene.materials[m as usize]),
+            Surface::Emitter(_) => None,
+        };
+        let tc = || {
+            let d = hit.differentials(diff);
+            TexCoord {
+                uv: hit.uv,
+                duvdx: d.duvdx,
+                duvdy: d.duvdy,
+            }
+        };
+        match self {
+            Aov::Uv => hit.uv.extend(0.0),
+            Aov::Normal => hit.shading_normal,
+            Aov::Depth => Vec3::splat(hit.t * ray.direction.length()),
+            Aov::MipLevel => Vec3::splat(material.map_or(0.0, |m| m.diffuse_mip_level(&tc()))),
+            Aov::Albedo => match scene.surfaces[hit.shape as usize] {
+                Surface::Material(m) => scene.materials[m as usize].reflectances(&tc()).0,
+                Surface::Emitter(l) => match &scene.lights[l as usize] {
+                    Light::Area(a) => a.color,
+                    Light::Point(p) => p.color,
+                },
+            },
+        }
+    }
+
+    /// The buffer mapped to displayable colors, for 8-bit output: normals to
+    /// `0.5·n + 0.5`, uv to its fractional part, depth to gray (near bright, far
+    /// dark, 0 for misses), MIP levels to a blue → green → red ramp over
+    /// 0 … highest level seen; albedo unchanged.
+    pub fn false_color(self, film: &Film) -> Film {
+        let max = film.pixels().iter().fold(0.0f32, |m, p| m.max(p.x));
+        let mut out = film.clone();
+        for p in out.pixels_mut() {
+            *p = match self {
+                Aov::Normal => 0.5 * *p + 0.5,
+                Aov::Uv => Vec3::new(p.x.rem_euclid(1.0), p.y.rem_euclid(1.0), 0.0),
+                Aov::Depth if p.x > 0.0 && max > 0.0 => Vec3::splat(1.0 - 0.9 * p.x / max),
+                Aov::Depth => Vec3::ZERO,
+                Aov::MipLevel => ramp(if max > 0.0 { p.x / max } else { 0.0 }),
+                Aov::Albedo => *p,
+            };
+        }
+        out
+    }
+}
+
+/// Blue (0) → green (0.5) → red (1).
+fn ramp(x: f32) -> Vec3 {
+    let x = x.clamp(0.0, 1.0);
+    if x < 0.5 {
+        Vec3::new(0.0, 2.0 * x, 1.0 - 2.0 * x)
+    } else {
+        Vec3::new(2.0 * x - 1.0, 2.0 - 2.0 * x, 0.0)
+    }
+}

@@ -200,3 +200,132 @@ fn help_documents_every_flag() {
     let o = glint(&["--help"], Path::new("."));
     assert!(String::from_utf8_lossy(&o.stdout).contains("render"));
 }
+
+/// Reads a PFM written by glint: (width, height, RGB rows from the top).
+fn read_pfm(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
+    let bytes = std::fs::read(path).unwrap();
+    let header_end = bytes
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b == b'\n')
+        .nth(2)
+        .unwrap()
+        .0
+        + 1;
+    let header = String::from_utf8_lossy(&bytes[..header_end]).into_owned();
+    let mut words = header.split_whitespace().skip(1);
+    let w: usize = words.next().unwrap().parse().unwrap();
+    let h: usize = words.next().unwrap().parse().unwrap();
+    let floats: Vec<f32> = bytes[header_end..]
+        .chunks(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    let mut rows: Vec<[f32; 3]> = floats.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+    // PFM stores the bottom row first.
+    let mut top_first = Vec::with_capacity(rows.len());
+    for row in rows.chunks_mut(w).rev() {
+        top_first.extend_from_slice(row);
+    }
+    (w, h, top_first)
+}
+
+#[test]
+fn aovs_write_raw_values_to_float_files_and_false_color_to_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let point_light = scene("point-light");
+    let run = |aov: &str, out: &str| {
+        let args = [
+            "render",
+            point_light.as_str(),
+            "-o",
+            out,
+            "--aov",
+            aov,
+            "--resolution",
+            "32x24",
+            "--spp",
+            "1",
+        ];
+        let o = glint(&args, dir.path());
+        assert!(o.status.success(), "{aov}: {}", stderr(&o));
+    };
+    run("normal", "normal.pfm");
+    let (w, h, normals) = read_pfm(&dir.path().join("normal.pfm"));
+    assert_eq!((w, h), (32, 24));
+    // Bottom-left corner sees the ground plane (normal +y); the top row sees sky (0).
+    assert_eq!(normals[(h - 1) * w], [0.0, 1.0, 0.0]);
+    assert_eq!(normals[0], [0.0, 0.0, 0.0]);
+    // At 33x25 the centre pixel's ray is the view direction: from (0, 2.5, 6)
+    // towards (0, 0.5, 0), meeting the unit sphere at (0, 1, 0).
+    let args = [
+        "render",
+        point_light.as_str(),
+        "-o",
+        "depth.pfm",
+        "--aov",
+        "depth",
+        "--resolution",
+        "33x25",
+        "--spp",
+        "1",
+        "--sampler",
+        "grid",
+    ];
+    assert!(glint(&args, dir.path()).status.success());
+    let (w, _, depth) = read_pfm(&dir.path().join("depth.pfm"));
+    let centre = depth[12 * w + 16][0];
+    let expected = ray_sphere_distance([0.0, 2.5, 6.0], [0.0, -2.0, -6.0], [0.0, 1.0, 0.0], 1.0);
+    assert!((centre - expected).abs() < 1e-4, "{centre} vs {expected}");
+    for aov in ["uv", "mip-level", "normal", "depth", "albedo"] {
+        run(aov, &format!("{aov}.png"));
+        assert!(image_dimensions(&dir.path().join(format!("{aov}.png"))) == (32, 24));
+    }
+    let o = glint(
+        &["render", point_light.as_str(), "--aov", "bogus"],
+        dir.path(),
+    );
+    assert_input_error(&o, "invalid value 'bogus' for '--aov <BUFFER>'");
+}
+
+#[test]
+fn texture_filter_override_changes_the_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let ground = scene("ground-mipmap");
+    let mut files = Vec::new();
+    for filter in ["nearest", "ewa"] {
+        let out = format!("{filter}.pfm");
+        let args = [
+            "render",
+            ground.as_str(),
+            "-o",
+            &out,
+            "--texture-filter",
+            filter,
+            "--resolution",
+            "64x36",
+            "--spp",
+            "1",
+        ];
+        let o = glint(&args, dir.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        files.push(std::fs::read(dir.path().join(&out)).unwrap());
+    }
+    assert_ne!(files[0], files[1]);
+}
+
+/// Distance from `origin` along `direction` to the first hit on a sphere.
+fn ray_sphere_distance(origin: [f32; 3], direction: [f32; 3], centre: [f32; 3], r: f32) -> f32 {
+    let dot = |a: [f32; 3], b: [f32; 3]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f32>();
+    let len = dot(direction, direction).sqrt();
+    let d = direction.map(|x| x / len);
+    let f = [0, 1, 2].map(|i| origin[i] - centre[i]);
+    let b = dot(f, d);
+    -b - (b * b - (dot(f, f) - r * r)).sqrt()
+}
+
+fn image_dimensions(path: &Path) -> (u32, u32) {
+    // PNG: width and height are big-endian u32s at bytes 16..24.
+    let bytes = std::fs::read(path).unwrap();
+    let be = |i: usize| u32::from_be_bytes(bytes[i..i + 4].try_into().unwrap());
+    (be(16), be(20))
+}

@@ -1,6 +1,7 @@
 //! Every kind of bad scene input gives one located, field-named error.
 
 use glint_scene::{parse, SceneError};
+use glint_texture::{Texture, TextureFilter, WrapMode};
 
 const CAMERA: &str = "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfov = 45\n";
 const MATERIAL: &str = "[materials.m]\ndiffuse = [1, 1, 1]\n";
@@ -50,6 +51,13 @@ fn each_kind_of_bad_input_has_its_own_message() {
         ("unknown lobe", format!("{CAMERA}[materials.m]\ndiffuse = [1, 1, 1]\nlobe = \"cook-torrance\"\n")),
         ("negative shininess", format!("{CAMERA}[materials.m]\ndiffuse = [1, 1, 1]\nshininess = -2\n")),
         ("unknown texture kind", format!("{CAMERA}[textures.t.marble]\nscale = 1\n")),
+        ("missing image file", format!("{CAMERA}[textures.t.image]\nfile = \"no/such/image.png\"\n")),
+        ("unknown image filter", format!("{CAMERA}[textures.t.image]\nfile = \"x.png\"\nfilter = \"cubic\"\n")),
+        ("unknown wrap mode", format!("{CAMERA}[textures.t.image]\nfile = \"x.png\"\nwrap = \"border\"\n")),
+        ("unknown checker filter", format!("{CAMERA}[textures.t.checkerboard]\ncolors = [[0, 0, 0], [1, 1, 1]]\nchecks = 4\nfilter = \"trilinear\"\n")),
+        ("checker image too large", format!("{CAMERA}[textures.t.checker_image]\ncolors = [[0, 0, 0], [1, 1, 1]]\nchecks = 1000\npixels_per_check = 32\n")),
+        ("zero uv scale", format!("{CAMERA}[materials.m]\ndiffuse = [1, 1, 1]\nuv_scale = [0, 1]\n")),
+        ("zero tile size", format!("{CAMERA}{MATERIAL}[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\ntile_size = 0\nmaterial = \"m\"\n")),
     ];
     let mut report = String::new();
     for (name, body) in &cases {
@@ -103,4 +111,42 @@ fn missing_file_names_the_path() {
     assert!(e
         .to_string()
         .starts_with("no/such/scene.toml: cannot read the scene file"));
+}
+
+#[test]
+fn image_paths_are_relative_to_the_scene_file_and_loaded_once() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("tex")).unwrap();
+    image::RgbImage::from_pixel(4, 2, image::Rgb([255, 128, 0]))
+        .save(dir.path().join("tex/orange.png"))
+        .unwrap();
+    let scene = format!(
+        "{CAMERA}[textures.a.image]\nfile = \"tex/orange.png\"\n\
+         [textures.b.image]\nfile = \"tex/orange.png\"\nfilter = \"ewa\"\nwrap = \"clamp\"\n\
+         [materials.m]\ndiffuse = \"a\"\nspecular = \"b\"\nuv_scale = [2, 3]\nuv_offset = [0.5, 0]\n"
+    );
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let d = glint_scene::load(&path).unwrap();
+    let m = &d.scene.materials[0];
+    let (Texture::Image(a), Some(Texture::Image(b))) = (&m.diffuse, &m.specular) else {
+        panic!("{m:?}")
+    };
+    assert!(
+        std::sync::Arc::ptr_eq(&a.image, &b.image),
+        "one image, loaded once"
+    );
+    assert_eq!(
+        (a.filter, a.wrap),
+        (TextureFilter::Trilinear, WrapMode::Repeat)
+    );
+    assert_eq!((b.filter, b.wrap), (TextureFilter::Ewa, WrapMode::Clamp));
+    assert_eq!(a.image.image().width(), 4);
+    let texel = a.image.image().texel(0, 0);
+    assert!(
+        (texel.x - 1.0).abs() < 1e-6 && (texel.y - 0.215_861).abs() < 1e-5,
+        "{texel}"
+    );
+    assert_eq!(m.uv_transform.scale, glam::Vec2::new(2.0, 3.0));
+    assert_eq!(m.uv_transform.offset, glam::Vec2::new(0.5, 0.0));
 }

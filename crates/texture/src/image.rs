@@ -66,33 +66,33 @@ impl Image {
     }
 
     /// The texel containing `st` (texture coordinates: [0, 1]² is one copy of the
-    /// image, t = 0 at the top row).
+    /// image, t = 0 at the top row): texel `(⌊s·w⌋, ⌊t·h⌋)`, wrapped.
     #[inline]
     pub fn nearest(&self, st: Vec2, wrap: WrapMode) -> Vec3 {
-        let x = (st.x * self.width as f32).floor();
-        let y = (st.y * self.height as f32).floor();
-        self.texel_wrapped(saturating_index(x), saturating_index(y), wrap)
+        let p = (reduce_st(st, wrap) * self.size()).floor();
+        self.texel_wrapped(p.x as i64, p.y as i64, wrap)
     }
 
-    /// Bilinear interpolation between the four texel centres around `st`.
+    /// Bilinear interpolation between the four texel centres around `st`: with
+    /// `(x, y) = (s·w − ½, t·h − ½)`, the texels around `(x, y)` blended by the
+    /// fractional parts (pbrt-v4 `Image::Bilerp`, section 10.4.3). Written as nested
+    /// [`lerp`]s so that equal texels give exactly that texel back.
     #[inline]
     pub fn bilinear(&self, st: Vec2, wrap: WrapMode) -> Vec3 {
-        let x = st.x * self.width as f32 - 0.5;
-        let y = st.y * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (xi, yi) = (saturating_index(x0), saturating_index(y0));
-        let texel = |dx: i64, dy: i64| {
-            self.texel_wrapped(xi.saturating_add(dx), yi.saturating_add(dy), wrap)
-        };
-        let top = texel(0, 0).lerp(texel(1, 0), fx);
-        let bottom = texel(0, 1).lerp(texel(1, 1), fx);
-        let value = top.lerp(bottom, fy);
-        if value.is_finite() {
-            value
-        } else {
-            texel(0, 0)
-        }
+        let p = reduce_st(st, wrap) * self.size() - 0.5;
+        let p0 = p.floor();
+        let f = p - p0;
+        let (x, y) = (p0.x as i64, p0.y as i64);
+        let texel = |dx, dy| self.texel_wrapped(x + dx, y + dy, wrap);
+        let top = lerp(texel(0, 0), texel(1, 0), f.x);
+        let bottom = lerp(texel(0, 1), texel(1, 1), f.x);
+        lerp(top, bottom, f.y)
+    }
+
+    /// `(width, height)` as floats.
+    #[inline]
+    pub fn size(&self) -> Vec2 {
+        Vec2::new(self.width as f32, self.height as f32)
     }
 
     /// The mean of all texels (accumulated in f64).
@@ -105,11 +105,35 @@ impl Image {
     }
 }
 
-/// A texel index from a floored coordinate; NaN maps to 0 and huge values
-/// saturate (wrap modes then bring them inside the image).
+/// With [`WrapMode::Clamp`], st is clamped to `[−CLAMP_MARGIN, 1 + CLAMP_MARGIN]`: every
+/// lookup that reaches the scan reads at most ~16 texel-widths of the 1×1 level away,
+/// so beyond this margin every texel it reads is a border texel anyway.
+const CLAMP_MARGIN: f32 = 16.0;
+
+/// `st` moved into a small range where every lookup gives the same result, so huge
+/// coordinates keep their f32 precision (and texel indices cannot overflow):
+/// Repeat has period 1, Mirror period 2, and Clamp reads only border texels beyond
+/// [`CLAMP_MARGIN`]. Non-finite coordinates become 0.
 #[inline]
-fn saturating_index(floored: f32) -> i64 {
-    floored as i64
+pub(crate) fn reduce_st(st: Vec2, wrap: WrapMode) -> Vec2 {
+    let reduce = |x: f32| {
+        if !x.is_finite() {
+            return 0.0;
+        }
+        match wrap {
+            WrapMode::Repeat => x.rem_euclid(1.0),
+            WrapMode::Mirror => x.rem_euclid(2.0),
+            WrapMode::Clamp => x.clamp(-CLAMP_MARGIN, 1.0 + CLAMP_MARGIN),
+        }
+    };
+    Vec2::new(reduce(st.x), reduce(st.y))
+}
+
+/// `a + (b − a)·t`: exactly `a` when `a = b` (glam's `Vec3::lerp`, `a(1 − t) + b t`,
+/// is not), so constant images filter to exactly their constant.
+#[inline]
+pub(crate) fn lerp(a: Vec3, b: Vec3, t: f32) -> Vec3 {
+    a + (b - a) * t
 }
 
 /// How texel coordinates outside `[0, n)` map back into the image.

@@ -10,6 +10,7 @@ use std::sync::OnceLock;
 
 use glam::{Vec2, Vec3};
 
+use crate::image::{lerp, reduce_st};
 use crate::{Image, WrapMode};
 
 /// The largest ratio of major to minor axis that [`MipMap::ewa`] filters
@@ -31,11 +32,6 @@ const EWA_MAX_TEXELS: f32 = 4096.0;
 /// The longest footprint axis (in st units, i.e. copies of the image) that lookups
 /// keep; longer ones are already blurred to the 1×1 level.
 const MAX_FOOTPRINT: f32 = 1024.0;
-
-/// With [`WrapMode::Clamp`], st is clamped to `[−CLAMP_MARGIN, 1 + CLAMP_MARGIN]`: every
-/// lookup that reaches the scan reads at most ~16 texel-widths of the 1×1 level away,
-/// so beyond this margin every texel it reads is a border texel anyway.
-const CLAMP_MARGIN: f32 = 16.0;
 
 /// An image pyramid from the full-resolution image down to 1×1.
 #[derive(Clone, Debug)]
@@ -79,9 +75,7 @@ impl MipMap {
     /// wrapped: texel `(⌊s·w⌋, ⌊t·h⌋)`. Levels past the last use the last.
     #[inline]
     pub fn nearest(&self, level: usize, st: Vec2, wrap: WrapMode) -> Vec3 {
-        let image = self.level(level);
-        let p = (reduce_st(st, wrap) * image_size(image)).floor();
-        image.texel_wrapped(p.x as i64, p.y as i64, wrap)
+        self.level(level).nearest(st, wrap)
     }
 
     /// Bilinear interpolation of `level` at st (texel centres at (i+0.5)/n), wrapped.
@@ -90,7 +84,7 @@ impl MipMap {
     /// the fractional parts of `x` and `y` (pbrt-v4 `Image::Bilerp`, section 10.4.3).
     #[inline]
     pub fn bilinear(&self, level: usize, st: Vec2, wrap: WrapMode) -> Vec3 {
-        bilerp(self.level(level), reduce_st(st, wrap), wrap)
+        self.level(level).bilinear(st, wrap)
     }
 
     /// The continuous level whose texel size matches a footprint `width` (in st units,
@@ -118,11 +112,11 @@ impl MipMap {
         let st = reduce_st(st, wrap);
         let lower = level as usize; // level is finite and ≥ 0
         let frac = level - lower as f32;
-        let fine = bilerp(self.level(lower), st, wrap);
+        let fine = self.level(lower).bilinear(st, wrap);
         if frac == 0.0 {
             return fine;
         }
-        lerp(fine, bilerp(self.level(lower + 1), st, wrap), frac)
+        lerp(fine, self.level(lower + 1).bilinear(st, wrap), frac)
     }
 
     /// Elliptically weighted average (Heckbert 1989; pbrt-v4 MIPMap::EWA, section 10.4.4).
@@ -180,52 +174,6 @@ impl MipMap {
         let level0 = &self.levels[0];
         level0.width().max(level0.height()) as f32
     }
-}
-
-/// `(width, height)` of `image` as floats.
-#[inline]
-fn image_size(image: &Image) -> Vec2 {
-    Vec2::new(image.width() as f32, image.height() as f32)
-}
-
-/// `st` moved into a small range where every lookup gives the same result, so huge
-/// coordinates keep their f32 precision (and texel indices cannot overflow):
-/// Repeat has period 1, Mirror period 2, and Clamp reads only border texels beyond
-/// [`CLAMP_MARGIN`]. Non-finite coordinates become 0.
-#[inline]
-fn reduce_st(st: Vec2, wrap: WrapMode) -> Vec2 {
-    let reduce = |x: f32| {
-        if !x.is_finite() {
-            return 0.0;
-        }
-        match wrap {
-            WrapMode::Repeat => x.rem_euclid(1.0),
-            WrapMode::Mirror => x.rem_euclid(2.0),
-            WrapMode::Clamp => x.clamp(-CLAMP_MARGIN, 1.0 + CLAMP_MARGIN),
-        }
-    };
-    Vec2::new(reduce(st.x), reduce(st.y))
-}
-
-/// Bilinear interpolation of `image` at (already reduced) `st`: see [`MipMap::bilinear`].
-/// Written as nested lerps so that equal texels give exactly that texel back.
-#[inline]
-fn bilerp(image: &Image, st: Vec2, wrap: WrapMode) -> Vec3 {
-    let p = st * image_size(image) - 0.5;
-    let p0 = p.floor();
-    let f = p - p0;
-    let (x, y) = (p0.x as i64, p0.y as i64);
-    let texel = |dx, dy| image.texel_wrapped(x + dx, y + dy, wrap);
-    let top = lerp(texel(0, 0), texel(1, 0), f.x);
-    let bottom = lerp(texel(0, 1), texel(1, 1), f.x);
-    lerp(top, bottom, f.y)
-}
-
-/// `a + (b − a)·t`: exactly `a` when `a = b` (glam's `Vec3::lerp`, `a(1 − t) + b t`,
-/// is not), so constant images filter to exactly their constant.
-#[inline]
-fn lerp(a: Vec3, b: Vec3, t: f32) -> Vec3 {
-    a + (b - a) * t
 }
 
 // ---------------------------------------------------------------------------------
@@ -399,7 +347,7 @@ fn ewa_weights() -> &'static [f32; EWA_LUT_SIZE] {
 /// gets the Gaussian weight from [`ewa_weights`]; the result is the weighted mean.
 /// `None` if the box holds more than [`EWA_MAX_TEXELS`] texels.
 fn ewa_in_level(image: &Image, st: Vec2, axes: EwaAxes, wrap: WrapMode) -> Option<Vec3> {
-    let res = image_size(image);
+    let res = image.size();
     let p = st * res - 0.5;
     let (a, b) = (axes.major * res, axes.minor * res);
     let ca = a.y * a.y + b.y * b.y + 1.0;
@@ -433,7 +381,7 @@ fn ewa_in_level(image: &Image, st: Vec2, axes: EwaAxes, wrap: WrapMode) -> Optio
     Some(if sum_weights > 0.0 {
         sum / sum_weights
     } else {
-        bilerp(image, st, wrap)
+        image.bilinear(st, wrap)
     })
 }
 

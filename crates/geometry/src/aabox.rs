@@ -96,6 +96,8 @@ impl AaBox {
             uv: 0.5 * (Vec2::new(us * q[ua], vs * q[va]) + Vec2::ONE),
             dpdu,
             dpdv,
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
             front_face: normal.dot(ray.direction) < 0.0,
             shape: 0,
         }

@@ -32,6 +32,58 @@ pub struct SurfaceDifferentials {
 /// they would otherwise overflow the filters downstream.
 const MAX_UV_DERIVATIVE: f32 = 1e8;
 
+/// The mirror reflection of a ray with differentials at a hit, and its
+/// differentials: pbrt-v4's `SurfaceInteraction::SpawnRay` for perfect specular
+/// reflection (after Igehy 1999). With `wo = −d`, `n` the normal on `wo`'s side and
+/// `wi = 2(wo·n)n − wo`, the offset rays leave from `p + ∂p/∂x` along
+/// `wi − ∂wo/∂x + 2((wo·n)·∂n/∂x + (∂wo/∂x·n + wo·∂n/∂x)·n)`, where
+/// `∂n/∂x = ∂n/∂u·∂u/∂x + ∂n/∂v·∂v/∂x`: curved mirrors widen the footprint.
+pub fn reflect_differential(
+    hit: &Hit,
+    direction: Vec3,
+    diff: &RayDifferential,
+    surface: &SurfaceDifferentials,
+) -> (Vec3, RayDifferential) {
+    let wo = -direction.normalize();
+    let n = hit.facing_normal(direction);
+    let wi = 2.0 * wo.dot(n) * n - wo;
+    let flip = if n.dot(hit.shading_normal) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let dndx = flip * (hit.dndu * surface.duvdx.x + hit.dndv * surface.duvdx.y);
+    let dndy = flip * (hit.dndu * surface.duvdy.x + hit.dndv * surface.duvdy.y);
+    let offset = |d_dir: Vec3, dndx: Vec3| {
+        let dwo = -d_dir.normalize() - wo;
+        let d_dn = dwo.dot(n) + wo.dot(dndx);
+        wi - dwo + 2.0 * (wo.dot(n) * dndx + d_dn * n)
+    };
+    let differential = RayDifferential {
+        rx_origin: hit.point + surface.dpdx,
+        rx_direction: offset(diff.rx_direction, dndx),
+        ry_origin: hit.point + surface.dpdy,
+        ry_direction: offset(diff.ry_direction, dndy),
+    };
+    (wi, differential)
+}
+
+impl RayDifferential {
+    /// The angle (radians) between a ray of direction `d` and the wider of its two
+    /// offset rays: the angular footprint an environment lookup filters over.
+    pub fn angular_width(&self, d: Vec3) -> f32 {
+        let angle = |o: Vec3| {
+            let cos = d.normalize().dot(o.normalize());
+            if cos.is_finite() {
+                cos.clamp(-1.0, 1.0).acos()
+            } else {
+                0.0
+            }
+        };
+        angle(self.rx_direction).max(angle(self.ry_direction))
+    }
+}
+
 impl Hit {
     /// The footprint of the pixel whose ray differentials are `diff` at this hit.
     pub fn differentials(&self, diff: &RayDifferential) -> SurfaceDifferentials {
@@ -141,5 +193,49 @@ mod tests {
         assert!(s.dpdy.is_finite() && s.duvdy.is_finite());
         hit.dpdv = hit.dpdu; // degenerate parameterisation
         assert_eq!(hit.differentials(&diff).duvdx, Vec2::ZERO);
+    }
+}
+
+#[cfg(test)]
+mod reflection_tests {
+    use super::*;
+    use crate::{Plane, Ray, Shape, Sphere};
+
+    fn camera_like(origin: Vec3, d: Vec3, spread: f32) -> RayDifferential {
+        let (right, up) = d.normalize().any_orthonormal_pair();
+        RayDifferential {
+            rx_origin: origin,
+            rx_direction: (d.normalize() + spread * right).normalize(),
+            ry_origin: origin,
+            ry_direction: (d.normalize() + spread * up).normalize(),
+        }
+    }
+
+    #[test]
+    fn a_flat_mirror_keeps_the_angular_spread_and_a_curved_one_widens_it() {
+        let origin = Vec3::new(0.0, 0.0, 5.0);
+        let d = -Vec3::Z;
+        let diff = camera_like(origin, d, 0.001);
+        let spread_in = diff.angular_width(d);
+        let flat = Shape::from(Plane::new(Vec3::ZERO, Vec3::Z, false).unwrap());
+        let ball = Shape::from(Sphere::new(Vec3::new(0.0, 0.0, -1.0), 1.0).unwrap());
+        let ray = Ray::new(origin, d);
+        let widths: Vec<f32> = [flat, ball]
+            .iter()
+            .map(|shape| {
+                let hit = shape.intersect(&ray, f32::INFINITY).unwrap();
+                let (wi, reflected) =
+                    reflect_differential(&hit, d, &diff, &hit.differentials(&diff));
+                assert!((wi - Vec3::Z).length() < 1e-5);
+                reflected.angular_width(wi)
+            })
+            .collect();
+        assert!(
+            (widths[0] - spread_in).abs() < 1e-4,
+            "{widths:?} {spread_in}"
+        );
+        // A convex mirror of radius 1 seen from distance 5 spreads the beam by
+        // about 1 + 2·5/1 = 11 times.
+        assert!(widths[1] > 8.0 * spread_in, "{widths:?} {spread_in}");
     }
 }

@@ -16,6 +16,10 @@ pub struct Hit {
     pub dpdu: Vec3,
     /// ∂p/∂v: world-space change of the point per unit of v.
     pub dpdv: Vec3,
+    /// ∂n/∂u: change of the shading normal per unit of u (zero on flat shapes).
+    pub dndu: Vec3,
+    /// ∂n/∂v: change of the shading normal per unit of v.
+    pub dndv: Vec3,
     /// Whether the ray arrived on the side the geometric normal points to.
     pub front_face: bool,
     /// Index of the shape in the collection that was queried.

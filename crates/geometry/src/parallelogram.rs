@@ -99,6 +99,8 @@ impl Parallelogram {
             uv,
             dpdu: self.edge1,
             dpdv: self.edge2,
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
             front_face: self.normal.dot(ray.direction) < 0.0,
             shape: 0,
         }

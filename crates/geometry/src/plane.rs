@@ -69,6 +69,8 @@ impl Plane {
             uv: Vec2::new(local.dot(self.tangent), local.dot(self.bitangent)) / self.tile,
             dpdu: self.tangent * self.tile,
             dpdv: self.bitangent * self.tile,
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
             front_face: self.normal.dot(ray.direction) < 0.0,
             shape: 0,
         }

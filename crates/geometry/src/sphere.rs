@@ -86,6 +86,9 @@ impl Sphere {
             uv: Vec2::new(phi / TAU, 1.0 - theta / PI),
             dpdu,
             dpdv,
+            // n = (p − c)/r, so ∂n/∂u = (∂p/∂u)/r (Weingarten, for a sphere).
+            dndu: dpdu / r,
+            dndv: dpdv / r,
             front_face: n.dot(ray.direction) < 0.0,
             shape: 0,
         }

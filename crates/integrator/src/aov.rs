@@ -22,10 +22,20 @@ pub enum Aov {
     Depth,
     /// The filtered diffuse reflectance `kd` (a light's color where a light is hit).
     Albedo,
+    /// `(n, n, n)`: how many mirror reflections the camera ray's path took (0 when
+    /// it stops at its first hit or misses), up to the render's max depth.
+    ReflectionDepth,
 }
 
 impl Aov {
-    pub const NAMES: [&'static str; 5] = ["uv", "mip-level", "normal", "depth", "albedo"];
+    pub const NAMES: [&'static str; 6] = [
+        "uv",
+        "mip-level",
+        "normal",
+        "depth",
+        "albedo",
+        "reflection-depth",
+    ];
 
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
@@ -34,12 +44,20 @@ impl Aov {
             "normal" => Some(Self::Normal),
             "depth" => Some(Self::Depth),
             "albedo" => Some(Self::Albedo),
+            "reflection-depth" => Some(Self::ReflectionDepth),
             _ => None,
         }
     }
 
-    /// The value of this AOV along a camera ray.
-    pub fn evaluate(self, scene: &Scene, ray: &Ray, diff: &RayDifferential) -> Vec3 {
+    /// The value of this AOV along a camera ray, following at most `max_depth`
+    /// mirror reflections.
+    pub fn evaluate(
+        self,
+        scene: &Scene,
+        ray: &Ray,
+        diff: &RayDifferential,
+        max_depth: u32,
+    ) -> Vec3 {
         let Some(hit) = scene.shapes.closest_hit(ray, f32::INFINITY) else {
             return Vec3::ZERO;
         };
@@ -60,6 +78,7 @@ impl Aov {
             Aov::Normal => hit.shading_normal,
             Aov::Depth => Vec3::splat(hit.t * ray.direction.length()),
             Aov::MipLevel => Vec3::splat(material.map_or(0.0, |m| m.diffuse_mip_level(&tc()))),
+            Aov::ReflectionDepth => Vec3::splat(reflection_depth(scene, *ray, max_depth) as f32),
             Aov::Albedo => match scene.surfaces[hit.shape as usize] {
                 Surface::Material(m) => scene.materials[m as usize].reflectances(&tc()).0,
                 Surface::Emitter(l) => match &scene.lights[l as usize] {
@@ -83,12 +102,36 @@ impl Aov {
                 Aov::Uv => Vec3::new(p.x.rem_euclid(1.0), p.y.rem_euclid(1.0), 0.0),
                 Aov::Depth if p.x > 0.0 && max > 0.0 => Vec3::splat(1.0 - 0.9 * p.x / max),
                 Aov::Depth => Vec3::ZERO,
-                Aov::MipLevel => ramp(if max > 0.0 { p.x / max } else { 0.0 }),
+                Aov::MipLevel | Aov::ReflectionDepth => {
+                    ramp(if max > 0.0 { p.x / max } else { 0.0 })
+                }
                 Aov::Albedo => *p,
             };
         }
         out
     }
+}
+
+/// The number of mirror reflections along the path of `ray`.
+fn reflection_depth(scene: &Scene, mut ray: Ray, max_depth: u32) -> u32 {
+    let mut depth = 0;
+    while depth < max_depth {
+        let Some(hit) = scene.shapes.closest_hit(&ray, f32::INFINITY) else {
+            break;
+        };
+        let reflective = match scene.surfaces[hit.shape as usize] {
+            Surface::Material(m) => scene.materials[m as usize].reflectivity > 0.0,
+            Surface::Emitter(_) => false,
+        };
+        if !reflective {
+            break;
+        }
+        let n = hit.facing_normal(ray.direction);
+        let wo = -ray.direction.normalize();
+        ray = glint_geometry::spawn_ray(&hit, 2.0 * wo.dot(n) * n - wo);
+        depth += 1;
+    }
+    depth
 }
 
 /// Blue (0) → green (0.5) → red (1).

@@ -1,65 +1,96 @@
 use crate::sampling::SamplePattern;
 use crate::{Scene, Surface};
 use glam::{Vec2, Vec3};
-use glint_geometry::{spawn_ray_to, Hit, Ray, RayDifferential};
+use glint_geometry::{reflect_differential, spawn_ray, spawn_ray_to, Hit, Ray, RayDifferential};
 use glint_lighting::{AreaLight, Light, PhongMaterial};
 use glint_texture::TexCoord;
 use rand_pcg::Pcg32;
 
-/// The direct-lighting integrator of the course report, section 2.5.
+/// The direct-lighting integrator of the course report (section 2.5), with the
+/// environment and mirror reflections of section 2.7.
 ///
-/// For a camera ray: a miss is black; a first hit on a light's front face is the
-/// light's color; otherwise the hit point reflects `ambient · kd` plus, for each
-/// light, the Phong reflection of every unoccluded light sample — one shadow ray per
-/// sample, the N samples of an area light averaged.
+/// For a ray: a miss sees the environment (black without one); a first hit on a
+/// light's front face is the light's color; otherwise the hit point reflects
+/// `ambient · kd`, plus for each light the Phong reflection of every unoccluded light
+/// sample (one shadow ray per sample, the N samples of an area light averaged), plus
+/// the environment's light through shadow rays towards importance-sampled directions;
+/// a material with reflectivity `r` blends in `r` times the mirror reflection, traced
+/// recursively up to `max_depth` reflections (beyond that, black).
 #[derive(Clone, Copy, Debug)]
 pub struct DirectIntegrator {
     pub light_samples: u32,
     pub light_pattern: SamplePattern,
+    pub environment_samples: u32,
+    pub max_depth: u32,
 }
 
 /// Reusable per-thread state: the random stream of the current camera sample,
-/// a buffer for light sample positions, and ray counters.
+/// buffers for sample positions, and ray counters.
 pub struct SampleContext {
     pub rng: Pcg32,
     pub light_points: Vec<Vec2>,
+    pub environment_points: Vec<Vec2>,
     pub shadow_rays: u64,
+    pub reflection_rays: u64,
 }
 
 impl SampleContext {
-    pub fn new(light_samples: u32) -> Self {
+    pub fn new(light_samples: u32, environment_samples: u32) -> Self {
         Self {
             rng: crate::sampling::pixel_rng(0, 0, 0),
             light_points: vec![Vec2::ZERO; light_samples as usize],
+            environment_points: vec![Vec2::ZERO; environment_samples as usize],
             shadow_rays: 0,
+            reflection_rays: 0,
         }
     }
 }
 
 impl DirectIntegrator {
-    /// Radiance arriving along `ray` (from the camera), whose pixel footprint is
-    /// given by the ray differentials `diff`.
+    /// Radiance arriving along `ray` (a camera ray, or a reflection ray `depth`
+    /// reflections deep), whose footprint is given by the ray differentials `diff`.
     pub fn li(
         &self,
         scene: &Scene,
         ray: &Ray,
         diff: &RayDifferential,
+        depth: u32,
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let Some(hit) = scene.shapes.closest_hit(ray, f32::INFINITY) else {
-            return Vec3::ZERO;
+            return match &scene.environment {
+                Some(env) => {
+                    env.radiance(ray.direction.normalize(), diff.angular_width(ray.direction))
+                }
+                None => Vec3::ZERO,
+            };
         };
-        match scene.surfaces[hit.shape as usize] {
-            Surface::Emitter(light) => match &scene.lights[light as usize] {
-                Light::Area(area) => area.color,
-                Light::Point(_) => Vec3::ZERO,
-            },
-            Surface::Material(m) => {
-                let material = &scene.materials[m as usize];
-                let tc = texture_footprint(material, &hit, diff);
-                self.shade(scene, material, &hit, ray, &tc, ctx)
+        let material = match scene.surfaces[hit.shape as usize] {
+            Surface::Emitter(light) => {
+                return match &scene.lights[light as usize] {
+                    Light::Area(area) => area.color,
+                    Light::Point(_) => Vec3::ZERO,
+                }
             }
-        }
+            Surface::Material(m) => &scene.materials[m as usize],
+        };
+        let r = material.reflectivity;
+        let local = if material.has_local_shading() {
+            let tc = texture_footprint(material, &hit, diff);
+            self.shade(scene, material, &hit, ray, &tc, ctx)
+        } else {
+            Vec3::ZERO
+        };
+        let mirror = if r > 0.0 && depth < self.max_depth {
+            let surface = hit.differentials(diff);
+            let (wi, reflected_diff) = reflect_differential(&hit, ray.direction, diff, &surface);
+            let reflected = spawn_ray(&hit, wi);
+            ctx.reflection_rays += 1;
+            material.mirror_tint * self.li(scene, &reflected, &reflected_diff, depth + 1, ctx)
+        } else {
+            Vec3::ZERO
+        };
+        (1.0 - r) * local + r * mirror
     }
 
     fn shade(
@@ -87,6 +118,9 @@ impl DirectIntegrator {
                 Light::Area(area) => self.area_light(scene, &point, area, ctx),
             };
         }
+        if self.environment_samples > 0 {
+            radiance += self.environment_light(scene, &point, ctx);
+        }
         radiance
     }
 
@@ -110,6 +144,43 @@ impl DirectIntegrator {
         }
         ctx.light_points = samples;
         light.color * sum / self.light_samples as f32
+    }
+
+    /// Monte Carlo estimate of `∫ L_env(ω)·V(ω)·f(ω)·cos θ dω` with directions
+    /// importance-sampled from the environment (stratified over [0, 1)²).
+    fn environment_light(
+        &self,
+        scene: &Scene,
+        point: &ShadingPoint,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let Some(env) = &scene.environment else {
+            return Vec3::ZERO;
+        };
+        let mut samples = std::mem::take(&mut ctx.environment_points);
+        SamplePattern::Stratified.fill(&mut ctx.rng, &mut samples);
+        let mut sum = Vec3::ZERO;
+        for &u in &samples {
+            let s = env.sample(point.n, u);
+            if s.pdf.is_nan() || s.pdf <= 0.0 || s.radiance == Vec3::ZERO {
+                continue;
+            }
+            let f = point
+                .material
+                .brdf_cos(point.kd, point.ks, point.n, s.direction, point.v);
+            if f == Vec3::ZERO {
+                continue;
+            }
+            ctx.shadow_rays += 1;
+            if !scene
+                .shapes
+                .any_hit(&spawn_ray(point.hit, s.direction), f32::INFINITY)
+            {
+                sum += s.radiance * f / s.pdf;
+            }
+        }
+        ctx.environment_points = samples;
+        sum / self.environment_samples as f32
     }
 }
 

@@ -12,6 +12,9 @@ use std::time::{Duration, Instant};
 /// parallel rendering.
 pub const TILE_SIZE: u32 = 16;
 
+/// The most mirror reflections a render follows.
+pub const MAX_DEPTH: u32 = 64;
+
 /// The most worker threads a render accepts.
 pub const MAX_THREADS: usize = 1024;
 
@@ -34,6 +37,11 @@ pub struct RenderSettings {
     pub threads: Option<usize>,
     /// Write this buffer instead of radiance.
     pub aov: Option<Aov>,
+    /// Most mirror reflections followed along one camera ray.
+    pub max_depth: u32,
+    /// Environment directions sampled per shading point to light surfaces
+    /// (0: the environment is only seen, directly and in mirrors).
+    pub environment_samples: u32,
 }
 
 impl Default for RenderSettings {
@@ -46,6 +54,8 @@ impl Default for RenderSettings {
             seed: 0,
             threads: None,
             aov: None,
+            max_depth: 4,
+            environment_samples: 16,
         }
     }
 }
@@ -57,6 +67,8 @@ pub enum SampleCount {
     PerPixel,
     /// Samples per area light per camera sample.
     PerLight,
+    /// Environment directions per shading point.
+    PerEnvironment,
 }
 
 impl std::fmt::Display for SampleCount {
@@ -64,6 +76,7 @@ impl std::fmt::Display for SampleCount {
         f.write_str(match self {
             SampleCount::PerPixel => "spp",
             SampleCount::PerLight => "light samples",
+            SampleCount::PerEnvironment => "environment samples",
         })
     }
 }
@@ -73,6 +86,8 @@ impl std::fmt::Display for SampleCount {
 pub enum SettingsError {
     #[error("{what} must be at least 1")]
     Zero { what: SampleCount },
+    #[error("max depth is {0}, more than the limit of {MAX_DEPTH}")]
+    Depth(u32),
     #[error("{what} is {count}, more than the limit of {MAX_SAMPLES}")]
     TooMany { what: SampleCount, count: u32 },
     #[error("{what} is {count}, but the grid pattern needs a perfect square (1, 4, 9, 16, …)")]
@@ -104,6 +119,15 @@ impl RenderSettings {
                 return Err(SettingsError::GridNotSquare { what, count });
             }
         }
+        if self.environment_samples > MAX_SAMPLES {
+            return Err(SettingsError::TooMany {
+                what: SampleCount::PerEnvironment,
+                count: self.environment_samples,
+            });
+        }
+        if self.max_depth > MAX_DEPTH {
+            return Err(SettingsError::Depth(self.max_depth));
+        }
         if let Some(n) = self.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
             return Err(SettingsError::Threads(n));
         }
@@ -116,12 +140,13 @@ impl RenderSettings {
 pub struct RenderStats {
     pub camera_rays: u64,
     pub shadow_rays: u64,
+    pub reflection_rays: u64,
     pub elapsed: Duration,
 }
 
 impl RenderStats {
     pub fn rays(&self) -> u64 {
-        self.camera_rays + self.shadow_rays
+        self.camera_rays + self.shadow_rays + self.reflection_rays
     }
 
     pub fn rays_per_second(&self) -> f64 {
@@ -168,12 +193,14 @@ fn render_on_current_pool(
     let integrator = DirectIntegrator {
         light_samples: settings.light_samples,
         light_pattern: settings.light_pattern,
+        environment_samples: settings.environment_samples,
+        max_depth: settings.max_depth,
     };
     let mut film = Film::new(resolution);
     let band = (TILE_SIZE * resolution.x) as usize;
     let total = film.pixels().len().div_ceil(band);
     let done = AtomicUsize::new(0);
-    let shadow_rays: u64 = film
+    let (shadow_rays, reflection_rays) = film
         .pixels_mut()
         .par_chunks_mut(band)
         .enumerate()
@@ -183,27 +210,28 @@ fn render_on_current_pool(
             on_tile_done(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             rays
         })
-        .sum();
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     let stats = RenderStats {
         camera_rays: resolution.x as u64 * resolution.y as u64 * settings.spp as u64,
         shadow_rays,
+        reflection_rays,
         elapsed: start.elapsed(),
     };
     RenderOutput { film, stats }
 }
 
 /// Renders the rows starting at `first_row` into `pixels` (whole rows, row-major);
-/// returns the number of shadow rays traced.
+/// returns the numbers of shadow and reflection rays traced.
 fn render_rows(
     scene: &Scene,
     settings: &RenderSettings,
     integrator: &DirectIntegrator,
     first_row: u32,
     pixels: &mut [Vec3],
-) -> u64 {
+) -> (u64, u64) {
     let width = scene.camera.resolution().x;
     let mut pixel_samples = vec![Vec2::ZERO; settings.spp as usize];
-    let mut ctx = SampleContext::new(settings.light_samples);
+    let mut ctx = SampleContext::new(settings.light_samples, settings.environment_samples);
     // Each of spp samples stands for 1/√spp of the pixel's width (pbrt-v4 scales
     // differentials the same way, never below 1/8).
     let footprint_scale = (1.0 / (settings.spp as f32).sqrt()).max(0.125);
@@ -218,13 +246,13 @@ fn render_rows(
             let raster = Vec2::new(x as f32, y as f32) + *jitter;
             let (ray, diff) = camera_ray(scene, raster, footprint_scale);
             sum += match settings.aov {
-                None => integrator.li(scene, &ray, &diff, &mut ctx),
-                Some(aov) => aov.evaluate(scene, &ray, &diff),
+                None => integrator.li(scene, &ray, &diff, 0, &mut ctx),
+                Some(aov) => aov.evaluate(scene, &ray, &diff, settings.max_depth),
             };
         }
         *radiance = sum / settings.spp as f32;
     }
-    ctx.shadow_rays
+    (ctx.shadow_rays, ctx.reflection_rays)
 }
 
 /// The camera ray through `raster`, with differentials shrunk to `scale` pixels.

@@ -1,7 +1,7 @@
 use glam::Vec3;
 use glint_camera::Camera;
 use glint_geometry::{Shape, ShapeList};
-use glint_lighting::{AreaLight, Light, PhongMaterial, PointLight};
+use glint_lighting::{AreaLight, EnvironmentLight, Light, PhongMaterial, PointLight};
 use glint_texture::{Texture, TextureFilter};
 
 /// What a shape is to the integrator: a reflecting surface or an emitter.
@@ -25,6 +25,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Ambient light; a hit surface reflects `ambient · kd` regardless of shadows.
     pub ambient: Vec3,
+    /// What rays that miss everything see, and a light for surfaces.
+    pub environment: Option<EnvironmentLight>,
 }
 
 impl Scene {
@@ -62,6 +64,7 @@ pub struct SceneBuilder {
     materials: Vec<PhongMaterial>,
     lights: Vec<Light>,
     ambient: Vec3,
+    environment: Option<EnvironmentLight>,
 }
 
 impl SceneBuilder {
@@ -101,6 +104,11 @@ impl SceneBuilder {
         self
     }
 
+    pub fn environment(&mut self, environment: EnvironmentLight) -> &mut Self {
+        self.environment = Some(environment);
+        self
+    }
+
     pub fn build(self, camera: Camera) -> Result<Scene, SceneError> {
         for (shape, surface) in self.surfaces.iter().enumerate() {
             if let Surface::Material(material) = *surface {
@@ -120,6 +128,7 @@ impl SceneBuilder {
             materials: self.materials,
             lights: self.lights,
             ambient: self.ambient,
+            environment: self.environment,
         })
     }
 }

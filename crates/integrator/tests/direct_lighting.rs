@@ -192,7 +192,7 @@ fn output_is_bit_identical_for_any_thread_count() {
         light_pattern: SamplePattern::Random,
         seed: 42,
         threads: Some(threads),
-        aov: None,
+        ..RenderSettings::default()
     };
     let one = render(&scene, &settings(1), &|_, _| {}).unwrap();
     let four = render(&scene, &settings(4), &|_, _| {}).unwrap();

@@ -9,10 +9,13 @@
 //!   light is a one-sided parallelogram that emits from its front side only.
 
 mod area_light;
+pub mod distribution;
+mod environment_light;
 mod material;
 mod point_light;
 
 pub use area_light::AreaLight;
+pub use environment_light::{EnvironmentLight, EnvironmentSample};
 pub use material::{PhongMaterial, SpecularLobe, UvTransform};
 pub use point_light::PointLight;
 

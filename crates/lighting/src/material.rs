@@ -57,6 +57,11 @@ pub struct PhongMaterial {
     pub lobe: SpecularLobe,
     /// Applied to the surface's uv before any texture lookup.
     pub uv_transform: UvTransform,
+    /// Fraction of the result taken from the perfect mirror reflection:
+    /// `L = (1 − r)·L_phong + r·tint·L_reflected`. 0 is plain Phong, 1 a mirror.
+    pub reflectivity: f32,
+    /// Color of the mirror reflection.
+    pub mirror_tint: Vec3,
 }
 
 impl PhongMaterial {
@@ -68,7 +73,42 @@ impl PhongMaterial {
             shininess,
             lobe: SpecularLobe::Phong,
             uv_transform: UvTransform::default(),
+            reflectivity: 0.0,
+            mirror_tint: Vec3::ONE,
         }
+    }
+
+    /// A perfect mirror whose reflection is multiplied by `tint`.
+    pub fn mirror(tint: Vec3) -> Self {
+        Self {
+            reflectivity: 1.0,
+            mirror_tint: tint,
+            ..Self::new(Vec3::ZERO, 1.0)
+        }
+    }
+
+    /// Whether anything but the mirror term contributes.
+    pub fn has_local_shading(&self) -> bool {
+        self.reflectivity < 1.0
+    }
+
+    /// The BRDF times the cosine, `f(l, v)·(n·l)`, for light from a distribution of
+    /// directions (the environment): Lambert's `kd/π` and the energy-normalised
+    /// modified Phong lobe (Lafortune and Willems 1994), `ks·(s + 2)/2π·cos^s α`
+    /// (`(s + 8)/8π` for Blinn–Phong). A white diffuse surface under a white
+    /// environment of radiance 1 reflects exactly 1.
+    #[inline]
+    pub fn brdf_cos(&self, kd: Vec3, ks: Vec3, n: Vec3, l: Vec3, v: Vec3) -> Vec3 {
+        let n_dot_l = n.dot(l);
+        if n_dot_l <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let norm = match self.lobe {
+            SpecularLobe::Phong => (self.shininess + 2.0) / (2.0 * std::f32::consts::PI),
+            SpecularLobe::BlinnPhong => (self.shininess + 8.0) / (8.0 * std::f32::consts::PI),
+        };
+        (kd * std::f32::consts::FRAC_1_PI + ks * norm * self.specular_lobe(n, l, v, n_dot_l))
+            * n_dot_l
     }
 
     /// `(kd, ks)` filtered over the footprint `tc` (surface uv and its derivatives).

@@ -3,12 +3,16 @@
 
 use crate::error::Problem;
 use crate::format::*;
+use crate::values::{Count, Pattern};
 use glam::Vec3;
 use glint_camera::{Camera, CameraError};
 use glint_geometry::{AaBox, Parallelogram, Plane, Sphere};
 use glint_integrator::{RenderSettings, SampleCount, Scene, SceneBuilder, SettingsError};
-use glint_lighting::{AreaLight, PhongMaterial, PointLight, UvTransform};
-use glint_texture::{load_image, Checkerboard, ImageTexture, Texture, TextureImage};
+use glint_lighting::{AreaLight, EnvironmentLight, PhongMaterial, PointLight, UvTransform};
+use glint_texture::{
+    load_image, Checkerboard, CubeMap, Environment, Image, ImageTexture, LatLongMap, Texture,
+    TextureImage,
+};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -105,6 +109,9 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         builder.area_light(light.facing(front));
     }
     builder.ambient(file.ambient.0);
+    if let Some(env) = &file.environment {
+        builder.environment(environment(env, base_dir)?);
+    }
     let scene = builder
         .build(camera)
         .expect("material ids were resolved above");
@@ -157,29 +164,35 @@ fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> {
         seed: render.seed,
         threads: None,
         aov: None,
+        max_depth: *render.max_depth.get_ref(),
+        environment_samples: *render.environment_samples.get_ref(),
     };
     settings.validate().map_err(|e| {
-        let (field, count, sampler) = match e {
+        // Point at the count if the file set it, else at its sampler.
+        let at = |count: &Spanned<Count>, sampler: &Spanned<Pattern>| {
+            if count.span().is_empty() {
+                sampler.span()
+            } else {
+                count.span()
+            }
+        };
+        let (field, span) = match &e {
             SettingsError::Zero { what }
             | SettingsError::TooMany { what, .. }
             | SettingsError::GridNotSquare { what, .. } => match what {
-                SampleCount::PerPixel => ("render.spp", &render.spp, &render.pixel_sampler),
+                SampleCount::PerPixel => ("render.spp", at(&render.spp, &render.pixel_sampler)),
                 SampleCount::PerLight => (
                     "render.light_samples",
-                    &render.light_samples,
-                    &render.light_sampler,
+                    at(&render.light_samples, &render.light_sampler),
+                ),
+                SampleCount::PerEnvironment => (
+                    "render.environment_samples",
+                    render.environment_samples.span(),
                 ),
             },
+            SettingsError::Depth(_) => ("render.max_depth", render.max_depth.span()),
             // The file sets no thread count, so these cannot come from it.
-            SettingsError::Threads(_) | SettingsError::ThreadPool(_) => {
-                return Problem::new(0..0, "render", e.to_string());
-            }
-        };
-        // Point at the count if the file set it, else at the sampler.
-        let span = if count.span().is_empty() {
-            sampler.span()
-        } else {
-            count.span()
+            SettingsError::Threads(_) | SettingsError::ThreadPool(_) => ("render", 0..0),
         };
         Problem::new(span, field, e.to_string())
     })?;
@@ -264,9 +277,27 @@ fn textures<'a>(
 
 fn material(
     name: &str,
-    table: &MaterialTable,
+    spanned: &Spanned<MaterialTable>,
     textures: &BTreeMap<&str, Texture>,
 ) -> Result<PhongMaterial, Problem> {
+    let table = spanned.get_ref();
+    if let Some(tint) = &table.mirror {
+        if table.diffuse.is_some() || table.specular.is_some() || table.reflectivity.0 > 0.0 {
+            return Err(Problem::new(
+                tint.span(),
+                format!("materials.{name}.mirror"),
+                "a mirror takes no diffuse, specular or reflectivity (use reflectivity on a Phong material to blend)",
+            ));
+        }
+        return Ok(PhongMaterial::mirror(tint.get_ref().0));
+    }
+    let Some(diffuse) = &table.diffuse else {
+        return Err(Problem::new(
+            spanned.span(),
+            format!("materials.{name}"),
+            "missing field `diffuse` (or `mirror` for a mirror)",
+        ));
+    };
     let input = |key: &str, value: &Spanned<ColorOrTexture>| match value.get_ref() {
         ColorOrTexture::Color(c) => Ok(Texture::Constant(c.0)),
         ColorOrTexture::Texture(t) => textures.get(t.as_str()).cloned().ok_or_else(|| {
@@ -286,7 +317,7 @@ fn material(
         }),
     };
     Ok(PhongMaterial {
-        diffuse: input("diffuse", &table.diffuse)?,
+        diffuse: input("diffuse", diffuse)?,
         specular: table
             .specular
             .as_ref()
@@ -298,5 +329,64 @@ fn material(
             scale: table.uv_scale.0,
             offset: table.uv_offset.0,
         },
+        reflectivity: table.reflectivity.0,
+        mirror_tint: table.reflection_tint.0,
     })
+}
+
+/// The environment light: one source (constant, cube map, lat-long image), turned
+/// and scaled.
+fn environment(
+    spanned: &Spanned<EnvironmentTable>,
+    base_dir: &Path,
+) -> Result<EnvironmentLight, Problem> {
+    let e = spanned.get_ref();
+    let sources = [e.color.is_some(), e.cube_map.is_some(), e.latlong.is_some()];
+    if sources.iter().filter(|s| **s).count() != 1 {
+        return Err(Problem::new(
+            spanned.span(),
+            "environment",
+            "expected exactly one of `color`, `cube_map` or `latlong`",
+        ));
+    }
+    let load = |file: &Spanned<String>, path: &str, field: &str| {
+        load_image(&base_dir.join(path))
+            .map_err(|err| Problem::new(file.span(), field, err.to_string()))
+    };
+    let map = if let Some(c) = e.color {
+        Environment::Constant(c.0)
+    } else if let Some(template) = &e.cube_map {
+        if !template.get_ref().contains("{face}") {
+            return Err(Problem::new(
+                template.span(),
+                "environment.cube_map",
+                "expected a path template containing {face}, e.g. \"studio/{face}.hdr\"",
+            ));
+        }
+        let mut faces = Vec::with_capacity(6);
+        for face in ["px", "nx", "py", "ny", "pz", "nz"] {
+            faces.push(load(
+                template,
+                &template.get_ref().replace("{face}", face),
+                "environment.cube_map",
+            )?);
+        }
+        let faces: [Image; 6] = faces.try_into().expect("six faces");
+        Environment::CubeMap(
+            CubeMap::new(faces)
+                .map_err(|m| Problem::new(template.span(), "environment.cube_map", m))?,
+        )
+    } else {
+        let file = e.latlong.as_ref().expect("one source");
+        Environment::LatLong(LatLongMap::new(load(
+            file,
+            file.get_ref(),
+            "environment.latlong",
+        )?))
+    };
+    Ok(EnvironmentLight::new(
+        map,
+        e.rotation.0.to_radians(),
+        e.intensity.0,
+    ))
 }

@@ -17,10 +17,11 @@ pub struct SceneFile {
     pub camera: CameraTable,
     #[serde(default)]
     pub render: RenderTable,
+    pub environment: Option<Spanned<EnvironmentTable>>,
     #[serde(default)]
     pub textures: BTreeMap<String, TextureTable>,
     #[serde(default)]
-    pub materials: BTreeMap<String, MaterialTable>,
+    pub materials: BTreeMap<String, Spanned<MaterialTable>>,
     #[serde(default)]
     pub sphere: Vec<SphereTable>,
     #[serde(default)]
@@ -70,6 +71,31 @@ pub struct RenderTable {
     pub light_samples: Spanned<Count>,
     pub light_sampler: Spanned<Pattern>,
     pub seed: u64,
+    pub max_depth: Spanned<u32>,
+    pub environment_samples: Spanned<u32>,
+}
+
+/// The environment: exactly one of `color`, `cube_map`, `latlong`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentTable {
+    pub color: Option<Color>,
+    /// Path template of the six faces, `{face}` standing for px nx py ny pz nz.
+    pub cube_map: Option<Spanned<String>>,
+    /// Path of an equirectangular image.
+    pub latlong: Option<Spanned<String>>,
+    /// Degrees about +y.
+    #[serde(default = "no_rotation")]
+    pub rotation: Real,
+    #[serde(default = "unit_intensity")]
+    pub intensity: NonNegative,
+}
+
+fn no_rotation() -> Real {
+    Real(0.0)
+}
+fn unit_intensity() -> NonNegative {
+    NonNegative(1.0)
 }
 
 impl Default for RenderTable {
@@ -82,6 +108,8 @@ impl Default for RenderTable {
             light_samples: Spanned::new(0..0, Count(settings.light_samples)),
             light_sampler: Spanned::new(0..0, Pattern(settings.light_pattern)),
             seed: settings.seed,
+            max_depth: Spanned::new(0..0, settings.max_depth),
+            environment_samples: Spanned::new(0..0, settings.environment_samples),
         }
     }
 }
@@ -149,7 +177,15 @@ fn trilinear() -> Filter {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialTable {
-    pub diffuse: Spanned<ColorOrTexture>,
+    /// Required unless the material is a `mirror`.
+    pub diffuse: Option<Spanned<ColorOrTexture>>,
+    /// A perfect mirror of this tint (no other shading keys allowed).
+    pub mirror: Option<Spanned<Color>>,
+    /// Fraction of mirror reflection blended into the Phong result.
+    #[serde(default = "no_reflection")]
+    pub reflectivity: Fraction,
+    #[serde(default = "white")]
+    pub reflection_tint: Color,
     pub specular: Option<Spanned<ColorOrTexture>>,
     #[serde(default = "unit_shininess")]
     pub shininess: NonNegative,
@@ -165,6 +201,10 @@ fn unit_scale() -> UvScale {
 }
 fn zero_offset() -> UvPair {
     UvPair(glam::Vec2::ZERO)
+}
+
+fn no_reflection() -> Fraction {
+    Fraction(0.0)
 }
 
 fn unit_shininess() -> NonNegative {

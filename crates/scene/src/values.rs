@@ -131,6 +131,14 @@ validated!(
     UvScale(glam::Vec2) via pair, |v| v.x != 0.0 && v.y != 0.0, "a scale [u, v] with no zero component"
 );
 validated!(
+    /// A finite number (of at most [`MAX_MAGNITUDE`]).
+    Real(f32) via number, |v| true, "a finite number"
+);
+validated!(
+    /// A number from 0 to 1.
+    Fraction(f32) via number, |v| (0.0..=1.0).contains(&v), "a number from 0 to 1"
+);
+validated!(
     /// A vertical field of view in degrees, strictly between 0 and 180.
     FieldOfView(f32) via number, |v| v > 0.0 && v < 180.0, "a field of view in degrees strictly between 0 and 180"
 );

@@ -1,4 +1,5 @@
-//! The texture stage of Glint: functions from surface uv to a linear RGB color.
+//! The texture stage of Glint: functions from surface uv to a linear RGB color, and
+//! environment maps (cube maps, lat-long images) from direction to radiance.
 //!
 //! # Conventions
 //! - Colors are **linear** RGB `f32` (no sRGB decoding happens here for procedural
@@ -13,6 +14,7 @@
 //!   that reads them (trilinear, EWA), and shared by every texture of the same image.
 
 mod checkerboard;
+mod environment;
 mod image;
 mod image_texture;
 mod io;
@@ -21,6 +23,10 @@ mod texcoord;
 
 pub use crate::image::{Image, WrapMode};
 pub use checkerboard::Checkerboard;
+pub use environment::{
+    cube_direction, cube_face_st, latlong_direction, latlong_uv, CubeFace, CubeMap, Environment,
+    LatLongMap,
+};
 pub use image_texture::{ImageTexture, TextureFilter, TextureImage};
 pub use io::{load_image, srgb_to_linear, ImageLoadError};
 pub use mipmap::MipMap;

@@ -1,0 +1,179 @@
+//! Piecewise-constant distributions for importance sampling (pbrt-v4 section
+//! A.5 and 12.5): sample a bin in proportion to its weight, then uniformly inside it.
+
+use glam::Vec2;
+
+/// A piecewise-constant density over [0, 1] with `n` equal bins.
+#[derive(Clone, Debug)]
+pub struct PiecewiseConstant1D {
+    weights: Vec<f32>,
+    /// `cdf[i]` = the probability of bins `0..i`; `cdf[n] = 1`.
+    cdf: Vec<f32>,
+    /// Integral of the weights over [0, 1] (their mean).
+    integral: f32,
+}
+
+impl PiecewiseConstant1D {
+    /// Weights must be finite and non-negative; all zero gives the uniform density.
+    pub fn new(weights: Vec<f32>) -> Self {
+        let n = weights.len().max(1);
+        let mut weights = weights;
+        if weights.is_empty() {
+            weights.push(1.0);
+        }
+        let total: f64 = weights.iter().map(|&w| w.max(0.0) as f64).sum();
+        let uniform = total.is_nan() || total <= 0.0;
+        let mut cdf = Vec::with_capacity(n + 1);
+        let mut running = 0.0f64;
+        cdf.push(0.0);
+        for &w in &weights {
+            running += if uniform { 1.0 } else { w.max(0.0) as f64 };
+            cdf.push((running / if uniform { n as f64 } else { total }) as f32);
+        }
+        cdf[n] = 1.0;
+        if uniform {
+            weights.iter_mut().for_each(|w| *w = 1.0);
+        }
+        let integral = if uniform {
+            1.0
+        } else {
+            (total / n as f64) as f32
+        };
+        Self {
+            weights,
+            cdf,
+            integral,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.weights.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.weights.is_empty()
+    }
+
+    /// Integral of the weights over [0, 1].
+    pub fn integral(&self) -> f32 {
+        self.integral
+    }
+
+    /// `(x, pdf(x), bin)` for a uniform `u` ∈ [0, 1).
+    #[inline]
+    pub fn sample(&self, u: f32) -> (f32, f32, usize) {
+        // The last bin whose cdf is ≤ u, skipping empty bins.
+        let bin = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .saturating_sub(1)
+            .min(self.len() - 1);
+        let (lo, hi) = (self.cdf[bin], self.cdf[bin + 1]);
+        let within = if hi > lo { (u - lo) / (hi - lo) } else { 0.5 };
+        let x = ((bin as f32 + within.clamp(0.0, 1.0)) / self.len() as f32)
+            .min(1.0 - f32::EPSILON / 2.0);
+        (x, self.pdf_of_bin(bin), bin)
+    }
+
+    /// The density at `x` ∈ [0, 1].
+    #[inline]
+    pub fn pdf(&self, x: f32) -> f32 {
+        let bin = ((x * self.len() as f32) as usize).min(self.len() - 1);
+        self.pdf_of_bin(bin)
+    }
+
+    #[inline]
+    fn pdf_of_bin(&self, bin: usize) -> f32 {
+        self.weights[bin].max(0.0) / self.integral
+    }
+}
+
+/// A piecewise-constant density over [0, 1]² on a `width × height` grid of bins:
+/// a marginal density over rows and a conditional density within each row.
+#[derive(Clone, Debug)]
+pub struct PiecewiseConstant2D {
+    rows: Vec<PiecewiseConstant1D>,
+    marginal: PiecewiseConstant1D,
+}
+
+impl PiecewiseConstant2D {
+    /// `weights` row-major, `width` per row, the first row at v = 0.
+    pub fn new(weights: &[f32], width: usize) -> Self {
+        let rows: Vec<PiecewiseConstant1D> = weights
+            .chunks(width.max(1))
+            .map(|row| PiecewiseConstant1D::new(row.to_vec()))
+            .collect();
+        let marginal = PiecewiseConstant1D::new(rows.iter().map(|r| r.integral()).collect());
+        Self { rows, marginal }
+    }
+
+    /// `(uv, pdf(uv))` for uniform `u` ∈ [0, 1)²; the pdf is per unit area of [0, 1]².
+    #[inline]
+    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
+        let (v, pdf_v, row) = self.marginal.sample(u.y);
+        let (x, pdf_u, _) = self.rows[row].sample(u.x);
+        (Vec2::new(x, v), pdf_v * pdf_u)
+    }
+
+    /// The density at `uv` ∈ [0, 1]².
+    #[inline]
+    pub fn pdf(&self, uv: Vec2) -> f32 {
+        let row = ((uv.y * self.rows.len() as f32) as usize).min(self.rows.len() - 1);
+        self.marginal.pdf(uv.y) * self.rows[row].pdf(uv.x)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_follow_the_weights_and_pdf_integrates_to_one() {
+        let d = PiecewiseConstant1D::new(vec![1.0, 0.0, 3.0, 4.0]);
+        assert!((d.integral() - 2.0).abs() < 1e-6);
+        let mut counts = [0usize; 4];
+        let n = 80_000;
+        for i in 0..n {
+            let u = (i as f32 + 0.5) / n as f32;
+            let (x, pdf, bin) = d.sample(u);
+            assert!((0.0..1.0).contains(&x));
+            assert_eq!(((x * 4.0) as usize), bin);
+            assert!((pdf - d.pdf(x)).abs() < 1e-6);
+            counts[bin] += 1;
+        }
+        assert_eq!(counts[1], 0, "an empty bin is never sampled");
+        for (bin, expected) in [(0, 0.125), (2, 0.375), (3, 0.5)] {
+            assert!((counts[bin] as f32 / n as f32 - expected).abs() < 1e-3);
+        }
+        let integral: f32 = (0..1000)
+            .map(|i| d.pdf((i as f32 + 0.5) / 1000.0) / 1000.0)
+            .sum();
+        assert!((integral - 1.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn all_zero_weights_give_the_uniform_density() {
+        let d = PiecewiseConstant1D::new(vec![0.0; 5]);
+        assert_eq!(d.pdf(0.3), 1.0);
+        assert!((d.sample(0.5).0 - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn two_dimensional_pdf_matches_sampling() {
+        let weights = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0];
+        let d = PiecewiseConstant2D::new(&weights, 3);
+        let mut total = 0.0f64;
+        let n = 300;
+        for j in 0..n {
+            for i in 0..n {
+                let uv = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                total += d.pdf(uv) as f64 / (n * n) as f64;
+                let (s, pdf) = d.sample(uv);
+                assert!((pdf - d.pdf(s)).abs() < 1e-4 * pdf.max(1.0));
+            }
+        }
+        assert!((total - 1.0).abs() < 1e-4, "{total}");
+        // Bin (1, 1) has weight 4 of 15 in total over 6 bins: pdf = 4 / (15/6).
+        assert!((d.pdf(Vec2::new(0.4, 0.8)) - 4.0 / 2.5).abs() < 1e-5);
+    }
+}

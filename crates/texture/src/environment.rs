@@ -1,0 +1,399 @@
+//! Environment maps: radiance as a function of direction, from six cube-map faces
+//! or one equirectangular (lat-long) image.
+//!
+//! # Conventions (as in the assets README)
+//! - Cube faces are `px nx py ny pz nz` (+x −x +y −y +z −z), each square, in the
+//!   OpenGL/RenderMan orientation: face texel `(i, j)` (i rightwards, j downwards) of
+//!   an `N × N` face has `s = 2(i + ½)/N − 1`, `t = 2(j + ½)/N − 1` and looks along
+//!   `px: (1, −t, −s)`, `nx: (−1, −t, s)`, `py: (s, 1, t)`, `ny: (s, −1, −t)`,
+//!   `pz: (s, −t, 1)`, `nz: (−s, −t, −1)`.
+//! - Lat-long: for a unit direction `d`, `u = ½ + atan2(d.x, −d.z)/2π`,
+//!   `v = acos(d.y)/π`, with `v = 0` the top row: the image centre looks down −z.
+//! - Footprints are angular widths in radians; a lookup reads the MIP level whose
+//!   texels subtend that angle.
+
+use crate::{Image, TextureImage, WrapMode};
+use glam::{Vec2, Vec3};
+use std::f32::consts::{PI, TAU};
+use std::sync::Arc;
+
+/// Index of a cube face in `px nx py ny pz nz` order.
+pub type CubeFace = usize;
+
+/// The face a direction points into and its face coordinates in [0, 1]²
+/// (`((s + 1)/2, (t + 1)/2)`, image orientation: the second grows downwards).
+#[inline]
+pub fn cube_face_st(d: Vec3) -> (CubeFace, Vec2) {
+    let a = d.abs();
+    let (face, s, t, major) = if a.x >= a.y && a.x >= a.z {
+        if d.x > 0.0 {
+            (0, -d.z, -d.y, a.x)
+        } else {
+            (1, d.z, -d.y, a.x)
+        }
+    } else if a.y >= a.z {
+        if d.y > 0.0 {
+            (2, d.x, d.z, a.y)
+        } else {
+            (3, d.x, -d.z, a.y)
+        }
+    } else if d.z > 0.0 {
+        (4, d.x, -d.y, a.z)
+    } else {
+        (5, -d.x, -d.y, a.z)
+    };
+    if major.is_nan() || major <= 0.0 {
+        return (4, Vec2::splat(0.5)); // zero or NaN direction
+    }
+    (face, 0.5 * (Vec2::new(s, t) / major + Vec2::ONE))
+}
+
+/// The (unnormalised) direction through face coordinates `st` of `face`;
+/// the inverse of [`cube_face_st`]. `st` may lie outside [0, 1]² (past the edge).
+#[inline]
+pub fn cube_direction(face: CubeFace, st: Vec2) -> Vec3 {
+    let (s, t) = (2.0 * st.x - 1.0, 2.0 * st.y - 1.0);
+    match face {
+        0 => Vec3::new(1.0, -t, -s),
+        1 => Vec3::new(-1.0, -t, s),
+        2 => Vec3::new(s, 1.0, t),
+        3 => Vec3::new(s, -1.0, -t),
+        4 => Vec3::new(s, -t, 1.0),
+        _ => Vec3::new(-s, -t, -1.0),
+    }
+}
+
+/// Lat-long coordinates `(u, v)` ∈ [0, 1]² of a unit direction.
+#[inline]
+pub fn latlong_uv(d: Vec3) -> Vec2 {
+    let u = 0.5 + d.x.atan2(-d.z) / TAU;
+    let v = d.y.clamp(-1.0, 1.0).acos() / PI;
+    Vec2::new(u.rem_euclid(1.0), v)
+}
+
+/// The unit direction at lat-long coordinates `(u, v)`; inverse of [`latlong_uv`].
+#[inline]
+pub fn latlong_direction(uv: Vec2) -> Vec3 {
+    let phi = (uv.x - 0.5) * TAU;
+    let theta = uv.y * PI;
+    let (sin_t, cos_t) = theta.sin_cos();
+    let (sin_p, cos_p) = phi.sin_cos();
+    Vec3::new(sin_t * sin_p, cos_t, -sin_t * cos_p)
+}
+
+/// Six square faces of one size, each with its own lazily built pyramid.
+#[derive(Clone, Debug)]
+pub struct CubeMap {
+    faces: [Arc<TextureImage>; 6],
+}
+
+impl CubeMap {
+    /// Faces in `px nx py ny pz nz` order; all must be square and of one size.
+    pub fn new(faces: [Image; 6]) -> Result<Self, String> {
+        let n = faces[0].width();
+        for (name, face) in ["px", "nx", "py", "ny", "pz", "nz"].iter().zip(&faces) {
+            if face.width() != face.height() || face.width() != n {
+                return Err(format!(
+                    "face {name} is {}x{}, but every face must be {n}x{n} (square, one size)",
+                    face.width(),
+                    face.height()
+                ));
+            }
+        }
+        Ok(Self {
+            faces: faces.map(TextureImage::new),
+        })
+    }
+
+    /// Texels along a face side at level 0.
+    pub fn size(&self) -> u32 {
+        self.faces[0].image().width()
+    }
+
+    pub fn face(&self, face: CubeFace) -> &Image {
+        self.faces[face].image()
+    }
+
+    fn level_count(&self) -> usize {
+        (32 - self.size().leading_zeros()) as usize
+    }
+
+    fn level(&self, face: CubeFace, level: usize) -> &Image {
+        if level == 0 {
+            self.faces[face].image()
+        } else {
+            let levels = self.faces[face].pyramid().levels();
+            &levels[level.min(levels.len() - 1)]
+        }
+    }
+
+    /// Radiance towards `d`, filtered over a cone of angular width `width`
+    /// (radians): trilinear between the levels whose texels subtend about that
+    /// angle (a level-0 texel at a face's centre subtends `2/N`).
+    pub fn radiance(&self, d: Vec3, width: f32) -> Vec3 {
+        let (face, st) = cube_face_st(d);
+        let level = (width * self.size() as f32 / 2.0).log2();
+        let last = (self.level_count() - 1) as f32;
+        let level = if level > 0.0 { level.min(last) } else { 0.0 };
+        let lower = level as usize;
+        let fine = self.bilinear(face, lower, st);
+        let frac = level - lower as f32;
+        if frac == 0.0 {
+            return fine;
+        }
+        fine + (self.bilinear(face, lower + 1, st) - fine) * frac
+    }
+
+    /// Bilinear filtering on one level that reads across face edges: a texel past
+    /// the edge is fetched from the face its centre's direction points into, so the
+    /// result is continuous across edges and corners (no seams).
+    pub fn bilinear(&self, face: CubeFace, level: usize, st: Vec2) -> Vec3 {
+        let image = self.level(face, level);
+        let n = image.width() as f32;
+        let p = st * n - 0.5;
+        let p0 = p.floor();
+        let f = p - p0;
+        let (x, y) = (p0.x as i64, p0.y as i64);
+        let n = image.width() as i64;
+        let outside = |i: i64| !(0..n).contains(&i);
+        let mut t = [[Vec3::ZERO; 2]; 2];
+        for (dy, row) in t.iter_mut().enumerate() {
+            for (dx, texel) in row.iter_mut().enumerate() {
+                *texel = self.texel(face, level, x + dx as i64, y + dy as i64);
+            }
+        }
+        // Past a corner only three faces meet: the texel diagonally beyond it does
+        // not exist, so it is taken as the mean of the other three, which makes all
+        // three faces agree at the corner.
+        for (dx, dy) in [(0usize, 0usize), (1, 0), (0, 1), (1, 1)] {
+            if outside(x + dx as i64) && outside(y + dy as i64) {
+                t[dy][dx] = (t[dy][1 - dx] + t[1 - dy][dx] + t[1 - dy][1 - dx]) / 3.0;
+            }
+        }
+        let top = t[0][0] + (t[0][1] - t[0][0]) * f.x;
+        let bottom = t[1][0] + (t[1][1] - t[1][0]) * f.x;
+        top + (bottom - top) * f.y
+    }
+
+    /// Texel `(i, j)` of `face` at `level`, following the cube past the face's edges.
+    fn texel(&self, face: CubeFace, level: usize, i: i64, j: i64) -> Vec3 {
+        let image = self.level(face, level);
+        let n = image.width() as i64;
+        if (0..n).contains(&i) && (0..n).contains(&j) {
+            return image.texel(i as u32, j as u32);
+        }
+        let st = (Vec2::new(i as f32, j as f32) + 0.5) / n as f32;
+        let (other, st) = cube_face_st(cube_direction(face, st));
+        let other_image = self.level(other, level);
+        let p = (st * n as f32).floor();
+        other_image.texel_wrapped(p.x as i64, p.y as i64, WrapMode::Clamp)
+    }
+}
+
+/// One equirectangular image covering the sphere of directions.
+#[derive(Clone, Debug)]
+pub struct LatLongMap {
+    image: Arc<TextureImage>,
+}
+
+impl LatLongMap {
+    pub fn new(image: Image) -> Self {
+        Self {
+            image: TextureImage::new(image),
+        }
+    }
+
+    pub fn image(&self) -> &Image {
+        self.image.image()
+    }
+
+    /// Radiance towards `d`, filtered over a cone of angular width `width`: a
+    /// level-0 texel spans `2π/W` in longitude, so the level is `log2(width·W/2π)`.
+    pub fn radiance(&self, d: Vec3, width: f32) -> Vec3 {
+        let uv = latlong_uv(d);
+        let w = self.image.image().width() as f32;
+        let level = (width * w / TAU).log2();
+        if level.is_nan() || level <= 0.0 {
+            return latlong_bilinear(self.image.image(), uv);
+        }
+        let levels = self.image.pyramid().levels();
+        let level = level.min((levels.len() - 1) as f32);
+        let lower = level as usize;
+        let fine = latlong_bilinear(&levels[lower], uv);
+        let frac = level - lower as f32;
+        if frac == 0.0 {
+            return fine;
+        }
+        let coarse = latlong_bilinear(&levels[(lower + 1).min(levels.len() - 1)], uv);
+        fine + (coarse - fine) * frac
+    }
+}
+
+/// Bilinear on a lat-long image: longitude wraps around, latitude stops at the poles.
+fn latlong_bilinear(image: &Image, uv: Vec2) -> Vec3 {
+    let size = image.size();
+    let p = uv * size - 0.5;
+    let p0 = p.floor();
+    let f = p - p0;
+    let (w, h) = (image.width(), image.height());
+    let texel = |dx: i64, dy: i64| {
+        let x = WrapMode::Repeat.wrap(p0.x as i64 + dx, w);
+        let y = WrapMode::Clamp.wrap(p0.y as i64 + dy, h);
+        image.texel(x, y)
+    };
+    let top = texel(0, 0) + (texel(1, 0) - texel(0, 0)) * f.x;
+    let bottom = texel(0, 1) + (texel(1, 1) - texel(0, 1)) * f.x;
+    top + (bottom - top) * f.y
+}
+
+/// Radiance arriving from every direction: a constant, a cube map or a lat-long map.
+#[derive(Clone, Debug)]
+pub enum Environment {
+    Constant(Vec3),
+    CubeMap(CubeMap),
+    LatLong(LatLongMap),
+}
+
+impl Environment {
+    /// Radiance arriving from direction `d` (unit, world space), filtered over a
+    /// cone of angular width `width` radians.
+    #[inline]
+    pub fn radiance(&self, d: Vec3, width: f32) -> Vec3 {
+        match self {
+            Environment::Constant(c) => *c,
+            Environment::CubeMap(c) => c.radiance(d, width),
+            Environment::LatLong(l) => l.radiance(d, width),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn directions() -> impl Iterator<Item = Vec3> {
+        (0..2000).map(|i| {
+            let (a, b) = (i as f32 * 0.618_034, i as f32 * 0.414_214);
+            let z = 1.0 - 2.0 * b.fract();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            Vec3::new(r * (TAU * a).cos(), r * (TAU * a).sin(), z)
+        })
+    }
+
+    #[test]
+    fn face_texels_follow_the_documented_orientation() {
+        // Texel (i, j) = (0, 0), top-left: s = t = −1 + 1/N.
+        let n = 4.0;
+        let c = -1.0 + 1.0 / n;
+        let expected = [
+            Vec3::new(1.0, -c, -c),
+            Vec3::new(-1.0, -c, c),
+            Vec3::new(c, 1.0, c),
+            Vec3::new(c, -1.0, -c),
+            Vec3::new(c, -c, 1.0),
+            Vec3::new(-c, -c, -1.0),
+        ];
+        for (face, e) in expected.iter().enumerate() {
+            let st = Vec2::splat(0.5 / n);
+            assert_eq!(cube_direction(face, st), *e, "face {face}");
+            let (f, back) = cube_face_st(*e);
+            assert_eq!(f, face);
+            assert!((back - st).length() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn direction_face_round_trips_on_faces_edges_and_corners() {
+        for d in directions() {
+            let (face, st) = cube_face_st(d);
+            assert!((0.0..=1.0).contains(&st.x) && (0.0..=1.0).contains(&st.y));
+            let back = cube_direction(face, st).normalize();
+            assert!((back - d).length() < 1e-5, "{d} -> {face} {st} -> {back}");
+        }
+        // Edges and corners: on the boundary the face is ambiguous, but the
+        // direction must come back.
+        for face in 0..6 {
+            for st in [
+                Vec2::ZERO,
+                Vec2::ONE,
+                Vec2::new(0.0, 1.0),
+                Vec2::new(1.0, 0.5),
+                Vec2::new(0.5, 0.0),
+            ] {
+                let d = cube_direction(face, st).normalize();
+                let (f2, st2) = cube_face_st(d);
+                let back = cube_direction(f2, st2).normalize();
+                assert!((back - d).length() < 1e-6, "face {face} {st}");
+            }
+        }
+    }
+
+    #[test]
+    fn latlong_round_trips_and_matches_the_assets_convention() {
+        assert!((latlong_uv(-Vec3::Z) - Vec2::new(0.5, 0.5)).length() < 1e-6);
+        assert!((latlong_uv(Vec3::X) - Vec2::new(0.75, 0.5)).length() < 1e-6);
+        assert!(latlong_uv(Vec3::Y).y < 1e-6);
+        for d in directions() {
+            let back = latlong_direction(latlong_uv(d));
+            assert!((back - d).length() < 1e-4, "{d} -> {back}");
+        }
+    }
+
+    fn constant_cube(n: u32, c: Vec3) -> CubeMap {
+        CubeMap::new(std::array::from_fn(|_| Image::from_fn(n, n, |_, _| c))).unwrap()
+    }
+
+    #[test]
+    fn a_constant_cube_map_is_constant_everywhere_at_every_level() {
+        let c = Vec3::new(0.3, 0.6, 0.9);
+        let cube = constant_cube(8, c);
+        for d in directions() {
+            for width in [0.0, 0.05, 0.3, 2.0, f32::INFINITY, f32::NAN] {
+                let got = cube.radiance(d, width);
+                assert!((got - c).abs().max_element() < 1e-6, "{d} {width}: {got}");
+            }
+        }
+    }
+
+    #[test]
+    fn filtering_is_continuous_across_face_edges() {
+        // Each face a different constant: across an edge, bilinear blends the two
+        // faces, so directions just either side of the edge read (nearly) the same.
+        let colors = [
+            Vec3::X,
+            Vec3::Y,
+            Vec3::Z,
+            Vec3::ONE,
+            Vec3::ZERO,
+            Vec3::splat(0.5),
+        ];
+        let cube = CubeMap::new(colors.map(|c| Image::from_fn(16, 16, |_, _| c))).unwrap();
+        for face in 0..6 {
+            for st in [
+                Vec2::new(1.0, 0.3),
+                Vec2::new(0.0, 0.7),
+                Vec2::new(0.4, 0.0),
+                Vec2::new(0.6, 1.0),
+                Vec2::ONE,
+            ] {
+                let on_edge = cube_direction(face, st).normalize();
+                let inside = cube_direction(face, st * 0.9999 + 0.00005).normalize();
+                let outside = cube_direction(face, (st - 0.5) * 1.0001 + 0.5).normalize();
+                let (a, b) = (cube.radiance(inside, 0.0), cube.radiance(outside, 0.0));
+                assert!(
+                    (a - b).abs().max_element() < 2e-3,
+                    "face {face} {st}: {a} vs {b}"
+                );
+                assert!(cube.radiance(on_edge, 0.0).is_finite());
+            }
+        }
+    }
+
+    #[test]
+    fn wrong_face_sizes_are_refused() {
+        let mut faces: [Image; 6] = std::array::from_fn(|_| Image::from_fn(4, 4, |_, _| Vec3::ONE));
+        faces[3] = Image::from_fn(4, 5, |_, _| Vec3::ONE);
+        let e = CubeMap::new(faces).unwrap_err();
+        assert!(e.contains("face ny is 4x5"), "{e}");
+    }
+}

@@ -247,6 +247,64 @@ mod tests {
     }
 
     #[test]
+    fn uv_derivatives_match_on_every_box_face_and_a_tiled_plane() {
+        // Step along dpdu (dpdv) from a hit, re-intersect towards that point, and
+        // check uv advanced by the step in u (v) only.
+        let aabox =
+            Shape::from(AaBox::new(Vec3::new(-1.0, -2.0, -3.0), Vec3::new(2.0, 1.0, 0.5)).unwrap());
+        let plane = Shape::from(
+            Plane::new(Vec3::new(0.0, -1.0, 0.0), Vec3::new(0.2, 1.0, 0.1), false)
+                .unwrap()
+                .with_tile_size(4.0)
+                .unwrap(),
+        );
+        let centre = Vec3::new(0.5, -0.5, -1.25);
+        let mut cases: Vec<(Shape, Vec3)> =
+            [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z]
+                .into_iter()
+                .map(|axis| (aabox, centre + 10.0 * axis + Vec3::new(0.13, 0.07, -0.11)))
+                .collect();
+        cases.push((plane, Vec3::new(0.3, 5.0, 0.2)));
+        let mut normals = Vec::new();
+        for (shape, origin) in cases {
+            let target = if shape == plane {
+                Vec3::new(1.0, -1.0, -2.0)
+            } else {
+                centre
+            };
+            let hit = shape
+                .intersect(&Ray::new(origin, target - origin), f32::INFINITY)
+                .unwrap();
+            normals.push(hit.geometric_normal);
+            let h = 1e-3;
+            for (deriv, axis) in [(hit.dpdu, 0), (hit.dpdv, 1)] {
+                let moved = hit.point + h * deriv;
+                let again = shape
+                    .intersect(&Ray::new(origin, moved - origin), f32::INFINITY)
+                    .unwrap();
+                let duv = (again.uv - hit.uv) / h;
+                assert!(
+                    (duv[axis] - 1.0).abs() < 1e-2,
+                    "{:?} axis {axis}: {duv}",
+                    hit.geometric_normal
+                );
+                assert!(
+                    duv[1 - axis].abs() < 1e-2,
+                    "{:?} axis {axis}: {duv}",
+                    hit.geometric_normal
+                );
+            }
+            // The frame is right-handed seen from outside: dpdu × dpdv along n.
+            assert!(
+                hit.dpdu.cross(hit.dpdv).dot(hit.geometric_normal) > 0.0,
+                "{:?}",
+                hit.geometric_normal
+            );
+        }
+        assert_eq!(normals.len(), 7);
+    }
+
+    #[test]
     fn t_max_limits_hits() {
         for (name, shape) in shapes() {
             let ray = Ray::new(Vec3::ZERO, Vec3::new(0.0, -0.1, -1.0));

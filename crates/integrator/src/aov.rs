@@ -1,12 +1,13 @@
 //! Arbitrary output variables: per-pixel buffers other than radiance, for
 //! studying a stage (texture coordinates, MIP level, normals, depth, albedo).
 
+use crate::direct::texture_footprint;
 use crate::{Scene, Surface};
 use glam::Vec3;
 use glint_camera::Film;
 use glint_geometry::{Ray, RayDifferential};
 use glint_lighting::Light;
-use glint_texture::TexCoord;
+use glint_texture::srgb_to_linear;
 
 /// What a render writes instead of radiance. Misses write 0 in every AOV.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -65,22 +66,20 @@ impl Aov {
             Surface::Material(m) => Some(&scene.materials[m as usize]),
             Surface::Emitter(_) => None,
         };
-        let tc = || {
-            let d = hit.differentials(diff);
-            TexCoord {
-                uv: hit.uv,
-                duvdx: d.duvdx,
-                duvdy: d.duvdy,
-            }
-        };
+
         match self {
             Aov::Uv => hit.uv.extend(0.0),
             Aov::Normal => hit.shading_normal,
             Aov::Depth => Vec3::splat(hit.t * ray.direction.length()),
-            Aov::MipLevel => Vec3::splat(material.map_or(0.0, |m| m.diffuse_mip_level(&tc()))),
+            Aov::MipLevel => Vec3::splat(material.map_or(0.0, |m| {
+                m.diffuse_mip_level(&texture_footprint(m, &hit, diff))
+            })),
             Aov::ReflectionDepth => Vec3::splat(reflection_depth(scene, *ray, max_depth) as f32),
             Aov::Albedo => match scene.surfaces[hit.shape as usize] {
-                Surface::Material(m) => scene.materials[m as usize].reflectances(&tc()).0,
+                Surface::Material(m) => {
+                    let m = &scene.materials[m as usize];
+                    m.reflectances(&texture_footprint(m, &hit, diff)).0
+                }
                 Surface::Emitter(l) => match &scene.lights[l as usize] {
                     Light::Area(a) => a.color,
                     Light::Point(p) => p.color,
@@ -91,8 +90,10 @@ impl Aov {
 
     /// The buffer mapped to displayable colors, for 8-bit output: normals to
     /// `0.5·n + 0.5`, uv to its fractional part, depth to gray (near bright, far
-    /// dark, 0 for misses), MIP levels to a blue → green → red ramp over
-    /// 0 … highest level seen; albedo unchanged.
+    /// dark, 0 for misses), MIP levels and reflection depths to a blue → green → red
+    /// ramp over 0 … the highest value seen; albedo unchanged. These are display
+    /// values: they are stored decoded from sRGB, so that an sRGB writer (the PNG
+    /// output) stores exactly them (0.5 as 128). Albedo is a linear color, kept as is.
     pub fn false_color(self, film: &Film) -> Film {
         let max = film.pixels().iter().fold(0.0f32, |m, p| m.max(p.x));
         let mut out = film.clone();
@@ -107,6 +108,9 @@ impl Aov {
                 }
                 Aov::Albedo => *p,
             };
+            if self != Aov::Albedo {
+                *p = Vec3::from_array(p.to_array().map(srgb_to_linear));
+            }
         }
         out
     }

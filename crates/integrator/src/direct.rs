@@ -186,7 +186,11 @@ impl DirectIntegrator {
 
 /// The texture lookup at `hit`: with the pixel's footprint from the ray
 /// differentials if the material filters over one, else just the point.
-fn texture_footprint(material: &PhongMaterial, hit: &Hit, diff: &RayDifferential) -> TexCoord {
+pub(crate) fn texture_footprint(
+    material: &PhongMaterial,
+    hit: &Hit,
+    diff: &RayDifferential,
+) -> TexCoord {
     if !material.uses_footprint() {
         return TexCoord::point(hit.uv);
     }

@@ -20,8 +20,8 @@ mod scene;
 pub use aov::Aov;
 pub use direct::{DirectIntegrator, SampleContext};
 pub use render::{
-    render, RenderOutput, RenderSettings, RenderStats, SampleCount, SettingsError, MAX_SAMPLES,
-    MAX_THREADS, TILE_SIZE,
+    camera_ray, render, RenderOutput, RenderSettings, RenderStats, SampleCount, SettingsError,
+    MAX_SAMPLES, MAX_THREADS, TILE_SIZE,
 };
 pub use sampling::SamplePattern;
 pub use scene::{Scene, SceneBuilder, SceneError, Surface};

@@ -2,7 +2,7 @@ use crate::direct::SampleContext;
 use crate::sampling::{pixel_rng, SamplePattern, PIXEL_STREAM};
 use crate::{Aov, DirectIntegrator, Scene};
 use glam::{Vec2, Vec3};
-use glint_camera::Film;
+use glint_camera::{Camera, Film};
 use glint_geometry::{Ray, RayDifferential};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -244,7 +244,7 @@ fn render_rows(
         for (sample, jitter) in pixel_samples.iter().enumerate() {
             ctx.rng = pixel_rng(settings.seed, pixel, sample as u64);
             let raster = Vec2::new(x as f32, y as f32) + *jitter;
-            let (ray, diff) = camera_ray(scene, raster, footprint_scale);
+            let (ray, diff) = camera_ray(&scene.camera, raster, footprint_scale);
             sum += match settings.aov {
                 None => integrator.li(scene, &ray, &diff, 0, &mut ctx),
                 Some(aov) => aov.evaluate(scene, &ray, &diff, settings.max_depth),
@@ -255,9 +255,10 @@ fn render_rows(
     (ctx.shadow_rays, ctx.reflection_rays)
 }
 
-/// The camera ray through `raster`, with differentials shrunk to `scale` pixels.
-fn camera_ray(scene: &Scene, raster: Vec2, scale: f32) -> (Ray, RayDifferential) {
-    let c = scene.camera.generate_ray_differential(raster.x, raster.y);
+/// The camera ray through `raster`, with its differentials shrunk to `scale`
+/// pixels (a render uses `max(1/8, 1/√spp)`).
+pub fn camera_ray(camera: &Camera, raster: Vec2, scale: f32) -> (Ray, RayDifferential) {
+    let c = camera.generate_ray_differential(raster.x, raster.y);
     let d = c.ray.direction;
     let diff = RayDifferential {
         rx_origin: c.ray.origin,

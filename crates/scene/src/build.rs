@@ -11,14 +11,12 @@ use glint_integrator::{RenderSettings, SampleCount, Scene, SceneBuilder, Setting
 use glint_lighting::{AreaLight, EnvironmentLight, PhongMaterial, PointLight, UvTransform};
 use glint_texture::{
     load_image, Checkerboard, CubeMap, Environment, Image, ImageTexture, LatLongMap, Texture,
-    TextureImage,
+    TextureImage, MAX_IMAGE_TEXELS,
 };
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// Largest side of a generated texture image, in texels.
-const MAX_TEXTURE_SIDE: u32 = 16384;
 use toml::Spanned;
 
 /// A scene ready to render, with the render settings its file asks for.
@@ -235,23 +233,31 @@ fn textures<'a>(
                 ..Checkerboard::new(c.colors[0].0, c.colors[1].0, c.checks.0)
             }),
             TextureTable::CheckerImage(c) => {
-                let per_check = c.pixels_per_check.get_ref().0;
-                let side = c.checks.0 as u64 * per_check as u64;
-                if side > MAX_TEXTURE_SIDE as u64 {
+                let (checks, per_check) = (c.checks.get_ref().0, c.pixels_per_check.get_ref().0);
+                let side = checks as u64 * per_check as u64;
+                if side * side > MAX_IMAGE_TEXELS {
+                    // Point at pixels_per_check if the file set it, else at checks.
+                    let (key, span) = if c.pixels_per_check.span().is_empty() {
+                        ("checks", c.checks.span())
+                    } else {
+                        ("pixels_per_check", c.pixels_per_check.span())
+                    };
                     return Err(Problem::new(
-                        c.pixels_per_check.span(),
-                        format!("textures.{name}.checker_image.pixels_per_check"),
+                        span,
+                        format!("textures.{name}.checker_image.{key}"),
                         format!(
-                            "checks × pixels_per_check is {side}, more than the largest image side {MAX_TEXTURE_SIDE}"
+                            "the image would be {side}x{side} texels (checks × pixels_per_check per side), more than the limit of {MAX_IMAGE_TEXELS} texels"
                         ),
                     ));
                 }
-                let checker = Checkerboard::new(c.colors[0].0, c.colors[1].0, c.checks.0);
+                let checker = Checkerboard::new(c.colors[0].0, c.colors[1].0, checks);
                 let image = TextureImage::new(checker.to_image(per_check));
                 Texture::Image(ImageTexture::new(image, c.wrap.0, c.filter.0))
             }
             TextureTable::Image(i) => {
-                let path = base_dir.join(i.file.get_ref());
+                // The same file under two spellings (./a.png, a.png) is loaded once.
+                let joined = base_dir.join(i.file.get_ref());
+                let path = std::fs::canonicalize(&joined).unwrap_or(joined);
                 let image = match images.get(&path) {
                     Some(image) => image.clone(),
                     None => {

@@ -143,7 +143,7 @@ fn point_filter() -> CheckerFilter {
 #[serde(deny_unknown_fields)]
 pub struct CheckerImageTable {
     pub colors: [Color; 2],
-    pub checks: Count,
+    pub checks: Spanned<Count>,
     #[serde(default = "course_pixels_per_check")]
     pub pixels_per_check: Spanned<Count>,
     #[serde(default = "repeat")]

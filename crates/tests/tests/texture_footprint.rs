@@ -1,9 +1,11 @@
 //! The pixel footprint, from camera ray differentials to the MIP level a texture
 //! lookup reads: camera → geometry → texture, with no integrator in between.
 
+use glam::Vec2;
 use glam::{UVec2, Vec3};
 use glint_camera::Camera;
-use glint_geometry::{Plane, Ray, RayDifferential, Shape};
+use glint_geometry::{Plane, Shape};
+use glint_integrator::camera_ray;
 use glint_snapfmt::sig5;
 use glint_texture::{Checkerboard, ImageTexture, TexCoord, TextureFilter, TextureImage, WrapMode};
 use std::fmt::Write;
@@ -11,6 +13,11 @@ use std::fmt::Write;
 /// The course's ground: 8 checks of 32 texels (a 256² image), one uv unit per
 /// 4 world units, seen by a 512² camera with a 45° field of view.
 fn mip_levels(eye_height: f32, distance: f32) -> (f32, f32, f32) {
+    mip_levels_at_scale(eye_height, distance, 1.0)
+}
+
+/// As [`mip_levels`], with the differentials shrunk to `scale` pixels.
+fn mip_levels_at_scale(eye_height: f32, distance: f32, scale: f32) -> (f32, f32, f32) {
     let ground = Shape::from(
         Plane::new(Vec3::ZERO, Vec3::Y, false)
             .unwrap()
@@ -22,14 +29,7 @@ fn mip_levels(eye_height: f32, distance: f32) -> (f32, f32, f32) {
     // This reference up is parallel to none of the views, straight down included.
     let up = Vec3::new(0.0, 1.0, -1.0);
     let camera = Camera::new(eye, target, up, 45.0, 1.0, UVec2::new(512, 512)).unwrap();
-    let c = camera.generate_ray_differential(256.0, 256.0);
-    let ray = Ray::new(c.ray.origin, c.ray.direction);
-    let diff = RayDifferential {
-        rx_origin: c.ray.origin,
-        rx_direction: c.dx_direction,
-        ry_origin: c.ray.origin,
-        ry_direction: c.dy_direction,
-    };
+    let (ray, diff) = camera_ray(&camera, Vec2::new(256.0, 256.0), scale);
     let hit = ground.intersect(&ray, f32::INFINITY).unwrap();
     let d = hit.differentials(&diff);
     let tc = TexCoord {
@@ -83,14 +83,23 @@ fn mip_level_for_fixed_rays_at_several_distances_and_angles() {
 fn straight_down_the_level_follows_the_texel_to_pixel_ratio() {
     // From height h straight down, one pixel spans 2·h·tan(22.5°)/512 world units,
     // i.e. that × 256 / 4 texels of level 0; the level is log2 of it.
-    for h in [2.0f32, 8.0, 32.0] {
+    for h in [32.0f32, 128.0, 512.0, 2048.0] {
         let (_, trilinear, ewa) = mip_levels(h, 0.0001);
         let texels = 2.0 * h * 22.5f32.to_radians().tan() / 512.0 * 256.0 / 4.0;
-        let expected = texels.log2().max(0.0);
+        let expected = texels.log2().clamp(0.0, 8.0);
+        assert!(expected > 0.0);
         assert!(
             (trilinear - expected).abs() < 1e-2,
             "h {h}: {trilinear} vs {expected}"
         );
         assert!((ewa - expected).abs() < 1e-2, "h {h}: {ewa} vs {expected}");
     }
+}
+
+#[test]
+fn four_samples_per_pixel_read_one_level_finer() {
+    // Each of 4 samples stands for a quarter of the pixel, half its width: one level.
+    let (_, one, _) = mip_levels_at_scale(128.0, 0.0001, 1.0);
+    let (_, four, _) = mip_levels_at_scale(128.0, 0.0001, 1.0 / 4f32.sqrt());
+    assert!((one - four - 1.0).abs() < 1e-3, "{one} {four}");
 }

@@ -13,12 +13,13 @@ use glam::{Vec2, Vec3};
 /// `lerp(colors[0], colors[1], f)` with `f` the fraction of the footprint on odd
 /// checks. Along a line the pattern is piecewise constant, changing only where the
 /// line crosses a cell boundary, so `f` is integrated exactly along the footprint's
-/// major axis (walking those crossings) and by a midpoint rule across its minor axis
-/// ([`ANALYTIC_LINES`] lines at most). Unlike filtering over the footprint's bounding
-/// box (Quilez, "filterable procedurals"), this keeps the real contrast of long thin
-/// footprints that run along the checks' diagonals. Footprints crossing more than
-/// [`MAX_CROSSINGS`] cell boundaries use the separable bounding-box integral instead,
-/// which is exact for axis-aligned boxes and tends to ½ for large footprints.
+/// major axis (walking those crossings) and by a midpoint rule across its minor axis,
+/// with lines under a tenth of a check apart. Unlike filtering over the footprint's
+/// bounding box (Quilez, "filterable procedurals"), this keeps the real contrast of
+/// long thin footprints that run along the checks' diagonals. Footprints that would
+/// need more than [`MAX_STEPS`] steps (lines × crossings) use the separable
+/// bounding-box integral instead, which is exact for axis-aligned boxes and tends to
+/// ½ as footprints grow.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkerboard {
     pub colors: [Vec3; 2],
@@ -50,7 +51,9 @@ impl Checkerboard {
 
     /// The course's checkerboard rasterised with `pixels_per_check` texels per
     /// check (the report's image used 32), oriented so that an image texture of it
-    /// (looked up at `st = (u, 1 − v)`) shows the same checks as [`Self::evaluate`].
+    /// (looked up at `st = (u, 1 − v)`) shows the same checks as [`Self::evaluate`]
+    /// on [0, 1]². Outside it the image repeats every 1 unit of uv; with an odd
+    /// `checks` the procedural pattern repeats only every 2, so the two differ there.
     pub fn to_image(&self, pixels_per_check: u32) -> crate::Image {
         let side = self.checks * pixels_per_check;
         crate::Image::from_fn(side, side, |x, y| {
@@ -62,43 +65,41 @@ impl Checkerboard {
 
     #[inline]
     pub fn evaluate(&self, uv: Vec2) -> Vec3 {
-        let cell = (uv * self.checks as f32).floor();
-        // f32 → i64 saturates (NaN → 0); the low bit gives the parity of negative
-        // cells too (two's complement), and xor cannot overflow.
-        let parity = ((cell.x as i64) ^ (cell.y as i64)) & 1;
-        self.colors[parity as usize]
+        self.colors[parity(uv * self.checks as f32) as usize]
     }
 }
 
-/// Most lines across the footprint's minor axis in the analytic filter.
-pub const ANALYTIC_LINES: u32 = 8;
-
-/// Most cell-boundary crossings the analytic filter walks along one line.
-pub const MAX_CROSSINGS: f32 = 256.0;
+/// The most steps (lines across the footprint × cell crossings along each) the
+/// analytic filter takes before it falls back to the bounding-box integral.
+pub const MAX_STEPS: f32 = 2048.0;
 
 /// The fraction of the parallelogram `c + s·a + t·b` (`s, t ∈ [−½, ½]`, in check
 /// units) that lies on odd checks.
 fn footprint_odd_fraction(c: Vec2, a: Vec2, b: Vec2) -> f32 {
     if !(c.is_finite() && a.is_finite() && b.is_finite()) {
-        return parity(c);
+        return parity(c) as f32;
     }
+    // The pattern repeats every two checks: keep coordinates small so that f32
+    // still resolves every cell boundary (beyond 2^24, k + 1 == k).
+    let c = c - 2.0 * (c * 0.5).floor();
     let (major, minor) = if a.length_squared() >= b.length_squared() {
         (a, b)
     } else {
         (b, a)
     };
     if major.length_squared() < 1e-12 {
-        return parity(c);
+        return parity(c) as f32;
     }
-    if major.abs().element_sum() > MAX_CROSSINGS {
+    // Lines under a tenth of a check apart, and at least two, so that a thin
+    // footprint along a row of cell corners is not read as that row alone.
+    let lines = (minor.length() * 10.0).ceil().max(2.0);
+    let crossings = major.abs().element_sum() + 2.0;
+    if lines * crossings > MAX_STEPS {
         let width = a.abs() + b.abs();
         let (fx, fy) = (odd_fraction(c.x, width.x), odd_fraction(c.y, width.y));
         return fx + fy - 2.0 * fx * fy;
     }
-    // Enough lines that neighbours are under a tenth of a check apart, and at least
-    // two, so that a thin footprint along a line of cell corners is not read as
-    // that line alone.
-    let lines = ((minor.length() * 10.0).ceil() as u32).clamp(2, ANALYTIC_LINES);
+    let lines = lines as u32;
     let sum: f32 = (0..lines)
         .map(|j| {
             let t = (j as f32 + 0.5) / lines as f32 - 0.5;
@@ -108,10 +109,12 @@ fn footprint_odd_fraction(c: Vec2, a: Vec2, b: Vec2) -> f32 {
     sum / lines as f32
 }
 
-/// 1 on odd checks, 0 on even ones.
+/// 1 on odd checks (cells whose integer coordinates sum to an odd number), 0 on
+/// even ones. f32 → i64 saturates (NaN → 0); the low bit gives the parity of
+/// negative cells too (two's complement), and xor cannot overflow.
 #[inline]
-fn parity(p: Vec2) -> f32 {
-    (((p.x.floor() as i64) ^ (p.y.floor() as i64)) & 1) as f32
+fn parity(p: Vec2) -> u8 {
+    (((p.x.floor() as i64) ^ (p.y.floor() as i64)) & 1) as u8
 }
 
 /// The exact fraction of the segment `p0 + s·d`, `s ∈ [0, 1]`, on odd checks.
@@ -121,10 +124,15 @@ fn parity(p: Vec2) -> f32 {
 /// the parity. The two sorted sequences are merged on the fly, so no allocation.
 fn odd_fraction_along(p0: Vec2, d: Vec2) -> f32 {
     let mut crossings = [axis_crossings(p0.x, d.x), axis_crossings(p0.y, d.y)];
-    let start = p0 + 1e-4 * d.signum() * d.abs().min(Vec2::splat(1.0));
-    let mut odd = parity(start) == 1.0;
+    let first = |c: &AxisCrossings| c.peek().unwrap_or(1.0);
+    // The parity in the middle of the first interval, away from any boundary.
+    let s1 = first(&crossings[0]).min(first(&crossings[1]));
+    let mut odd = parity(p0 + 0.5 * s1 * d) == 1;
     let (mut s, mut covered) = (0.0f32, 0.0f32);
-    loop {
+    // Each step passes at least one crossing; the bound ends the loop even if
+    // rounding ever made a crossing repeat.
+    let max_steps = 2 * (d.abs().element_sum() + 4.0).min(MAX_STEPS) as u32;
+    for _ in 0..max_steps {
         let next = match (crossings[0].peek(), crossings[1].peek()) {
             (Some(x), Some(y)) => x.min(y),
             (Some(x), None) => x,
@@ -145,6 +153,7 @@ fn odd_fraction_along(p0: Vec2, d: Vec2) -> f32 {
             }
         }
     }
+    covered + if odd { 1.0 - s } else { 0.0 }
 }
 
 /// The parameters `s ∈ (0, 1)` where `x0 + s·dx` is an integer, in increasing order.
@@ -191,7 +200,7 @@ impl AxisCrossings {
 #[inline]
 fn odd_fraction(x: f32, w: f32) -> f32 {
     if w.is_nan() || w <= 1e-4 || !w.is_finite() {
-        return ((x.floor() as i64) & 1) as f32;
+        return parity(Vec2::new(x, 0.0)) as f32;
     }
     let integral = |x: f32| {
         let half = x * 0.5;
@@ -326,6 +335,35 @@ mod tests {
             duvdy: Vec2::new(-0.05, 0.05),
         };
         assert!(c.evaluate_filtered(&diagonal).x < 0.2);
+    }
+
+    #[test]
+    fn huge_coordinates_terminate_and_keep_the_pattern() {
+        let mut c = Checkerboard::new(Vec3::ZERO, Vec3::ONE, 1);
+        c.analytic = true;
+        // 2^24 < x < 2^25: f32 spacing is 2 there, so k + 1 == k.
+        for (x, d) in [
+            (20_000_002.0, 10.0),
+            (20_000_002.0, -10.0),
+            (3.0e7, 3.0),
+            (1e30, 7.0),
+        ] {
+            let tc = TexCoord {
+                uv: Vec2::new(x, 0.25),
+                duvdx: Vec2::new(d, 0.0),
+                duvdy: Vec2::new(0.0, 0.05),
+            };
+            let f = c.evaluate_filtered(&tc).x;
+            assert!((0.0..=1.0).contains(&f), "{x} {d}: {f}");
+        }
+    }
+
+    #[test]
+    fn a_line_starting_just_before_a_boundary_keeps_its_parity() {
+        // From (0.99999, 0.5) along (1, 0.3): almost all of the way in cell (1, 0),
+        // which is odd: the fraction must be close to 1, not to 0.
+        let f = odd_fraction_along(Vec2::new(0.99999, 0.5), Vec2::new(1.0, 0.3));
+        assert!((f - 0.99999).abs() < 1e-4, "{f}");
     }
 
     #[test]

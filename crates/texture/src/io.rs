@@ -13,29 +13,61 @@ pub struct ImageLoadError {
     pub message: String,
 }
 
+/// The largest image side accepted, in texels.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// The most texels an image may have (a 4096 × 4096 image): 192 MiB as linear
+/// f32 RGB, and its MIP pyramid builds from a copy of it.
+pub const MAX_IMAGE_TEXELS: u64 = 1 << 24;
+
 /// Reads a PNG, JPEG, Radiance HDR or OpenEXR file as linear RGB.
 ///
 /// Integer formats (8- and 16-bit, as PNG and JPEG store them) are taken to be
 /// sRGB-encoded and decoded to linear here, once; float formats (HDR, EXR) are
-/// already linear. Grayscale is replicated to RGB; alpha is ignored.
+/// already linear. Grayscale is replicated to RGB; alpha is ignored. Images larger
+/// than [`MAX_IMAGE_SIDE`] or [`MAX_IMAGE_TEXELS`] are refused before decoding.
 pub fn load_image(path: &Path) -> Result<Image, ImageLoadError> {
     let fail = |message: String| ImageLoadError {
         path: path.to_path_buf(),
         message,
     };
-    let decoded = image::ImageReader::open(path)
+    let mut reader = image::ImageReader::open(path)
         .map_err(|e| fail(e.to_string()))?
         .with_guessed_format()
+        .map_err(|e| fail(e.to_string()))?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_IMAGE_SIDE);
+    limits.max_image_height = Some(MAX_IMAGE_SIDE);
+    reader.limits(limits);
+    let (w, h) = reader.into_dimensions().map_err(|e| fail(e.to_string()))?;
+    check_size(w, h).map_err(fail)?;
+    let decoded = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
         .map_err(|e| fail(e.to_string()))?
         .decode()
         .map_err(|e| fail(e.to_string()))?;
-    Ok(from_dynamic(decoded))
+    from_dynamic(decoded).map_err(fail)
+}
+
+fn check_size(w: u32, h: u32) -> Result<(), String> {
+    if w == 0 || h == 0 {
+        return Err(format!("the image is {w}x{h}: it has no texels"));
+    }
+    if w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE || w as u64 * h as u64 > MAX_IMAGE_TEXELS {
+        return Err(format!(
+            "the image is {w}x{h}, larger than the limit of {MAX_IMAGE_TEXELS} texels (4096 x 4096), each side at most {MAX_IMAGE_SIDE}"
+        ));
+    }
+    Ok(())
 }
 
 /// Converts a decoded image to linear RGB (see [`load_image`] for the rules).
-pub fn from_dynamic(decoded: image::DynamicImage) -> Image {
+/// Non-finite texels (NaN, ∞ in float files) become 0 and negative ones 0, so
+/// that one bad texel cannot spread through every MIP level.
+pub fn from_dynamic(decoded: image::DynamicImage) -> Result<Image, String> {
     use image::DynamicImage as D;
     let (w, h) = (decoded.width(), decoded.height());
+    check_size(w, h)?;
     let texels: Vec<Vec3> = match decoded {
         D::ImageRgb32F(_) | D::ImageRgba32F(_) => {
             let rgb = decoded.into_rgb32f();
@@ -55,7 +87,12 @@ pub fn from_dynamic(decoded: image::DynamicImage) -> Image {
                 .collect()
         }
     };
-    Image::new(w, h, texels)
+    let sanitize = |c: f32| if c.is_finite() { c.max(0.0) } else { 0.0 };
+    let texels = texels
+        .into_iter()
+        .map(|t| Vec3::from_array(t.to_array().map(sanitize)))
+        .collect();
+    Ok(Image::new(w, h, texels))
 }
 
 /// The sRGB electro-optical transfer function (IEC 61966-2-1): encoded → linear.
@@ -110,7 +147,37 @@ mod tests {
             1,
             image::Rgb([2.5, 0.5, 0.125]),
         ));
-        assert_eq!(from_dynamic(hdr).texel(0, 0), Vec3::new(2.5, 0.5, 0.125));
+        assert_eq!(
+            from_dynamic(hdr).unwrap().texel(0, 0),
+            Vec3::new(2.5, 0.5, 0.125)
+        );
+    }
+
+    #[test]
+    fn bad_float_texels_are_made_zero_and_empty_images_refused() {
+        let hdr = image::DynamicImage::ImageRgb32F(
+            image::Rgb32FImage::from_raw(
+                3,
+                1,
+                vec![f32::NAN, 1.0, f32::INFINITY, -2.0, 0.5, 0.25, 1.0, 1.0, 1.0],
+            )
+            .unwrap(),
+        );
+        let img = from_dynamic(hdr).unwrap();
+        assert_eq!(img.texel(0, 0), Vec3::new(0.0, 1.0, 0.0));
+        assert_eq!(img.texel(1, 0), Vec3::new(0.0, 0.5, 0.25));
+        let empty = image::DynamicImage::ImageRgb32F(image::Rgb32FImage::new(0, 5));
+        assert!(from_dynamic(empty).unwrap_err().contains("no texels"));
+    }
+
+    #[test]
+    fn oversized_images_are_refused_before_decoding() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.png");
+        // A 5000 x 4000 grayscale PNG compresses to a few kilobytes.
+        image::GrayImage::new(5000, 4000).save(&path).unwrap();
+        let e = load_image(&path).unwrap_err().to_string();
+        assert!(e.contains("5000x4000, larger than the limit"), "{e}");
     }
 
     #[test]

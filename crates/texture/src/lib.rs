@@ -28,7 +28,7 @@ pub use environment::{
     LatLongMap,
 };
 pub use image_texture::{ImageTexture, TextureFilter, TextureImage};
-pub use io::{load_image, srgb_to_linear, ImageLoadError};
+pub use io::{load_image, srgb_to_linear, ImageLoadError, MAX_IMAGE_SIDE, MAX_IMAGE_TEXELS};
 pub use mipmap::MipMap;
 pub use texcoord::TexCoord;
 

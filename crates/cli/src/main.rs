@@ -66,6 +66,15 @@ struct RenderArgs {
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
 
+    /// Most mirror reflections followed per camera ray (overrides render.max_depth)
+    #[arg(long, value_name = "N")]
+    max_depth: Option<u32>,
+
+    /// Environment directions sampled per shading point (overrides
+    /// render.environment_samples; 0: the environment lights nothing)
+    #[arg(long, value_name = "N")]
+    environment_samples: Option<u32>,
+
     /// Seed of every random stream (overrides render.seed)
     #[arg(long, value_name = "N")]
     seed: Option<u64>,
@@ -80,7 +89,8 @@ struct RenderArgs {
 
     /// Write this buffer instead of the shaded image: raw values in .exr/.pfm,
     /// false color in .png (normals as 0.5·n + 0.5, uv as its fractional part,
-    /// depth as gray from near to far, MIP level as a blue-green-red ramp)
+    /// depth as gray from near to far, MIP level and reflection depth as a
+    /// blue-green-red ramp)
     #[arg(long, value_name = "BUFFER")]
     aov: Option<AovName>,
 }
@@ -109,6 +119,8 @@ enum AovName {
     Depth,
     /// Filtered diffuse color
     Albedo,
+    /// How many mirror reflections the path took
+    ReflectionDepth,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -312,6 +324,12 @@ fn apply_overrides(args: &RenderArgs, settings: &mut RenderSettings) {
     if let Some(seed) = args.seed {
         settings.seed = seed;
     }
+    if let Some(depth) = args.max_depth {
+        settings.max_depth = depth;
+    }
+    if let Some(n) = args.environment_samples {
+        settings.environment_samples = n;
+    }
     if args.threads.is_some() {
         settings.threads = args.threads;
     }
@@ -322,6 +340,7 @@ fn apply_overrides(args: &RenderArgs, settings: &mut RenderSettings) {
             AovName::Normal => Aov::Normal,
             AovName::Depth => Aov::Depth,
             AovName::Albedo => Aov::Albedo,
+            AovName::ReflectionDepth => Aov::ReflectionDepth,
         });
     }
 }

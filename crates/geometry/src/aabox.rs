@@ -1,4 +1,4 @@
-use crate::{Hit, Ray};
+use crate::{Hit, Parallelogram, Ray};
 use glam::{Vec2, Vec3};
 
 /// An axis-aligned box `[min, max]`, a closed solid seen from outside and inside.
@@ -35,6 +35,28 @@ impl AaBox {
 
     pub fn min(&self) -> Vec3 {
         self.min
+    }
+
+    /// The six faces as two-sided parallelograms in `+x −x +y −y +z −z` order,
+    /// with the same uv (upright seen from outside) and outward normals as the box's
+    /// own hits: for a box whose faces carry different materials.
+    pub fn face_parallelograms(&self) -> [Parallelogram; 6] {
+        let extent = self.max - self.min;
+        FACES.map(|(axis, sign, (ua, us), (va, vs))| {
+            let mut origin = Vec3::ZERO;
+            origin[axis] = if sign > 0.0 {
+                self.max[axis]
+            } else {
+                self.min[axis]
+            };
+            origin[ua] = if us > 0.0 { self.min[ua] } else { self.max[ua] };
+            origin[va] = if vs > 0.0 { self.min[va] } else { self.max[va] };
+            let mut edge1 = Vec3::ZERO;
+            edge1[ua] = us * extent[ua];
+            let mut edge2 = Vec3::ZERO;
+            edge2[va] = vs * extent[va];
+            Parallelogram::new(origin, edge1, edge2, true).expect("a box face has area")
+        })
     }
     pub fn max(&self) -> Vec3 {
         self.max

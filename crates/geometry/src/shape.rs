@@ -305,6 +305,27 @@ mod tests {
     }
 
     #[test]
+    fn box_faces_as_parallelograms_match_the_box() {
+        let b = AaBox::new(Vec3::new(-1.0, -2.0, -3.0), Vec3::new(2.0, 1.0, 0.5)).unwrap();
+        let faces = b.face_parallelograms();
+        let centre = Vec3::new(0.5, -0.5, -1.25);
+        for (i, axis) in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z]
+            .into_iter()
+            .enumerate()
+        {
+            let origin = centre + 10.0 * axis + Vec3::new(0.3, -0.2, 0.1);
+            let ray = Ray::new(origin, centre + Vec3::new(0.1, 0.2, -0.15) - origin);
+            let from_box = Shape::from(b).intersect(&ray, f32::INFINITY).unwrap();
+            let from_face = Shape::from(faces[i])
+                .intersect(&ray, f32::INFINITY)
+                .unwrap();
+            assert_eq!(from_face.geometric_normal, axis);
+            assert!((from_box.uv - from_face.uv).length() < 1e-5, "face {i}");
+            assert!((from_box.point - from_face.point).length() < 1e-5);
+        }
+    }
+
+    #[test]
     fn t_max_limits_hits() {
         for (name, shape) in shapes() {
             let ray = Ray::new(Vec3::ZERO, Vec3::new(0.0, -0.1, -1.0));

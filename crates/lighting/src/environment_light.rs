@@ -17,8 +17,9 @@ pub struct EnvironmentSample {
 ///
 /// The map is turned by `rotation` radians about +y (world = R · map) and its
 /// radiance multiplied by `scale`. It is importance-sampled by luminance: a
-/// piecewise-constant distribution over the map's texels, each weighted by its
-/// luminance times the solid angle it covers (pbrt-v4 section 12.5), so the density
+/// piecewise-constant distribution over the map's texels, each weighted by the
+/// luminance around it times the solid angle it covers (pbrt-v4 section 12.5; see
+/// `sampling_distribution` for the neighbourhood), so the density
 /// in solid angle is `p(u, v) / J` with `J = 2π² sin θ` for lat-long maps and
 /// `J = 4/(1 + s² + t²)^{3/2}` per face (times 6 faces) for cube maps. A constant
 /// environment is sampled with the cosine-weighted hemisphere about the shading
@@ -32,7 +33,7 @@ pub struct EnvironmentLight {
 }
 
 /// Weight added to every texel of the sampling distribution, relative to the mean,
-/// so the density is positive wherever bilinear filtering can spread radiance.
+/// so the density is positive everywhere.
 const WEIGHT_FLOOR: f32 = 1e-3;
 
 impl EnvironmentLight {
@@ -160,33 +161,44 @@ fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
-/// Texel weights ∝ luminance × solid angle (with a small floor), or `None` for
-/// a constant environment.
+/// Texel weights for sampling, or `None` for a constant environment.
+///
+/// A texel's weight is the largest luminance in its 3 × 3 neighbourhood (across
+/// cube-face edges too) times its solid angle, plus a small floor. Taking the
+/// neighbourhood's maximum covers everything bilinear filtering can return inside
+/// the texel, so a dim texel beside a bright one is never sampled with a density
+/// far below the radiance it shows: no fireflies, and the estimator stays unbiased.
 fn sampling_distribution(environment: &Environment) -> Option<PiecewiseConstant2D> {
     let (mut weights, width) = match environment {
         Environment::Constant(_) => return None,
         Environment::LatLong(map) => {
             let image = map.image();
-            let (w, h) = (image.width() as usize, image.height() as usize);
+            let (w, h) = (image.width() as i64, image.height() as i64);
+            let luminance_at = |x: i64, y: i64| {
+                let x = x.rem_euclid(w) as u32;
+                let y = y.clamp(0, h - 1) as u32;
+                luminance(image.texel(x, y))
+            };
             let weights = (0..h)
                 .flat_map(|y| (0..w).map(move |x| (x, y)))
                 .map(|(x, y)| {
                     let sin_theta = ((y as f32 + 0.5) / h as f32 * PI).sin();
-                    luminance(image.texel(x as u32, y as u32)).max(0.0) * sin_theta
+                    neighbourhood_max(|dx, dy| luminance_at(x + dx, y + dy)) * sin_theta
                 })
                 .collect::<Vec<_>>();
-            (weights, w)
+            (weights, w as usize)
         }
         Environment::CubeMap(cube) => {
             let n = cube.size() as usize;
             let mut weights = vec![0.0; 6 * n * n];
             for face in 0..6 {
-                let image = cube.face(face);
                 for y in 0..n {
                     for x in 0..n {
                         let st = (Vec2::new(x as f32, y as f32) + 0.5) / n as f32;
                         let solid_angle = 1.0 / cube_jacobian(st);
-                        let lum = luminance(image.texel(x as u32, y as u32)).max(0.0);
+                        let lum = neighbourhood_max(|dx, dy| {
+                            luminance(cube.texel(face, 0, x as i64 + dx, y as i64 + dy))
+                        });
                         weights[y * 6 * n + face * n + x] = lum * solid_angle;
                     }
                 }
@@ -203,6 +215,17 @@ fn sampling_distribution(environment: &Environment) -> Option<PiecewiseConstant2
             .for_each(|w| *w = w.min(f32::MAX / 2.0) + WEIGHT_FLOOR * mean);
     }
     Some(PiecewiseConstant2D::new(&weights, width))
+}
+
+/// The largest of `lum(dx, dy)` over the 3 × 3 neighbourhood, negatives as 0.
+fn neighbourhood_max(lum: impl Fn(i64, i64) -> f32) -> f32 {
+    let mut best = 0.0f32;
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            best = best.max(lum(dx, dy));
+        }
+    }
+    best
 }
 
 #[cfg(test)]

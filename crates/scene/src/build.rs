@@ -83,7 +83,6 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
     }
     for (i, b) in file.boxes.iter().enumerate() {
         let field = format!("box[{i}]");
-        let m = lookup(format!("{field}.material"), &b.material)?;
         let aabox = AaBox::new(b.min.0, b.max.get_ref().0).ok_or_else(|| {
             Problem::new(
                 b.max.span(),
@@ -91,7 +90,41 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
                 "expected max to be greater than min on every axis",
             )
         })?;
-        builder.shape(aabox, m);
+        match (&b.material, &b.face_materials) {
+            (Some(material), None) => {
+                let m = lookup(format!("{field}.material"), material)?;
+                builder.shape(aabox, m);
+            }
+            (None, Some(names)) if names.get_ref().len() == 6 => {
+                for (face, (shape, name)) in aabox
+                    .face_parallelograms()
+                    .into_iter()
+                    .zip(names.get_ref())
+                    .enumerate()
+                {
+                    let m = lookup(format!("{field}.face_materials[{face}]"), name)?;
+                    builder.shape(shape, m);
+                }
+            }
+            (None, Some(names)) => {
+                return Err(Problem::new(
+                    names.span(),
+                    format!("{field}.face_materials"),
+                    format!(
+                        "expected 6 materials (px nx py ny pz nz), got {}",
+                        names.get_ref().len()
+                    ),
+                ))
+            }
+            _ => {
+                let span = b.max.span();
+                return Err(Problem::new(
+                    span,
+                    field,
+                    "expected exactly one of `material` or `face_materials`",
+                ));
+            }
+        }
     }
     for p in &file.point_light {
         builder.point_light(PointLight {

@@ -277,7 +277,10 @@ pub struct PlaneTable {
 pub struct BoxTable {
     pub min: Point,
     pub max: Spanned<Point>,
-    pub material: Spanned<String>,
+    /// One material for the whole box…
+    pub material: Option<Spanned<String>>,
+    /// …or one per face, in `px nx py ny pz nz` order (the report's textured box).
+    pub face_materials: Option<Spanned<Vec<Spanned<String>>>>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -176,7 +176,7 @@ impl CubeMap {
     }
 
     /// Texel `(i, j)` of `face` at `level`, following the cube past the face's edges.
-    fn texel(&self, face: CubeFace, level: usize, i: i64, j: i64) -> Vec3 {
+    pub fn texel(&self, face: CubeFace, level: usize, i: i64, j: i64) -> Vec3 {
         let image = self.level(face, level);
         let n = image.width() as i64;
         if (0..n).contains(&i) && (0..n).contains(&j) {

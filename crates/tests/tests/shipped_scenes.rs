@@ -49,7 +49,8 @@ fn every_shipped_scene_loads() {
     for name in names {
         let d = load(&scene_path(&name)).unwrap_or_else(|e| panic!("{e}"));
         assert!(d.settings.validate().is_ok(), "{name}");
-        assert!(!d.scene.lights.is_empty(), "{name} has no light");
+        let lit = !d.scene.lights.is_empty() || d.scene.environment.is_some();
+        assert!(lit, "{name} has neither a light nor an environment");
     }
 }
 

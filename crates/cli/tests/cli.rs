@@ -280,6 +280,27 @@ fn aovs_write_raw_values_to_float_files_and_false_color_to_png() {
         run(aov, &format!("{aov}.png"));
         assert!(image_dimensions(&dir.path().join(format!("{aov}.png"))) == (32, 24));
     }
+    // Reflection depth in the environment scene: the chrome sphere reflects.
+    let env = scene("environment");
+    let args = [
+        "render",
+        env.as_str(),
+        "-o",
+        "refl.pfm",
+        "--aov",
+        "reflection-depth",
+        "--resolution",
+        "48x27",
+        "--spp",
+        "1",
+        "--max-depth",
+        "3",
+    ];
+    let o = glint(&args, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, _, refl) = read_pfm(&dir.path().join("refl.pfm"));
+    let deepest = refl.iter().map(|p| p[0]).fold(0.0f32, f32::max);
+    assert!((1.0..=3.0).contains(&deepest), "{deepest}");
     let o = glint(
         &["render", point_light.as_str(), "--aov", "bogus"],
         dir.path(),

@@ -57,6 +57,15 @@ fn each_kind_of_bad_input_has_its_own_message() {
         ("unknown checker filter", format!("{CAMERA}[textures.t.checkerboard]\ncolors = [[0, 0, 0], [1, 1, 1]]\nchecks = 4\nfilter = \"trilinear\"\n")),
         ("checker image too large", format!("{CAMERA}[textures.t.checker_image]\ncolors = [[0, 0, 0], [1, 1, 1]]\nchecks = 1000\npixels_per_check = 32\n")),
         ("zero uv scale", format!("{CAMERA}[materials.m]\ndiffuse = [1, 1, 1]\nuv_scale = [0, 1]\n")),
+        ("environment with two sources", format!("{CAMERA}[environment]\ncolor = [1, 1, 1]\nlatlong = \"sky.hdr\"\n")),
+        ("environment with no source", format!("{CAMERA}[environment]\nintensity = 2\n")),
+        ("cube map template without {{face}}", format!("{CAMERA}[environment]\ncube_map = \"sky.hdr\"\n")),
+        ("missing cube map face", format!("{CAMERA}[environment]\ncube_map = \"no/such/{{face}}.hdr\"\n")),
+        ("mirror with a diffuse color", format!("{CAMERA}[materials.m]\nmirror = [1, 1, 1]\ndiffuse = [1, 0, 0]\n")),
+        ("material with neither diffuse nor mirror", format!("{CAMERA}[materials.m]\nshininess = 3\n")),
+        ("reflectivity above one", format!("{CAMERA}[materials.m]\ndiffuse = [1, 1, 1]\nreflectivity = 1.5\n")),
+        ("max depth above the limit", format!("{CAMERA}[render]\nmax_depth = 1000\n")),
+        ("box with five face materials", format!("{CAMERA}{MATERIAL}[[box]]\nmin = [0, 0, 0]\nmax = [1, 1, 1]\nface_materials = [\"m\", \"m\", \"m\", \"m\", \"m\"]\n")),
         ("zero tile size", format!("{CAMERA}{MATERIAL}[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\ntile_size = 0\nmaterial = \"m\"\n")),
     ];
     let mut report = String::new();

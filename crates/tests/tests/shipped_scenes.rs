@@ -161,3 +161,22 @@ fn shipped_scene_renders_bit_identically_on_1_and_4_threads() {
     };
     assert_eq!(at(1), at(4));
 }
+
+/// A 16×16 render of the environment scene (cube map, mirrors, environment light),
+/// every pixel's RGB locked to five significant digits.
+#[test]
+fn environment_16x16_render_snapshot() {
+    let d = load(&scene_path("environment")).unwrap();
+    let film = render_at(&d, 16, 16, |s| {
+        (s.spp, s.pixel_pattern) = (4, SamplePattern::Grid);
+        s.environment_samples = 4;
+    });
+    let mut s = String::new();
+    for y in 0..16 {
+        for x in 0..16 {
+            let p = film.pixel(x, y);
+            writeln!(s, "({x:2},{y:2}) {} {} {}", sig5(p.x), sig5(p.y), sig5(p.z)).unwrap();
+        }
+    }
+    insta::assert_snapshot!(s);
+}

@@ -1,0 +1,173 @@
+//! Environment lighting: what misses see, mirrors, and the environment as a light.
+
+use glam::{UVec2, Vec3};
+use glint_camera::Camera;
+use glint_geometry::{Parallelogram, Sphere};
+use glint_integrator::{render, Aov, RenderSettings, SamplePattern, Scene, SceneBuilder};
+use glint_lighting::{EnvironmentLight, PhongMaterial};
+use glint_texture::{CubeMap, Environment, Image, LatLongMap, Texture};
+
+fn camera(resolution: u32) -> Camera {
+    Camera::new(
+        Vec3::new(0.0, 0.0, 4.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        40.0,
+        1.0,
+        UVec2::splat(resolution),
+    )
+    .unwrap()
+}
+
+fn settings(spp: u32, environment_samples: u32) -> RenderSettings {
+    RenderSettings {
+        spp,
+        pixel_pattern: SamplePattern::Stratified,
+        environment_samples,
+        ..RenderSettings::default()
+    }
+}
+
+fn white_diffuse() -> PhongMaterial {
+    PhongMaterial {
+        specular: Some(Texture::Constant(Vec3::ZERO)),
+        ..PhongMaterial::new(Vec3::ONE, 1.0)
+    }
+}
+
+fn sphere_in(environment: Environment, material: PhongMaterial) -> Scene {
+    let mut b = SceneBuilder::new();
+    let m = b.material(material);
+    b.shape(Sphere::new(Vec3::ZERO, 1.0).unwrap(), m)
+        .environment(EnvironmentLight::new(environment, 0.3, 1.0));
+    b.build(camera(24)).unwrap()
+}
+
+#[test]
+fn a_mirror_in_a_one_color_cube_map_shows_no_seam() {
+    let c = Vec3::new(0.25, 0.5, 0.75);
+    let faces = std::array::from_fn(|_| Image::from_fn(8, 8, |_, _| c));
+    let env = Environment::CubeMap(CubeMap::new(faces).unwrap());
+    let scene = sphere_in(env, PhongMaterial::mirror(Vec3::ONE));
+    let film = render(&scene, &settings(4, 0), &|_, _| {}).unwrap().film;
+    // Every pixel, on the sphere (reflections across every face edge and corner, at
+    // every MIP level the widening footprints reach) or off it, is exactly c.
+    for p in film.pixels() {
+        assert!((*p - c).abs().max_element() < 1e-6, "{p}");
+    }
+}
+
+#[test]
+fn furnace_constant_white_environment_gives_exactly_one() {
+    let scene = sphere_in(Environment::Constant(Vec3::ONE), white_diffuse());
+    let film = render(&scene, &settings(4, 8), &|_, _| {}).unwrap().film;
+    for p in film.pixels() {
+        assert!((*p - Vec3::ONE).abs().max_element() < 1e-5, "{p}");
+    }
+}
+
+#[test]
+fn furnace_constant_white_map_gives_one_within_monte_carlo_tolerance() {
+    let map = Environment::LatLong(LatLongMap::new(Image::from_fn(64, 32, |_, _| Vec3::ONE)));
+    let scene = sphere_in(map, white_diffuse());
+    let film = render(&scene, &settings(16, 64), &|_, _| {}).unwrap().film;
+    let mean = film.pixels().iter().map(|p| p.x as f64).sum::<f64>() / film.pixels().len() as f64;
+    assert!((mean - 1.0).abs() < 0.01, "mean {mean}");
+    for p in film.pixels() {
+        assert!((p.x - 1.0).abs() < 0.15, "{p}");
+    }
+}
+
+/// A smooth environment, as a lat-long image and as the cube map resampled from it.
+fn gradient_maps() -> (Environment, Environment) {
+    let radiance =
+        |d: Vec3| Vec3::new(0.5 + 0.5 * d.y, 0.4 + 0.3 * d.x, 0.6 - 0.4 * d.z).max(Vec3::ZERO);
+    let latlong = Image::from_fn(256, 128, |x, y| {
+        let uv = glam::Vec2::new((x as f32 + 0.5) / 256.0, (y as f32 + 0.5) / 128.0);
+        radiance(glint_texture::latlong_direction(uv))
+    });
+    let faces = std::array::from_fn(|face| {
+        Image::from_fn(64, 64, |x, y| {
+            let st = glam::Vec2::new((x as f32 + 0.5) / 64.0, (y as f32 + 0.5) / 64.0);
+            radiance(glint_texture::cube_direction(face, st).normalize())
+        })
+    });
+    (
+        Environment::LatLong(LatLongMap::new(latlong)),
+        Environment::CubeMap(CubeMap::new(faces).unwrap()),
+    )
+}
+
+fn relative_mse(a: &glint_camera::Film, b: &glint_camera::Film) -> f32 {
+    a.pixels()
+        .iter()
+        .zip(b.pixels())
+        .map(|(a, b)| ((*a - *b) * (*a - *b) / (*b * *b + Vec3::splat(0.01))).element_sum() / 3.0)
+        .sum::<f32>()
+        / a.pixels().len() as f32
+}
+
+#[test]
+fn cube_map_and_latlong_renders_of_one_environment_agree() {
+    let (latlong, cube) = gradient_maps();
+    let both = |material: PhongMaterial, environment_samples| {
+        let films: Vec<_> = [latlong.clone(), cube.clone()]
+            .into_iter()
+            .map(|env| {
+                let s = settings(4, environment_samples);
+                render(&sphere_in(env, material.clone()), &s, &|_, _| {})
+                    .unwrap()
+                    .film
+            })
+            .collect();
+        relative_mse(&films[0], &films[1])
+    };
+    // Seen in a mirror (no Monte Carlo noise): the two mappings agree to filtering.
+    let mirror = both(PhongMaterial::mirror(Vec3::ONE), 0);
+    assert!(mirror < 1e-4, "mirror: relative MSE {mirror}");
+    // Lighting a diffuse surface: equal up to the noise of 4 × 256 samples.
+    let diffuse = both(white_diffuse(), 256);
+    assert!(diffuse < 2e-3, "diffuse: relative MSE {diffuse}");
+}
+
+#[test]
+fn reflections_stop_at_max_depth() {
+    // Two facing mirrors: a ray between them bounces until max_depth, then sees black.
+    let mut b = SceneBuilder::new();
+    let m = b.material(PhongMaterial::mirror(Vec3::ONE));
+    let wall = |z: f32, facing: f32| {
+        Parallelogram::new(
+            Vec3::new(-5.0, -5.0, z),
+            Vec3::X * 10.0,
+            Vec3::Y * 10.0,
+            true,
+        )
+        .unwrap()
+        .facing(Vec3::new(0.0, 0.0, facing))
+    };
+    b.shape(wall(-1.0, 1.0), m)
+        .shape(wall(6.0, -1.0), m)
+        .environment(EnvironmentLight::new(
+            Environment::Constant(Vec3::ONE),
+            0.0,
+            1.0,
+        ));
+    let scene = b.build(camera(3)).unwrap();
+    for max_depth in [0, 1, 3] {
+        let s = RenderSettings {
+            max_depth,
+            aov: Some(Aov::ReflectionDepth),
+            ..settings(1, 0)
+        };
+        let depth = render(&scene, &s, &|_, _| {}).unwrap().film.pixel(1, 1);
+        assert_eq!(depth.x, max_depth as f32);
+        let radiance = render(&scene, &RenderSettings { aov: None, ..s }, &|_, _| {})
+            .unwrap()
+            .film;
+        assert_eq!(
+            radiance.pixel(1, 1),
+            Vec3::ZERO,
+            "trapped between mirrors: black"
+        );
+    }
+}

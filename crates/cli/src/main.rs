@@ -253,8 +253,12 @@ fn render(args: &RenderArgs) -> Result<(), Failure> {
 
     let stats = rendered.stats;
     let resolution = film.resolution();
+    let environment_samples = match scene.environment {
+        Some(_) => format!(", {} environment samples", settings.environment_samples),
+        None => String::new(),
+    };
     println!(
-        "wrote {}: {}x{}, {} spp, {} light samples, {:.2} s wall ({:.2} s rendering), {} rays ({:.2} M rays/s)",
+        "wrote {}: {}x{}, {} spp, {} light samples{environment_samples}, {:.2} s wall ({:.2} s rendering), {} rays ({:.2} M rays/s)",
         output.display(),
         resolution.x,
         resolution.y,

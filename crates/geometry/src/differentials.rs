@@ -32,6 +32,13 @@ pub struct SurfaceDifferentials {
 /// they would otherwise overflow the filters downstream.
 const MAX_UV_DERIVATIVE: f32 = 1e8;
 
+/// The mirror reflection of the unit direction `wo` (pointing away from the
+/// surface) about the unit normal `n`: `2(wo·n)n − wo`.
+#[inline]
+pub fn reflect(wo: Vec3, n: Vec3) -> Vec3 {
+    2.0 * wo.dot(n) * n - wo
+}
+
 /// The mirror reflection of a ray with differentials at a hit, and its
 /// differentials: pbrt-v4's `SurfaceInteraction::SpawnRay` for perfect specular
 /// reflection (after Igehy 1999). With `wo = −d`, `n` the normal on `wo`'s side and
@@ -46,7 +53,7 @@ pub fn reflect_differential(
 ) -> (Vec3, RayDifferential) {
     let wo = -direction.normalize();
     let n = hit.facing_normal(direction);
-    let wi = 2.0 * wo.dot(n) * n - wo;
+    let wi = reflect(wo, n);
     let flip = if n.dot(hit.shading_normal) < 0.0 {
         -1.0
     } else {

@@ -29,7 +29,7 @@ mod shape_list;
 mod sphere;
 
 pub use aabox::AaBox;
-pub use differentials::{reflect_differential, RayDifferential, SurfaceDifferentials};
+pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceDifferentials};
 pub use hit::Hit;
 pub use offset::{offset_ray_origin, spawn_ray, spawn_ray_to, SHADOW_EPSILON};
 pub use parallelogram::Parallelogram;

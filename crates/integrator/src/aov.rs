@@ -5,7 +5,7 @@ use crate::direct::texture_footprint;
 use crate::{Scene, Surface};
 use glam::Vec3;
 use glint_camera::Film;
-use glint_geometry::{Ray, RayDifferential};
+use glint_geometry::{reflect, Ray, RayDifferential};
 use glint_lighting::Light;
 use glint_texture::srgb_to_linear;
 
@@ -130,9 +130,8 @@ fn reflection_depth(scene: &Scene, mut ray: Ray, max_depth: u32) -> u32 {
         if !reflective {
             break;
         }
-        let n = hit.facing_normal(ray.direction);
         let wo = -ray.direction.normalize();
-        ray = glint_geometry::spawn_ray(&hit, 2.0 * wo.dot(n) * n - wo);
+        ray = glint_geometry::spawn_ray(&hit, reflect(wo, hit.facing_normal(ray.direction)));
         depth += 1;
     }
     depth

@@ -7,8 +7,10 @@ use glam::Vec2;
 #[derive(Clone, Debug)]
 pub struct PiecewiseConstant1D {
     weights: Vec<f32>,
-    /// `cdf[i]` = the probability of bins `0..i`; `cdf[n] = 1`.
-    cdf: Vec<f32>,
+    /// `cdf[i]` = the probability of bins `0..i`; `cdf[n] = 1`. In f64, so that
+    /// bins a million times lighter than the total keep a non-zero width (and so
+    /// are sampled with the density `pdf` reports).
+    cdf: Vec<f64>,
     /// Integral of the weights over [0, 1] (their mean).
     integral: f32,
 }
@@ -28,7 +30,7 @@ impl PiecewiseConstant1D {
         cdf.push(0.0);
         for &w in &weights {
             running += if uniform { 1.0 } else { w.max(0.0) as f64 };
-            cdf.push((running / if uniform { n as f64 } else { total }) as f32);
+            cdf.push(running / if uniform { n as f64 } else { total });
         }
         cdf[n] = 1.0;
         if uniform {
@@ -62,6 +64,7 @@ impl PiecewiseConstant1D {
     /// `(x, pdf(x), bin)` for a uniform `u` ∈ [0, 1).
     #[inline]
     pub fn sample(&self, u: f32) -> (f32, f32, usize) {
+        let u = u as f64;
         // The last bin whose cdf is ≤ u, skipping empty bins.
         let bin = self
             .cdf
@@ -69,9 +72,15 @@ impl PiecewiseConstant1D {
             .saturating_sub(1)
             .min(self.len() - 1);
         let (lo, hi) = (self.cdf[bin], self.cdf[bin + 1]);
-        let within = if hi > lo { (u - lo) / (hi - lo) } else { 0.5 };
-        let x = ((bin as f32 + within.clamp(0.0, 1.0)) / self.len() as f32)
-            .min(1.0 - f32::EPSILON / 2.0);
+        let within = if hi > lo {
+            ((u - lo) / (hi - lo)).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        let n = self.len() as f32;
+        // Stay inside the bin: rounding must not carry x into the next one.
+        let x = (((bin as f64 + within) / self.len() as f64) as f32)
+            .clamp(bin as f32 / n, ((bin + 1) as f32 / n).next_down());
         (x, self.pdf_of_bin(bin), bin)
     }
 
@@ -99,6 +108,11 @@ pub struct PiecewiseConstant2D {
 impl PiecewiseConstant2D {
     /// `weights` row-major, `width` per row, the first row at v = 0.
     pub fn new(weights: &[f32], width: usize) -> Self {
+        let weights = if weights.is_empty() {
+            &[1.0][..]
+        } else {
+            weights
+        };
         let rows: Vec<PiecewiseConstant1D> = weights
             .chunks(width.max(1))
             .map(|row| PiecewiseConstant1D::new(row.to_vec()))

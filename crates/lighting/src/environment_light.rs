@@ -1,6 +1,9 @@
 use crate::distribution::PiecewiseConstant2D;
 use glam::{Vec2, Vec3};
-use glint_texture::{cube_direction, cube_face_st, latlong_direction, latlong_uv, Environment};
+use glint_texture::{
+    cube_direction, cube_face_st, latlong_direction, latlong_texel, latlong_uv, CubeMap,
+    Environment,
+};
 use std::f32::consts::{FRAC_1_PI, PI};
 
 /// A direction sampled towards the environment, with the radiance it brings and
@@ -23,7 +26,8 @@ pub struct EnvironmentSample {
 /// in solid angle is `p(u, v) / J` with `J = 2π² sin θ` for lat-long maps and
 /// `J = 4/(1 + s² + t²)^{3/2}` per face (times 6 faces) for cube maps. A constant
 /// environment is sampled with the cosine-weighted hemisphere about the shading
-/// normal, the exact optimum for it (`L·cos θ/π` then has zero variance).
+/// normal, the exact optimum for it (`L·cos θ/π` then has zero variance); so is a
+/// map whose texels are all equal.
 #[derive(Clone, Debug)]
 pub struct EnvironmentLight {
     environment: Environment,
@@ -92,8 +96,7 @@ impl EnvironmentLight {
             }
             (Environment::CubeMap(_), Some(dist)) => {
                 let (uv, p) = dist.sample(u);
-                let face = ((uv.x * 6.0) as usize).min(5);
-                let st = Vec2::new(uv.x * 6.0 - face as f32, uv.y);
+                let (face, st) = unpack_cube_uv(uv);
                 let d = cube_direction(face, st);
                 (d.normalize(), p / cube_jacobian(st))
             }
@@ -122,8 +125,7 @@ impl EnvironmentLight {
             }
             (Environment::CubeMap(_), Some(dist)) => {
                 let (face, st) = cube_face_st(self.to_map(d));
-                let uv = Vec2::new((face as f32 + st.x) / 6.0, st.y);
-                dist.pdf(uv) / cube_jacobian(st)
+                dist.pdf(pack_cube_uv(face, st)) / cube_jacobian(st)
             }
         }
     }
@@ -136,6 +138,17 @@ fn rotate_y(d: Vec3, angle: f32) -> Vec3 {
     }
     let (s, c) = angle.sin_cos();
     Vec3::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z)
+}
+
+/// The six faces side by side in [0, 1]²: face `f` covers `u ∈ [f/6, (f+1)/6)`.
+fn pack_cube_uv(face: usize, st: Vec2) -> Vec2 {
+    Vec2::new((face as f32 + st.x) / 6.0, st.y)
+}
+
+/// The inverse of [`pack_cube_uv`].
+fn unpack_cube_uv(uv: Vec2) -> (usize, Vec2) {
+    let face = ((uv.x * 6.0) as usize).min(5);
+    (face, Vec2::new(uv.x * 6.0 - face as f32, uv.y))
 }
 
 /// `dω / d(u, v)` on the cube's six faces laid side by side in [0, 1]²: each face is
@@ -171,14 +184,12 @@ fn luminance(c: Vec3) -> f32 {
 fn sampling_distribution(environment: &Environment) -> Option<PiecewiseConstant2D> {
     let (mut weights, width) = match environment {
         Environment::Constant(_) => return None,
+        Environment::LatLong(map) if is_uniform(map.image().texels()) => return None,
+        Environment::CubeMap(cube) if cube_is_uniform(cube) => return None,
         Environment::LatLong(map) => {
             let image = map.image();
             let (w, h) = (image.width() as i64, image.height() as i64);
-            let luminance_at = |x: i64, y: i64| {
-                let x = x.rem_euclid(w) as u32;
-                let y = y.clamp(0, h - 1) as u32;
-                luminance(image.texel(x, y))
-            };
+            let luminance_at = |x: i64, y: i64| luminance(latlong_texel(image, x, y));
             let weights = (0..h)
                 .flat_map(|y| (0..w).map(move |x| (x, y)))
                 .map(|(x, y)| {
@@ -195,7 +206,7 @@ fn sampling_distribution(environment: &Environment) -> Option<PiecewiseConstant2
                 for y in 0..n {
                     for x in 0..n {
                         let st = (Vec2::new(x as f32, y as f32) + 0.5) / n as f32;
-                        let solid_angle = 1.0 / cube_jacobian(st);
+                        let solid_angle = cube_jacobian(st);
                         let lum = neighbourhood_max(|dx, dy| {
                             luminance(cube.texel(face, 0, x as i64 + dx, y as i64 + dy))
                         });
@@ -215,6 +226,17 @@ fn sampling_distribution(environment: &Environment) -> Option<PiecewiseConstant2
             .for_each(|w| *w = w.min(f32::MAX / 2.0) + WEIGHT_FLOOR * mean);
     }
     Some(PiecewiseConstant2D::new(&weights, width))
+}
+
+/// Whether every texel has the same value: such a map is a constant environment
+/// and is sampled exactly like one.
+fn is_uniform(texels: &[Vec3]) -> bool {
+    texels.iter().all(|t| *t == texels[0])
+}
+
+fn cube_is_uniform(cube: &CubeMap) -> bool {
+    let first = cube.face(0).texel(0, 0);
+    (0..6).all(|f| is_uniform(cube.face(f).texels()) && cube.face(f).texel(0, 0) == first)
 }
 
 /// The largest of `lum(dx, dy)` over the 3 × 3 neighbourhood, negatives as 0.
@@ -320,6 +342,36 @@ mod tests {
                 bright > n / 4,
                 "only {bright} of {n} samples hit the hot spot"
             );
+        }
+    }
+
+    #[test]
+    fn cube_texels_are_weighted_by_their_solid_angle() {
+        // One luminance everywhere, but not uniform (a faint pattern, so that it is
+        // sampled by luminance): the density in solid angle must be close to the
+        // uniform 1/4π everywhere, corners included.
+        let faces = std::array::from_fn(|_| {
+            Image::from_fn(16, 16, |x, y| {
+                Vec3::splat(1.0 + 1e-3 * ((x + y) % 2) as f32)
+            })
+        });
+        let light =
+            EnvironmentLight::new(Environment::CubeMap(CubeMap::new(faces).unwrap()), 0.0, 1.0);
+        // At texel centres (the density is constant within a texel, so at a cube
+        // corner itself it is off by the Jacobian's change across half a texel).
+        let centre = |face: usize, i: f32, j: f32| {
+            glint_texture::cube_direction(face, Vec2::new((i + 0.5) / 16.0, (j + 0.5) / 16.0))
+                .normalize()
+        };
+        let directions = [
+            centre(0, 7.0, 8.0),
+            centre(2, 0.0, 0.0),
+            centre(5, 15.0, 3.0),
+            centre(3, 0.0, 15.0),
+        ];
+        for d in directions {
+            let p = 4.0 * PI * light.pdf(Vec3::Y, d);
+            assert!((0.99..1.01).contains(&p), "{d}: 4π·pdf = {p}");
         }
     }
 

@@ -411,6 +411,17 @@ fn environment(
             )?);
         }
         let faces: [Image; 6] = faces.try_into().expect("six faces");
+        let texels: u64 = faces
+            .iter()
+            .map(|f| f.width() as u64 * f.height() as u64)
+            .sum();
+        if texels > MAX_IMAGE_TEXELS {
+            return Err(Problem::new(
+                template.span(),
+                "environment.cube_map",
+                format!("the six faces have {texels} texels in all, more than the limit of {MAX_IMAGE_TEXELS}"),
+            ));
+        }
         Environment::CubeMap(
             CubeMap::new(faces)
                 .map_err(|m| Problem::new(template.span(), "environment.cube_map", m))?,

@@ -91,6 +91,9 @@ impl CubeMap {
     /// Faces in `px nx py ny pz nz` order; all must be square and of one size.
     pub fn new(faces: [Image; 6]) -> Result<Self, String> {
         let n = faces[0].width();
+        if n == 0 {
+            return Err("the cube map's faces have no texels".into());
+        }
         for (name, face) in ["px", "nx", "py", "ny", "pz", "nz"].iter().zip(&faces) {
             if face.width() != face.height() || face.width() != n {
                 return Err(format!(
@@ -129,10 +132,13 @@ impl CubeMap {
 
     /// Radiance towards `d`, filtered over a cone of angular width `width`
     /// (radians): trilinear between the levels whose texels subtend about that
-    /// angle (a level-0 texel at a face's centre subtends `2/N`).
+    /// angle. A level-0 texel at face coordinates (s, t) subtends about
+    /// `(2/N)/(1 + s² + t²)^{3/4}` (its solid angle is `(2/N)²/(1 + s² + t²)^{3/2}`),
+    /// so the level is `log2(width·N/2) + ¾·log2(1 + s² + t²)`.
     pub fn radiance(&self, d: Vec3, width: f32) -> Vec3 {
         let (face, st) = cube_face_st(d);
-        let level = (width * self.size() as f32 / 2.0).log2();
+        let (s, t) = (2.0 * st.x - 1.0, 2.0 * st.y - 1.0);
+        let level = (width * self.size() as f32 / 2.0).log2() + 0.75 * (1.0 + s * s + t * t).log2();
         let last = (self.level_count() - 1) as f32;
         let level = if level > 0.0 { level.min(last) } else { 0.0 };
         let lower = level as usize;
@@ -149,30 +155,21 @@ impl CubeMap {
     /// result is continuous across edges and corners (no seams).
     pub fn bilinear(&self, face: CubeFace, level: usize, st: Vec2) -> Vec3 {
         let image = self.level(face, level);
-        let n = image.width() as f32;
-        let p = st * n - 0.5;
-        let p0 = p.floor();
-        let f = p - p0;
-        let (x, y) = (p0.x as i64, p0.y as i64);
         let n = image.width() as i64;
-        let outside = |i: i64| !(0..n).contains(&i);
-        let mut t = [[Vec3::ZERO; 2]; 2];
-        for (dy, row) in t.iter_mut().enumerate() {
-            for (dx, texel) in row.iter_mut().enumerate() {
-                *texel = self.texel(face, level, x + dx as i64, y + dy as i64);
+        let inside = |i: i64| (0..n).contains(&i);
+        image.bilinear_with(st, |x, y| {
+            if inside(x) || inside(y) {
+                return self.texel(face, level, x, y);
             }
-        }
-        // Past a corner only three faces meet: the texel diagonally beyond it does
-        // not exist, so it is taken as the mean of the other three, which makes all
-        // three faces agree at the corner.
-        for (dx, dy) in [(0usize, 0usize), (1, 0), (0, 1), (1, 1)] {
-            if outside(x + dx as i64) && outside(y + dy as i64) {
-                t[dy][dx] = (t[dy][1 - dx] + t[1 - dy][dx] + t[1 - dy][1 - dx]) / 3.0;
-            }
-        }
-        let top = t[0][0] + (t[0][1] - t[0][0]) * f.x;
-        let bottom = t[1][0] + (t[1][1] - t[1][0]) * f.x;
-        top + (bottom - top) * f.y
+            // Diagonally past a corner, where only three faces meet, there is no
+            // texel: take the mean of the other three of the 2 × 2 footprint, which
+            // makes all three faces agree at the corner.
+            let (xi, yi) = (x.clamp(0, n - 1), y.clamp(0, n - 1));
+            (self.texel(face, level, xi, y)
+                + self.texel(face, level, x, yi)
+                + self.texel(face, level, xi, yi))
+                / 3.0
+        })
     }
 
     /// Texel `(i, j)` of `face` at `level`, following the cube past the face's edges.
@@ -207,12 +204,17 @@ impl LatLongMap {
         self.image.image()
     }
 
-    /// Radiance towards `d`, filtered over a cone of angular width `width`: a
-    /// level-0 texel spans `2π/W` in longitude, so the level is `log2(width·W/2π)`.
+    /// Radiance towards `d`, filtered over a cone of angular width `width`: the
+    /// level whose texels span `width` along the meridian (`π/H` at level 0), so
+    /// `log2(width·H/π)`. Towards the poles a texel narrows across (`2π·sin θ/W`)
+    /// while keeping its height; an isotropic pyramid cannot follow that, and
+    /// choosing the level by the narrow side would blur away several levels of
+    /// detail along the meridian, so there the filter is finer than the footprint
+    /// across longitude.
     pub fn radiance(&self, d: Vec3, width: f32) -> Vec3 {
         let uv = latlong_uv(d);
-        let w = self.image.image().width() as f32;
-        let level = (width * w / TAU).log2();
+        let image = self.image.image();
+        let level = (width * image.height() as f32 / PI).log2();
         if level.is_nan() || level <= 0.0 {
             return latlong_bilinear(self.image.image(), uv);
         }
@@ -229,21 +231,25 @@ impl LatLongMap {
     }
 }
 
-/// Bilinear on a lat-long image: longitude wraps around, latitude stops at the poles.
+/// Bilinear on a lat-long image: longitude wraps around, and past a pole the
+/// filter continues on the other side of it (half a turn away), so the value at
+/// the pole does not depend on the longitude it is approached from.
 fn latlong_bilinear(image: &Image, uv: Vec2) -> Vec3 {
-    let size = image.size();
-    let p = uv * size - 0.5;
-    let p0 = p.floor();
-    let f = p - p0;
-    let (w, h) = (image.width(), image.height());
-    let texel = |dx: i64, dy: i64| {
-        let x = WrapMode::Repeat.wrap(p0.x as i64 + dx, w);
-        let y = WrapMode::Clamp.wrap(p0.y as i64 + dy, h);
-        image.texel(x, y)
+    image.bilinear_with(uv, |x, y| latlong_texel(image, x, y))
+}
+
+/// Texel `(x, y)` of a lat-long image, for any integer coordinates: longitude
+/// wraps, and a row past a pole is the mirrored row half a turn away.
+pub fn latlong_texel(image: &Image, x: i64, y: i64) -> Vec3 {
+    let (w, h) = (image.width() as i64, image.height() as i64);
+    let (x, y) = if y < 0 {
+        (x + w / 2, -1 - y)
+    } else if y >= h {
+        (x + w / 2, 2 * h - 1 - y)
+    } else {
+        (x, y)
     };
-    let top = texel(0, 0) + (texel(1, 0) - texel(0, 0)) * f.x;
-    let bottom = texel(0, 1) + (texel(1, 1) - texel(0, 1)) * f.x;
-    top + (bottom - top) * f.y
+    image.texel(x.rem_euclid(w) as u32, y.clamp(0, h - 1) as u32)
 }
 
 /// Radiance arriving from every direction: a constant, a cube map or a lat-long map.
@@ -379,12 +385,35 @@ mod tests {
                 let on_edge = cube_direction(face, st).normalize();
                 let inside = cube_direction(face, st * 0.9999 + 0.00005).normalize();
                 let outside = cube_direction(face, (st - 0.5) * 1.0001 + 0.5).normalize();
-                let (a, b) = (cube.radiance(inside, 0.0), cube.radiance(outside, 0.0));
-                assert!(
-                    (a - b).abs().max_element() < 2e-3,
-                    "face {face} {st}: {a} vs {b}"
-                );
-                assert!(cube.radiance(on_edge, 0.0).is_finite());
+                for width in [0.0, 0.1, 0.5] {
+                    let (a, b) = (cube.radiance(inside, width), cube.radiance(outside, width));
+                    let gap = (a - b).abs().max_element();
+                    assert!(gap < 2e-3, "face {face} {st} width {width}: {a} vs {b}");
+                    assert!(cube.radiance(on_edge, width).is_finite());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn latlong_filtering_is_continuous_over_the_poles() {
+        // A function continuous on the sphere: 3 + d.x + 2·d.z, which is 3 at both
+        // poles. Its top row still varies with longitude (the row's centre is
+        // π/2H from the pole); bilinear filtering that reads across the pole
+        // averages opposite longitudes and so gives 3 there from every side,
+        // where clamping at the top row would leave about ±0.2.
+        let (w, h) = (32, 16);
+        let map = LatLongMap::new(Image::from_fn(w, h, |x, y| {
+            let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+            let d = latlong_direction(uv);
+            Vec3::splat(3.0 + d.x + 2.0 * d.z)
+        }));
+        for pole in [1.0f32, -1.0] {
+            for i in 0..16 {
+                let phi = i as f32 * 0.4;
+                let d = Vec3::new(1e-5 * phi.cos(), pole, 1e-5 * phi.sin()).normalize();
+                let v = map.radiance(d, 0.0).x;
+                assert!((v - 3.0).abs() < 0.02, "pole {pole}, longitude {phi}: {v}");
             }
         }
     }

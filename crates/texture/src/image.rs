@@ -79,13 +79,20 @@ impl Image {
     /// [`lerp`]s so that equal texels give exactly that texel back.
     #[inline]
     pub fn bilinear(&self, st: Vec2, wrap: WrapMode) -> Vec3 {
-        let p = reduce_st(st, wrap) * self.size() - 0.5;
+        self.bilinear_with(reduce_st(st, wrap), |x, y| self.texel_wrapped(x, y, wrap))
+    }
+
+    /// Bilinear interpolation at `st` with texels read by `fetch(x, y)`, which
+    /// decides what lies past the image's edges (a wrap mode, the next cube face,
+    /// the other side of a pole).
+    #[inline]
+    pub fn bilinear_with(&self, st: Vec2, fetch: impl Fn(i64, i64) -> Vec3) -> Vec3 {
+        let p = st * self.size() - 0.5;
         let p0 = p.floor();
         let f = p - p0;
         let (x, y) = (p0.x as i64, p0.y as i64);
-        let texel = |dx, dy| self.texel_wrapped(x + dx, y + dy, wrap);
-        let top = lerp(texel(0, 0), texel(1, 0), f.x);
-        let bottom = lerp(texel(0, 1), texel(1, 1), f.x);
+        let top = lerp(fetch(x, y), fetch(x + 1, y), f.x);
+        let bottom = lerp(fetch(x, y + 1), fetch(x + 1, y + 1), f.x);
         lerp(top, bottom, f.y)
     }
 

@@ -122,6 +122,7 @@ impl AaBox {
             dndv: Vec3::ZERO,
             front_face: normal.dot(ray.direction) < 0.0,
             shape: 0,
+            primitive: 0,
         }
     }
 }

@@ -22,8 +22,10 @@ pub struct Hit {
     pub dndv: Vec3,
     /// Whether the ray arrived on the side the geometric normal points to.
     pub front_face: bool,
-    /// Index of the shape in the collection that was queried.
+    /// Index of the object (shape or mesh) in the collection that was queried.
     pub shape: u32,
+    /// Index of the triangle within a mesh; 0 for analytic shapes.
+    pub primitive: u32,
 }
 
 impl Hit {

@@ -18,8 +18,10 @@
 //!   epsilon: the offset scales with the magnitude of the hit point.
 
 mod aabox;
+pub mod bvh;
 mod differentials;
 mod hit;
+mod mesh;
 mod offset;
 mod parallelogram;
 mod plane;
@@ -27,14 +29,16 @@ mod ray;
 mod shape;
 mod shape_list;
 mod sphere;
+pub mod triangle;
 
 pub use aabox::AaBox;
 pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceDifferentials};
 pub use hit::Hit;
+pub use mesh::{MeshError, TriangleMesh};
 pub use offset::{offset_ray_origin, spawn_ray, spawn_ray_to, SHADOW_EPSILON};
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use ray::Ray;
 pub use shape::Shape;
-pub use shape_list::ShapeList;
+pub use shape_list::{ObjectRef, ShapeList};
 pub use sphere::Sphere;

@@ -103,6 +103,7 @@ impl Parallelogram {
             dndv: Vec3::ZERO,
             front_face: self.normal.dot(ray.direction) < 0.0,
             shape: 0,
+            primitive: 0,
         }
     }
 }

@@ -73,6 +73,7 @@ impl Plane {
             dndv: Vec3::ZERO,
             front_face: self.normal.dot(ray.direction) < 0.0,
             shape: 0,
+            primitive: 0,
         }
     }
 }

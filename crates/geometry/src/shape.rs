@@ -1,3 +1,4 @@
+use crate::bvh::Bounds3;
 use crate::{AaBox, Hit, Parallelogram, Plane, Ray, Sphere};
 
 /// Every kind of shape, as one enum so intersection dispatch is a `match`,
@@ -29,6 +30,23 @@ impl Shape {
             Shape::Parallelogram(p) => p.surface_at(ray, t),
             Shape::Plane(p) => p.surface_at(ray, t),
             Shape::Box(b) => b.surface_at(ray, t),
+        }
+    }
+
+    /// Bounds of the shape, or `None` for the unbounded plane.
+    pub fn bounds(&self) -> Option<Bounds3> {
+        match self {
+            Shape::Sphere(s) => Some(Bounds3::new(
+                s.center() - s.radius(),
+                s.center() + s.radius(),
+            )),
+            Shape::Parallelogram(p) => {
+                let (e1, e2) = p.edges();
+                let o = p.origin();
+                Some(Bounds3::new(o, o + e1).include(o + e2).include(o + e1 + e2))
+            }
+            Shape::Plane(_) => None,
+            Shape::Box(b) => Some(Bounds3::new(b.min(), b.max())),
         }
     }
 

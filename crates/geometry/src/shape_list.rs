@@ -1,13 +1,52 @@
-use crate::{Hit, Ray, Shape};
+use crate::bvh::{Bounds3, Bvh, BvhStats};
+use crate::triangle::WatertightRay;
+use crate::{Hit, Ray, Shape, TriangleMesh};
 
-/// Shapes in one flat array, queried by testing each in turn.
+/// What an object index names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Object {
+    Shape(u32),
+    Mesh(u32),
+}
+
+/// One object of a [`ShapeList`].
+#[derive(Clone, Copy, Debug)]
+pub enum ObjectRef<'a> {
+    Shape(&'a Shape),
+    Mesh(&'a TriangleMesh),
+}
+
+/// A primitive the BVH holds: an analytic shape, or one triangle of a mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Primitive {
+    object: u32,
+    triangle: u32,
+}
+
+/// Every object of a scene — analytic shapes and triangle meshes — and the two
+/// queries the integrator asks of them: [`ShapeList::closest_hit`] and
+/// [`ShapeList::any_hit`].
 ///
-/// This is the query interface the integrator uses: [`ShapeList::closest_hit`]
-/// and [`ShapeList::any_hit`]. An acceleration structure can later answer the same
-/// two queries without the integrator changing.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// Objects are numbered in the order they are added (shapes and meshes share one
+/// numbering); a hit reports its object in [`Hit::shape`] and, for meshes, the
+/// triangle in [`Hit::primitive`]. After [`ShapeList::build_bvh`], bounded
+/// primitives (each shape, each triangle) are found through a BVH and only
+/// unbounded planes are tested one by one; before it, every object is tested in
+/// turn (the course's linear loop), with the same answers.
+#[derive(Clone, Debug, Default)]
 pub struct ShapeList {
     shapes: Vec<Shape>,
+    meshes: Vec<TriangleMesh>,
+    objects: Vec<Object>,
+    bvh: Option<Bvh>,
+    primitives: Vec<Primitive>,
+    unbounded: Vec<u32>,
+}
+
+impl PartialEq for ShapeList {
+    fn eq(&self, other: &Self) -> bool {
+        self.shapes == other.shapes && self.meshes == other.meshes && self.objects == other.objects
+    }
 }
 
 impl ShapeList {
@@ -15,53 +54,218 @@ impl ShapeList {
         Self::default()
     }
 
-    /// Adds a shape and returns its index, which hits report in [`Hit::shape`].
+    /// Adds a shape and returns its object index. Invalidates the BVH.
     pub fn push(&mut self, shape: impl Into<Shape>) -> u32 {
         self.shapes.push(shape.into());
-        (self.shapes.len() - 1) as u32
+        self.add(Object::Shape(self.shapes.len() as u32 - 1))
     }
 
+    /// Adds a triangle mesh and returns its object index. Invalidates the BVH.
+    pub fn push_mesh(&mut self, mesh: TriangleMesh) -> u32 {
+        self.meshes.push(mesh);
+        self.add(Object::Mesh(self.meshes.len() as u32 - 1))
+    }
+
+    fn add(&mut self, object: Object) -> u32 {
+        self.bvh = None;
+        self.objects.push(object);
+        self.objects.len() as u32 - 1
+    }
+
+    /// Object `i`: a shape or a mesh.
+    pub fn object(&self, i: u32) -> ObjectRef<'_> {
+        match self.objects[i as usize] {
+            Object::Shape(s) => ObjectRef::Shape(&self.shapes[s as usize]),
+            Object::Mesh(m) => ObjectRef::Mesh(&self.meshes[m as usize]),
+        }
+    }
+
+    /// The analytic shapes, in the order they were added.
     pub fn shapes(&self) -> &[Shape] {
         &self.shapes
     }
 
+    pub fn meshes(&self) -> &[TriangleMesh] {
+        &self.meshes
+    }
+
+    /// Number of objects (shapes and meshes).
     pub fn len(&self) -> usize {
-        self.shapes.len()
+        self.objects.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.shapes.is_empty()
+        self.objects.is_empty()
     }
 
-    /// The nearest hit with `0 < t < t_max`, if any.
-    pub fn closest_hit(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let mut closest = t_max;
-        let mut winner = None;
-        for (i, shape) in self.shapes.iter().enumerate() {
-            if let Some(t) = shape.hit_distance(ray, closest) {
-                closest = t;
-                winner = Some(i);
+    /// Builds the BVH over every bounded primitive (binned SAH; see [`Bvh`]).
+    pub fn build_bvh(&mut self) {
+        let mut primitives = Vec::new();
+        let mut bounds = Vec::new();
+        self.unbounded.clear();
+        for (object, kind) in self.objects.iter().enumerate() {
+            let object = object as u32;
+            match *kind {
+                Object::Shape(s) => match self.shapes[s as usize].bounds() {
+                    Some(b) => {
+                        primitives.push(Primitive {
+                            object,
+                            triangle: 0,
+                        });
+                        bounds.push(b);
+                    }
+                    None => self.unbounded.push(object),
+                },
+                Object::Mesh(m) => {
+                    let mesh = &self.meshes[m as usize];
+                    for triangle in 0..mesh.triangle_count() as u32 {
+                        let (lo, hi) = mesh.triangle_bounds(triangle);
+                        primitives.push(Primitive { object, triangle });
+                        bounds.push(Bounds3::new(lo, hi));
+                    }
+                }
             }
         }
-        winner.map(|i| Hit {
-            shape: i as u32,
-            ..self.shapes[i].surface_at(ray, closest)
+        self.bvh = Some(Bvh::build(&bounds));
+        self.primitives = primitives;
+    }
+
+    /// Statistics of the BVH, once built.
+    pub fn bvh_stats(&self) -> Option<BvhStats> {
+        self.bvh.as_ref().map(Bvh::stats)
+    }
+
+    /// The nearest hit with `0 < t < t_max`, if any. Hits at exactly the same
+    /// distance (a ray through an edge where two surfaces meet) go to the lowest
+    /// object index, then the lowest triangle: the same answer with or without the
+    /// BVH, whatever its layout.
+    pub fn closest_hit(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let watertight = WatertightRay::new(ray);
+        let mut best: Option<(f32, Primitive)> = None;
+        // A candidate at distance t (found below the current best's t, or equal to
+        // it) becomes the best if nearer, or as near with a lower (object, triangle).
+        let consider = |p: Primitive, t: f32, best: &mut Option<(f32, Primitive)>| {
+            let better = match *best {
+                None => true,
+                Some((bt, bp)) => {
+                    t < bt || (t == bt && (p.object, p.triangle) < (bp.object, bp.triangle))
+                }
+            };
+            if better {
+                *best = Some((t, p));
+            }
+            better
+        };
+        let limit = |best: &Option<(f32, Primitive)>| best.map_or(t_max, |(t, _)| t.next_up());
+        match &self.bvh {
+            Some(_) => {
+                for &object in &self.unbounded {
+                    let p = Primitive {
+                        object,
+                        triangle: 0,
+                    };
+                    if let Some(t) = self.primitive_distance(p, ray, &watertight, limit(&best)) {
+                        consider(p, t, &mut best);
+                    }
+                }
+            }
+            None => {
+                for p in self.all_primitives() {
+                    if let Some(t) = self.primitive_distance(p, ray, &watertight, limit(&best)) {
+                        consider(p, t, &mut best);
+                    }
+                }
+            }
+        }
+        if let Some(bvh) = &self.bvh {
+            // The BVH prunes with the distance it is given; the closure keeps the
+            // tie rule and reports only primitives that became the best.
+            let start = limit(&best);
+            bvh.closest_hit(ray, start, |i, ray, _| {
+                let p = self.primitives[i as usize];
+                let t = self.primitive_distance(p, ray, &watertight, limit(&best))?;
+                consider(p, t, &mut best).then_some(t)
+            });
+        }
+        let (t, p) = best?;
+        let hit = match self.objects[p.object as usize] {
+            Object::Shape(s) => Some(self.shapes[s as usize].surface_at(ray, t)),
+            // Re-run the (same, deterministic) test for the barycentrics. Without an
+            // upper limit: the test compares T < t_max·det before dividing, and
+            // t = T/det rounded can make t_max·det fall just below T, turning a
+            // found hit into a miss.
+            Object::Mesh(m) => self.meshes[m as usize].surface_at(p.triangle, ray, f32::INFINITY),
+        }?;
+        Some(Hit {
+            shape: p.object,
+            primitive: p.triangle,
+            ..hit
         })
     }
 
     /// Whether anything lies on the ray with `0 < t < t_max` (shadow query).
     pub fn any_hit(&self, ray: &Ray, t_max: f32) -> bool {
-        self.shapes
+        let watertight = WatertightRay::new(ray);
+        match &self.bvh {
+            Some(bvh) => {
+                self.unbounded.iter().any(|&object| {
+                    let p = Primitive {
+                        object,
+                        triangle: 0,
+                    };
+                    self.primitive_distance(p, ray, &watertight, t_max)
+                        .is_some()
+                }) || bvh.any_hit(ray, t_max, |i, ray, t_max| {
+                    self.primitive_distance(self.primitives[i as usize], ray, &watertight, t_max)
+                        .is_some()
+                })
+            }
+            None => self.all_primitives().any(|p| {
+                self.primitive_distance(p, ray, &watertight, t_max)
+                    .is_some()
+            }),
+        }
+    }
+
+    /// Every primitive, object by object (the linear loop's order).
+    fn all_primitives(&self) -> impl Iterator<Item = Primitive> + '_ {
+        self.objects
             .iter()
-            .any(|s| s.hit_distance(ray, t_max).is_some())
+            .enumerate()
+            .flat_map(move |(object, kind)| {
+                let triangles = match *kind {
+                    Object::Shape(_) => 1,
+                    Object::Mesh(m) => self.meshes[m as usize].triangle_count() as u32,
+                };
+                (0..triangles).map(move |triangle| Primitive {
+                    object: object as u32,
+                    triangle,
+                })
+            })
+    }
+
+    #[inline]
+    fn primitive_distance(
+        &self,
+        p: Primitive,
+        ray: &Ray,
+        watertight: &WatertightRay,
+        t_max: f32,
+    ) -> Option<f32> {
+        match self.objects[p.object as usize] {
+            Object::Shape(s) => self.shapes[s as usize].hit_distance(ray, t_max),
+            Object::Mesh(m) => self.meshes[m as usize].hit_distance(p.triangle, watertight, t_max),
+        }
     }
 }
 
 impl FromIterator<Shape> for ShapeList {
     fn from_iter<I: IntoIterator<Item = Shape>>(iter: I) -> Self {
-        Self {
-            shapes: iter.into_iter().collect(),
+        let mut list = Self::new();
+        for shape in iter {
+            list.push(shape);
         }
+        list
     }
 }
 
@@ -81,19 +285,212 @@ mod tests {
 
     #[test]
     fn closest_hit_picks_the_nearest_shape_whatever_the_order() {
-        let ray = Ray::new(Vec3::ZERO, -Vec3::Z);
-        let hit = scene().closest_hit(&ray, f32::INFINITY).unwrap();
-        assert_eq!(hit.shape, 1);
-        assert!((hit.t - 4.0).abs() < 1e-6);
-        let reversed: ShapeList = scene().shapes().iter().rev().copied().collect();
-        assert_eq!(reversed.closest_hit(&ray, f32::INFINITY).unwrap().shape, 1);
+        for with_bvh in [false, true] {
+            let ray = Ray::new(Vec3::ZERO, -Vec3::Z);
+            let mut list = scene();
+            if with_bvh {
+                list.build_bvh();
+            }
+            let hit = list.closest_hit(&ray, f32::INFINITY).unwrap();
+            assert_eq!(hit.shape, 1);
+            assert!((hit.t - 4.0).abs() < 1e-6);
+            let mut reversed: ShapeList = scene().shapes().iter().rev().copied().collect();
+            if with_bvh {
+                reversed.build_bvh();
+            }
+            assert_eq!(reversed.closest_hit(&ray, f32::INFINITY).unwrap().shape, 1);
+            // The plane, outside the BVH, is still found.
+            let sideways = Ray::new(Vec3::new(5.0, 0.0, 0.0), -Vec3::Z);
+            assert_eq!(list.closest_hit(&sideways, f32::INFINITY).unwrap().shape, 2);
+        }
     }
 
     #[test]
     fn any_hit_respects_t_max() {
-        let ray = Ray::new(Vec3::ZERO, -Vec3::Z);
-        assert!(scene().any_hit(&ray, 4.5));
-        assert!(!scene().any_hit(&ray, 3.5));
-        assert!(!scene().any_hit(&Ray::new(Vec3::ZERO, Vec3::Z), f32::INFINITY));
+        for with_bvh in [false, true] {
+            let mut list = scene();
+            if with_bvh {
+                list.build_bvh();
+            }
+            let ray = Ray::new(Vec3::ZERO, -Vec3::Z);
+            assert!(list.any_hit(&ray, 4.5));
+            assert!(!list.any_hit(&ray, 3.5));
+            assert!(!list.any_hit(&Ray::new(Vec3::ZERO, Vec3::Z), f32::INFINITY));
+        }
+    }
+}
+
+#[cfg(test)]
+mod bvh_agreement {
+    use super::*;
+    use crate::{AaBox, Parallelogram, Sphere, TriangleMesh};
+    use glam::{Vec2, Vec3};
+
+    /// xorshift64*: a tiny deterministic generator for test scenes.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f32 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            ((self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32) / (1u64 << 24) as f32
+        }
+        fn in_cube(&mut self, r: f32) -> Vec3 {
+            Vec3::new(self.next(), self.next(), self.next()) * 2.0 * r - r
+        }
+    }
+
+    /// A UV sphere of `n × 2n` quads (two triangles each).
+    fn tessellated_sphere(centre: Vec3, radius: f32, n: u32) -> TriangleMesh {
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..=2 * n {
+                let (theta, phi) = (
+                    j as f32 / n as f32 * std::f32::consts::PI,
+                    i as f32 / n as f32 * std::f32::consts::PI,
+                );
+                positions.push(
+                    centre
+                        + radius
+                            * Vec3::new(
+                                theta.sin() * phi.cos(),
+                                theta.cos(),
+                                theta.sin() * phi.sin(),
+                            ),
+                );
+            }
+        }
+        let row = 2 * n + 1;
+        let mut indices = Vec::new();
+        for j in 0..n {
+            for i in 0..2 * n {
+                let (a, b, c, d) = (
+                    j * row + i,
+                    j * row + i + 1,
+                    (j + 1) * row + i,
+                    (j + 1) * row + i + 1,
+                );
+                indices.push([a, c, b]);
+                indices.push([b, c, d]);
+            }
+        }
+        TriangleMesh::new(positions, indices, vec![], vec![]).unwrap()
+    }
+
+    fn random_scene(rng: &mut Rng) -> ShapeList {
+        let mut list = ShapeList::new();
+        for _ in 0..20 {
+            let c = rng.in_cube(5.0);
+            match (rng.next() * 4.0) as u32 {
+                0 => {
+                    list.push(Sphere::new(c, 0.2 + rng.next()).unwrap());
+                }
+                1 => {
+                    list.push(
+                        AaBox::new(c, c + Vec3::splat(0.3) + rng.in_cube(0.5).abs()).unwrap(),
+                    );
+                }
+                2 => {
+                    if let Some(p) = Parallelogram::new(c, rng.in_cube(1.0), rng.in_cube(1.0), true)
+                    {
+                        list.push(p);
+                    }
+                }
+                _ => {
+                    list.push_mesh(tessellated_sphere(c, 0.3 + rng.next(), 6));
+                }
+            }
+        }
+        // A few degenerate triangles: zero area, collinear, repeated vertices.
+        let p = rng.in_cube(3.0);
+        list.push_mesh(
+            TriangleMesh::new(
+                vec![p, p, p + Vec3::X, p + 2.0 * Vec3::X],
+                vec![[0, 1, 2], [0, 2, 3], [1, 1, 1]],
+                vec![],
+                vec![Vec2::ZERO; 4],
+            )
+            .unwrap(),
+        );
+        list
+    }
+
+    #[test]
+    fn bvh_and_brute_force_agree_on_random_rays_over_random_scenes() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        for _ in 0..20 {
+            let linear = random_scene(&mut rng);
+            let mut accelerated = linear.clone();
+            accelerated.build_bvh();
+            for _ in 0..500 {
+                let origin = rng.in_cube(8.0);
+                let toward = rng.in_cube(5.0);
+                let ray = Ray::new(origin, toward - origin);
+                let (a, b) = (
+                    linear.closest_hit(&ray, f32::INFINITY),
+                    accelerated.closest_hit(&ray, f32::INFINITY),
+                );
+                match (a, b) {
+                    (None, None) => {}
+                    (Some(a), Some(b)) => {
+                        assert!(
+                            (a.t - b.t).abs() <= 1e-5 * a.t.max(1.0),
+                            "t {} vs {}",
+                            a.t,
+                            b.t
+                        );
+                        assert!(a.point.is_finite() && a.geometric_normal.is_finite());
+                        if (a.shape, a.primitive) != (b.shape, b.primitive) {
+                            // Only a tie (two primitives at the same distance) may differ.
+                            assert!((a.t - b.t).abs() <= 1e-6 * a.t.max(1.0));
+                        }
+                    }
+                    (a, b) => panic!("linear {:?} vs bvh {:?}", a.map(|h| h.t), b.map(|h| h.t)),
+                }
+                let t_max = 0.5 + rng.next() * 20.0;
+                assert_eq!(
+                    linear.any_hit(&ray, t_max),
+                    accelerated.any_hit(&ray, t_max)
+                );
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod found_hits_stay_found {
+    use super::*;
+    use crate::TriangleMesh;
+    use glam::Vec3;
+
+    #[test]
+    fn every_triangle_hit_found_yields_a_surface_record() {
+        // Many rays at a fine fan of triangles: whenever a distance is found, the
+        // surface record must exist too (rounding once turned such hits into misses).
+        let mut positions = vec![Vec3::new(0.0, 0.0, -3.0)];
+        for i in 0..64 {
+            let a = i as f32 / 64.0 * std::f32::consts::TAU;
+            positions.push(Vec3::new(a.cos(), a.sin(), -3.0));
+        }
+        let indices = (0..64u32).map(|i| [0, 1 + i, 1 + (i + 1) % 64]).collect();
+        let mut list = ShapeList::new();
+        list.push_mesh(TriangleMesh::new(positions, indices, vec![], vec![]).unwrap());
+        list.build_bvh();
+        let mut found = 0;
+        for j in 0..300 {
+            for i in 0..300 {
+                let d = Vec3::new(i as f32 / 300.0 - 0.5, j as f32 / 300.0 - 0.5, -1.0);
+                let ray = Ray::new(Vec3::new(0.013, -0.007, 0.0), d);
+                let hit = list.closest_hit(&ray, f32::INFINITY);
+                // The fan lies in z = −3 and covers the disk of radius cos(π/64).
+                let p = ray.at(3.0);
+                let inside = p.x * p.x + p.y * p.y < 0.99;
+                if inside {
+                    assert!(hit.is_some(), "ray {d} slipped through");
+                    found += 1;
+                }
+            }
+        }
+        assert!(found > 10_000);
     }
 }

@@ -91,6 +91,7 @@ impl Sphere {
             dndv: dpdv / r,
             front_face: n.dot(ray.direction) < 0.0,
             shape: 0,
+            primitive: 0,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! studying a stage (texture coordinates, MIP level, normals, depth, albedo).
 
 use crate::direct::texture_footprint;
-use crate::{Scene, Surface};
+use crate::{Scene, SurfaceKind};
 use glam::Vec3;
 use glint_camera::Film;
 use glint_geometry::{reflect, Ray, RayDifferential};
@@ -62,9 +62,10 @@ impl Aov {
         let Some(hit) = scene.shapes.closest_hit(ray, f32::INFINITY) else {
             return Vec3::ZERO;
         };
-        let material = match scene.surfaces[hit.shape as usize] {
-            Surface::Material(m) => Some(&scene.materials[m as usize]),
-            Surface::Emitter(_) => None,
+        let surface = scene.surface_of(&hit);
+        let material = match surface {
+            SurfaceKind::Material(m) => Some(m),
+            SurfaceKind::Emitter(_) => None,
         };
 
         match self {
@@ -75,15 +76,10 @@ impl Aov {
                 m.diffuse_mip_level(&texture_footprint(m, &hit, diff))
             })),
             Aov::ReflectionDepth => Vec3::splat(reflection_depth(scene, *ray, max_depth) as f32),
-            Aov::Albedo => match scene.surfaces[hit.shape as usize] {
-                Surface::Material(m) => {
-                    let m = &scene.materials[m as usize];
-                    m.reflectances(&texture_footprint(m, &hit, diff)).0
-                }
-                Surface::Emitter(l) => match &scene.lights[l as usize] {
-                    Light::Area(a) => a.color,
-                    Light::Point(p) => p.color,
-                },
+            Aov::Albedo => match surface {
+                SurfaceKind::Material(m) => m.reflectances(&texture_footprint(m, &hit, diff)).0,
+                SurfaceKind::Emitter(Light::Area(a)) => a.color,
+                SurfaceKind::Emitter(Light::Point(p)) => p.color,
             },
         }
     }
@@ -123,9 +119,9 @@ fn reflection_depth(scene: &Scene, mut ray: Ray, max_depth: u32) -> u32 {
         let Some(hit) = scene.shapes.closest_hit(&ray, f32::INFINITY) else {
             break;
         };
-        let reflective = match scene.surfaces[hit.shape as usize] {
-            Surface::Material(m) => scene.materials[m as usize].reflectivity > 0.0,
-            Surface::Emitter(_) => false,
+        let reflective = match scene.surface_of(&hit) {
+            SurfaceKind::Material(m) => m.reflectivity > 0.0,
+            SurfaceKind::Emitter(_) => false,
         };
         if !reflective {
             break;

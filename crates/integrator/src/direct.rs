@@ -1,5 +1,5 @@
 use crate::sampling::SamplePattern;
-use crate::{Scene, Surface};
+use crate::{Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::{reflect_differential, spawn_ray, spawn_ray_to, Hit, Ray, RayDifferential};
 use glint_lighting::{AreaLight, Light, PhongMaterial};
@@ -65,14 +65,10 @@ impl DirectIntegrator {
                 None => Vec3::ZERO,
             };
         };
-        let material = match scene.surfaces[hit.shape as usize] {
-            Surface::Emitter(light) => {
-                return match &scene.lights[light as usize] {
-                    Light::Area(area) => area.color,
-                    Light::Point(_) => Vec3::ZERO,
-                }
-            }
-            Surface::Material(m) => &scene.materials[m as usize],
+        let material = match scene.surface_of(&hit) {
+            SurfaceKind::Emitter(Light::Area(area)) => return area.color,
+            SurfaceKind::Emitter(_) => return Vec3::ZERO,
+            SurfaceKind::Material(m) => m,
         };
         let r = material.reflectivity;
         let local = if material.has_local_shading() {
@@ -103,12 +99,19 @@ impl DirectIntegrator {
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let (kd, ks) = material.reflectances(tc);
+        let n = hit.facing_normal(ray.direction);
+        let ng = if hit.geometric_normal.dot(n) < 0.0 {
+            -hit.geometric_normal
+        } else {
+            hit.geometric_normal
+        };
         let point = ShadingPoint {
             hit,
             material,
             kd,
             ks,
-            n: hit.facing_normal(ray.direction),
+            n,
+            ng,
             v: -ray.direction.normalize(),
         };
         let mut radiance = scene.ambient * kd;
@@ -165,6 +168,9 @@ impl DirectIntegrator {
             if s.pdf.is_nan() || s.pdf <= 0.0 || s.radiance == Vec3::ZERO {
                 continue;
             }
+            if !point.above_surface(s.direction) {
+                continue;
+            }
             let f = point
                 .material
                 .brdf_cos(point.kd, point.ks, point.n, s.direction, point.v);
@@ -202,15 +208,29 @@ pub(crate) fn texture_footprint(
     }
 }
 
-/// A surface point being shaded: the hit, its material and reflectances, and the
-/// unit normal `n` (on the viewer's side) and direction `v` towards the viewer.
+/// A surface point being shaded: the hit, its material and reflectances, the
+/// unit shading normal `n` (on the viewer's side), the geometric normal `ng` on the
+/// same side, and the direction `v` towards the viewer.
 struct ShadingPoint<'a> {
     hit: &'a Hit,
     material: &'a PhongMaterial,
     kd: Vec3,
     ks: Vec3,
     n: Vec3,
+    ng: Vec3,
     v: Vec3,
+}
+
+impl ShadingPoint<'_> {
+    /// Whether light from direction `l` can reach the surface at all: it must be
+    /// above the *geometric* surface. With interpolated shading normals a light can
+    /// be above the shading normal's horizon but below the triangle's; its shadow
+    /// ray would leave into the surface and be blocked by the neighbouring
+    /// triangles, leaving dark specks (the "shadow terminator" problem).
+    #[inline]
+    fn above_surface(&self, l: Vec3) -> bool {
+        self.ng.dot(l) > 0.0
+    }
 }
 
 impl ShadingPoint<'_> {
@@ -226,6 +246,9 @@ impl ShadingPoint<'_> {
         let Some(l) = (position - self.hit.point).try_normalize() else {
             return Vec3::ZERO;
         };
+        if !self.above_surface(l) {
+            return Vec3::ZERO;
+        }
         let reflected = self.material.reflect(self.kd, self.ks, self.n, l, self.v);
         if reflected == Vec3::ZERO {
             return Vec3::ZERO;

@@ -24,4 +24,4 @@ pub use render::{
     MAX_SAMPLES, MAX_THREADS, TILE_SIZE,
 };
 pub use sampling::SamplePattern;
-pub use scene::{Scene, SceneBuilder, SceneError, Surface};
+pub use scene::{Scene, SceneBuilder, SceneError, Surface, SurfaceKind};

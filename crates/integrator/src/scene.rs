@@ -1,6 +1,6 @@
 use glam::Vec3;
 use glint_camera::Camera;
-use glint_geometry::{Shape, ShapeList};
+use glint_geometry::{Hit, Shape, ShapeList, TriangleMesh};
 use glint_lighting::{AreaLight, EnvironmentLight, Light, PhongMaterial, PointLight};
 use glint_texture::{Texture, TextureFilter};
 
@@ -11,6 +11,15 @@ pub enum Surface {
     Material(u32),
     /// The visible face of the light at this index of [`Scene::lights`].
     Emitter(u32),
+    /// A triangle mesh whose triangles' materials are listed at this index of
+    /// [`Scene::mesh_materials`].
+    Mesh(u32),
+}
+
+/// What a hit point is made of.
+pub enum SurfaceKind<'a> {
+    Material(&'a PhongMaterial),
+    Emitter(&'a Light),
 }
 
 /// The scene as the integrator sees it: a camera, shapes in one flat list with a
@@ -27,9 +36,24 @@ pub struct Scene {
     pub ambient: Vec3,
     /// What rays that miss everything see, and a light for surfaces.
     pub environment: Option<EnvironmentLight>,
+    /// Per mesh, the material index of each triangle.
+    pub mesh_materials: Vec<Vec<u32>>,
 }
 
 impl Scene {
+    /// The material or light at `hit`.
+    #[inline]
+    pub fn surface_of(&self, hit: &Hit) -> SurfaceKind<'_> {
+        match self.surfaces[hit.shape as usize] {
+            Surface::Material(m) => SurfaceKind::Material(&self.materials[m as usize]),
+            Surface::Emitter(l) => SurfaceKind::Emitter(&self.lights[l as usize]),
+            Surface::Mesh(k) => {
+                let m = self.mesh_materials[k as usize][hit.primitive as usize];
+                SurfaceKind::Material(&self.materials[m as usize])
+            }
+        }
+    }
+
     /// Sets the filter of every image texture the materials use (the command
     /// line's `--texture-filter`). Procedural textures keep their own filtering.
     pub fn override_texture_filter(&mut self, filter: TextureFilter) {
@@ -65,6 +89,7 @@ pub struct SceneBuilder {
     lights: Vec<Light>,
     ambient: Vec3,
     environment: Option<EnvironmentLight>,
+    mesh_materials: Vec<Vec<u32>>,
 }
 
 impl SceneBuilder {
@@ -82,6 +107,21 @@ impl SceneBuilder {
     pub fn shape(&mut self, shape: impl Into<Shape>, material: u32) -> &mut Self {
         self.shapes.push(shape);
         self.surfaces.push(Surface::Material(material));
+        self
+    }
+
+    /// Adds a triangle mesh whose triangle `i` is made of material
+    /// `triangle_materials[i]` (one entry per triangle).
+    pub fn mesh(&mut self, mesh: TriangleMesh, triangle_materials: Vec<u32>) -> &mut Self {
+        assert_eq!(
+            mesh.triangle_count(),
+            triangle_materials.len(),
+            "one material per triangle"
+        );
+        self.shapes.push_mesh(mesh);
+        self.surfaces
+            .push(Surface::Mesh(self.mesh_materials.len() as u32));
+        self.mesh_materials.push(triangle_materials);
         self
     }
 
@@ -109,18 +149,23 @@ impl SceneBuilder {
         self
     }
 
-    pub fn build(self, camera: Camera) -> Result<Scene, SceneError> {
+    /// The scene, with its BVH built.
+    pub fn build(mut self, camera: Camera) -> Result<Scene, SceneError> {
         for (shape, surface) in self.surfaces.iter().enumerate() {
-            if let Surface::Material(material) = *surface {
-                if material as usize >= self.materials.len() {
-                    return Err(SceneError::UnknownMaterial {
-                        shape,
-                        material,
-                        count: self.materials.len(),
-                    });
-                }
+            let used: &[u32] = match surface {
+                Surface::Material(m) => std::slice::from_ref(m),
+                Surface::Mesh(k) => &self.mesh_materials[*k as usize],
+                Surface::Emitter(_) => &[],
+            };
+            if let Some(&material) = used.iter().find(|&&m| m as usize >= self.materials.len()) {
+                return Err(SceneError::UnknownMaterial {
+                    shape,
+                    material,
+                    count: self.materials.len(),
+                });
             }
         }
+        self.shapes.build_bvh();
         Ok(Scene {
             camera,
             shapes: self.shapes,
@@ -129,6 +174,7 @@ impl SceneBuilder {
             lights: self.lights,
             ambient: self.ambient,
             environment: self.environment,
+            mesh_materials: self.mesh_materials,
         })
     }
 }

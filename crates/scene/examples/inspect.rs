@@ -4,6 +4,7 @@
 //!
 //! `cargo run -p glint-scene --example inspect -- scenes/cornell-set1.toml`
 
+use glint_geometry::ObjectRef;
 use glint_integrator::Surface;
 use glint_lighting::Light;
 use std::path::PathBuf;
@@ -54,12 +55,34 @@ fn main() -> std::process::ExitCode {
             m.lobe
         );
     }
-    for (shape, surface) in s.shapes.shapes().iter().zip(&s.surfaces) {
+    for (i, surface) in s.surfaces.iter().enumerate() {
         let what = match surface {
             Surface::Material(m) => format!("\"{}\"", d.material_names[*m as usize]),
             Surface::Emitter(l) => format!("emitter of light #{l}"),
+            Surface::Mesh(k) => format!(
+                "{} per-triangle materials",
+                s.mesh_materials[*k as usize].len()
+            ),
         };
-        println!("shape    {what}: {shape:?}");
+        match s.shapes.object(i as u32) {
+            ObjectRef::Shape(shape) => println!("shape    {what}: {shape:?}"),
+            ObjectRef::Mesh(mesh) => println!(
+                "mesh     {what}: {} triangles, {} vertices, {}",
+                mesh.triangle_count(),
+                mesh.vertex_count(),
+                if mesh.has_normals() {
+                    "smooth normals"
+                } else {
+                    "flat"
+                }
+            ),
+        }
+    }
+    if let Some(stats) = s.shapes.bvh_stats() {
+        println!(
+            "BVH      {} nodes, {} leaves, depth {}, SAH cost {:.2}",
+            stats.nodes, stats.leaves, stats.max_depth, stats.sah_cost
+        );
     }
     for (i, light) in s.lights.iter().enumerate() {
         match light {

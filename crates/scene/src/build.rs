@@ -3,9 +3,12 @@
 
 use crate::error::Problem;
 use crate::format::*;
+use crate::obj::load_obj;
 use crate::values::{Count, Pattern};
 use glam::Vec3;
+use glam::{Affine3A, EulerRot, Quat};
 use glint_camera::{Camera, CameraError};
+use glint_geometry::TriangleMesh;
 use glint_geometry::{AaBox, Parallelogram, Plane, Sphere};
 use glint_integrator::{RenderSettings, SampleCount, Scene, SceneBuilder, SettingsError};
 use glint_lighting::{AreaLight, EnvironmentLight, PhongMaterial, PointLight, UvTransform};
@@ -33,6 +36,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
     let camera = camera(&file.camera, file.render.resolution.0)?;
     let textures = textures(&file.textures, base_dir)?;
     let mut builder = SceneBuilder::new();
+    let mut extra_material_names = Vec::new();
     let mut material_ids = BTreeMap::new();
     for (name, table) in &file.materials {
         let material = material(name, table, &textures)?;
@@ -126,6 +130,57 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
             }
         }
     }
+    let mut default_mesh_material = None;
+    for (i, m) in file.mesh.iter().enumerate() {
+        let field = format!("mesh[{i}]");
+        let obj = load_obj(&base_dir.join(m.file.get_ref()))
+            .map_err(|e| Problem::new(m.file.span(), format!("{field}.file"), e))?;
+        let triangle_materials: Vec<u32> = match &m.material {
+            Some(name) => vec![lookup(format!("{field}.material"), name)?; obj.indices.len()],
+            None => {
+                // The OBJ's own materials, named FILE:NAME; faces without one get a
+                // light gray diffuse material.
+                let ids: Vec<u32> = obj
+                    .materials
+                    .iter()
+                    .map(|(name, material)| {
+                        extra_material_names.push(format!("{}:{name}", m.file.get_ref()));
+                        builder.material(material.clone())
+                    })
+                    .collect();
+                obj.triangle_materials
+                    .iter()
+                    .map(|t| match t {
+                        Some(k) => ids[*k as usize],
+                        None => *default_mesh_material.get_or_insert_with(|| {
+                            extra_material_names.push("(default mesh material)".into());
+                            builder.material(PhongMaterial {
+                                specular: Some(Texture::Constant(Vec3::ZERO)),
+                                ..PhongMaterial::new(Vec3::splat(0.8), 1.0)
+                            })
+                        }),
+                    })
+                    .collect()
+            }
+        };
+        let mesh =
+            TriangleMesh::new(obj.positions, obj.indices, obj.normals, obj.uvs).map_err(|e| {
+                Problem::new(
+                    m.file.span(),
+                    format!("{field}.file"),
+                    format!("{}: {e}", m.file.get_ref()),
+                )
+            })?;
+        let mesh = if mesh.has_normals() {
+            mesh
+        } else {
+            mesh.with_angle_weighted_normals()
+        };
+        let (r, s) = (m.rotate.0 * std::f32::consts::PI / 180.0, m.scale.0);
+        let rotation = Quat::from_euler(EulerRot::ZYX, r.z, r.y, r.x);
+        let transform = Affine3A::from_scale_rotation_translation(s, rotation, m.translate.0);
+        builder.mesh(mesh.transformed(&transform), triangle_materials);
+    }
     for p in &file.point_light {
         builder.point_light(PointLight {
             position: p.position.0,
@@ -146,7 +201,12 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
     let scene = builder
         .build(camera)
         .expect("material ids were resolved above");
-    let material_names = file.materials.keys().cloned().collect();
+    let material_names = file
+        .materials
+        .keys()
+        .cloned()
+        .chain(extra_material_names)
+        .collect();
     Ok(SceneDescription {
         scene,
         settings,

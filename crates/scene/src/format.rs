@@ -31,6 +31,8 @@ pub struct SceneFile {
     #[serde(default, rename = "box")]
     pub boxes: Vec<BoxTable>,
     #[serde(default)]
+    pub mesh: Vec<MeshTable>,
+    #[serde(default)]
     pub point_light: Vec<PointLightTable>,
     #[serde(default)]
     pub area_light: Vec<AreaLightTable>,
@@ -301,4 +303,28 @@ pub struct AreaLightTable {
     pub normal: Option<Spanned<Direction>>,
     #[serde(default = "white")]
     pub color: Color,
+}
+
+/// A triangle mesh read from an OBJ file, placed by a transform.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshTable {
+    /// Path of the OBJ file, relative to the scene file.
+    pub file: Spanned<String>,
+    /// A material for every triangle (instead of the OBJ's MTL materials).
+    pub material: Option<Spanned<String>>,
+    #[serde(default = "origin")]
+    pub translate: Point,
+    /// Degrees about x, then y, then z.
+    #[serde(default = "origin")]
+    pub rotate: Point,
+    #[serde(default = "unit_scale3")]
+    pub scale: Scale3,
+}
+
+fn origin() -> Point {
+    Point(glam::Vec3::ZERO)
+}
+fn unit_scale3() -> Scale3 {
+    Scale3(glam::Vec3::ONE)
 }

@@ -15,6 +15,7 @@
 mod build;
 mod error;
 mod format;
+mod obj;
 mod values;
 
 pub use build::SceneDescription;

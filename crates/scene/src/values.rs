@@ -257,3 +257,39 @@ impl<'de> Deserialize<'de> for CheckerFilter {
         .map(CheckerFilter)
     }
 }
+
+/// A scale: one number (uniform) or `[sx, sy, sz]`, with no zero component.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scale3(pub Vec3);
+
+impl<'de> Deserialize<'de> for Scale3 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Vec3;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a scale: a number or [sx, sy, sz]")
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Vec3, E> {
+                Ok(Vec3::splat(finite(v as f32)?))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Vec3, E> {
+                Ok(Vec3::splat(finite(v as f32)?))
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Vec3, E> {
+                Ok(Vec3::splat(finite(v as f32)?))
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(self, seq: A) -> Result<Vec3, A::Error> {
+                vector(de::value::SeqAccessDeserializer::new(seq))
+            }
+        }
+        let v = d.deserialize_any(V)?;
+        if v.cmpeq(Vec3::ZERO).any() {
+            return Err(de::Error::custom(format!(
+                "expected a scale with no zero component, got [{}, {}, {}]",
+                v.x, v.y, v.z
+            )));
+        }
+        Ok(Scale3(v))
+    }
+}

@@ -1,5 +1,6 @@
 //! End-to-end tests of Glint over the shipped scenes (`scenes/`); the tests live
-//! in `tests/`. This library only locates the shipped files.
+//! in `tests/` and the benchmarks in `benches/`. This library locates the shipped
+//! files and makes meshes for benchmarks.
 
 use std::path::PathBuf;
 
@@ -24,4 +25,40 @@ pub fn shipped_scenes() -> Vec<String> {
         .collect();
     names.sort();
     names
+}
+
+/// A displaced grid of about `triangles` triangles over [−1, 1]² in x, z with a
+/// bumpy height `y = 0.1·sin(7x)·cos(5z) + 0.05·sin(23x + 17z)`: a mesh of any size
+/// for benchmarks, made by code (two triangles per grid cell).
+pub fn displaced_grid(triangles: usize) -> glint_geometry::TriangleMesh {
+    use glam::Vec3;
+    let n = ((triangles as f64 / 2.0).sqrt().ceil() as u32).max(1);
+    let height = |x: f32, z: f32| {
+        0.1 * (7.0 * x).sin() * (5.0 * z).cos() + 0.05 * (23.0 * x + 17.0 * z).sin()
+    };
+    let mut positions = Vec::with_capacity(((n + 1) * (n + 1)) as usize);
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, z) = (
+                2.0 * i as f32 / n as f32 - 1.0,
+                2.0 * j as f32 / n as f32 - 1.0,
+            );
+            positions.push(Vec3::new(x, height(x, z), z));
+        }
+    }
+    let row = n + 1;
+    let mut indices = Vec::with_capacity((2 * n * n) as usize);
+    for j in 0..n {
+        for i in 0..n {
+            let (a, b, c, d) = (
+                j * row + i,
+                j * row + i + 1,
+                (j + 1) * row + i,
+                (j + 1) * row + i + 1,
+            );
+            indices.push([a, c, b]);
+            indices.push([b, c, d]);
+        }
+    }
+    glint_geometry::TriangleMesh::new(positions, indices, vec![], vec![]).expect("a valid grid")
 }

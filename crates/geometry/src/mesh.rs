@@ -1,0 +1,331 @@
+//! Indexed triangle meshes.
+
+use crate::triangle::WatertightRay;
+use crate::{Hit, Ray};
+use glam::{Affine3A, Mat3, Vec2, Vec3};
+
+/// Why a mesh could not be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    #[error("the mesh has no triangles")]
+    Empty,
+    #[error("triangle {triangle} uses vertex {index}, but there are only {count} vertices")]
+    IndexOutOfRange {
+        triangle: usize,
+        index: u32,
+        count: usize,
+    },
+    #[error("{what} has {got} entries, expected one per vertex ({expected})")]
+    AttributeCount {
+        what: &'static str,
+        got: usize,
+        expected: usize,
+    },
+    #[error("vertex {0} is not finite")]
+    NonFinite(usize),
+}
+
+/// Triangles sharing vertices: positions, optional per-vertex shading normals and
+/// texture coordinates, and three vertex indices per triangle.
+///
+/// A hit's uv is interpolated from the vertices' (or, without them, is the
+/// barycentric `(b1, b2)`); its shading normal is the interpolated vertex normal
+/// when the mesh has normals, else the face normal. The geometric normal follows
+/// the winding: `(p1 − p0) × (p2 − p0)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleMesh {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    indices: Vec<[u32; 3]>,
+}
+
+impl TriangleMesh {
+    /// A mesh from its parts; `normals` and `uvs` are empty or one per vertex.
+    pub fn new(
+        positions: Vec<Vec3>,
+        indices: Vec<[u32; 3]>,
+        normals: Vec<Vec3>,
+        uvs: Vec<Vec2>,
+    ) -> Result<Self, MeshError> {
+        if indices.is_empty() {
+            return Err(MeshError::Empty);
+        }
+        let count = positions.len();
+        for (triangle, tri) in indices.iter().enumerate() {
+            if let Some(&index) = tri.iter().find(|&&i| i as usize >= count) {
+                return Err(MeshError::IndexOutOfRange {
+                    triangle,
+                    index,
+                    count,
+                });
+            }
+        }
+        for (what, got) in [("normals", normals.len()), ("uvs", uvs.len())] {
+            if got != 0 && got != count {
+                return Err(MeshError::AttributeCount {
+                    what,
+                    got,
+                    expected: count,
+                });
+            }
+        }
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(MeshError::NonFinite(i));
+        }
+        Ok(Self {
+            positions,
+            normals,
+            uvs,
+            indices,
+        })
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len()
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// The three vertex indices of every triangle.
+    pub fn indices(&self) -> &[[u32; 3]] {
+        &self.indices
+    }
+
+    pub fn has_normals(&self) -> bool {
+        !self.normals.is_empty()
+    }
+
+    /// The three corners of triangle `i`.
+    #[inline]
+    pub fn corners(&self, i: u32) -> [Vec3; 3] {
+        self.indices[i as usize].map(|v| self.positions[v as usize])
+    }
+
+    /// Bounds `(min, max)` of triangle `i`.
+    pub fn triangle_bounds(&self, i: u32) -> (Vec3, Vec3) {
+        let [a, b, c] = self.corners(i);
+        (a.min(b).min(c), a.max(b).max(c))
+    }
+
+    /// The same mesh with angle-weighted vertex normals (Thürmer and Wüthrich,
+    /// "Computing Vertex Normals from Polygonal Facets", JGT 1998): each face adds
+    /// its unit normal times its corner angle to its three vertices. Degenerate
+    /// faces add nothing; a vertex with no valid face keeps a zero normal and falls
+    /// back to the face normal when shaded.
+    pub fn with_angle_weighted_normals(mut self) -> Self {
+        let mut normals = vec![Vec3::ZERO; self.positions.len()];
+        for tri in &self.indices {
+            let p = tri.map(|v| self.positions[v as usize]);
+            let Some(n) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
+                continue;
+            };
+            for k in 0..3 {
+                let (e1, e2) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+                let angle = e1.angle_between(e2);
+                if angle.is_finite() {
+                    normals[tri[k] as usize] += angle * n;
+                }
+            }
+        }
+        self.normals = normals.into_iter().map(|n| n.normalize_or_zero()).collect();
+        self
+    }
+
+    /// The mesh under an affine transform; normals by the inverse transpose.
+    pub fn transformed(&self, m: &Affine3A) -> Self {
+        let normal_matrix: Mat3 = Mat3::from(m.matrix3).inverse().transpose();
+        Self {
+            positions: self
+                .positions
+                .iter()
+                .map(|p| m.transform_point3(*p))
+                .collect(),
+            normals: self
+                .normals
+                .iter()
+                .map(|n| (normal_matrix * *n).normalize_or_zero())
+                .collect(),
+            uvs: self.uvs.clone(),
+            indices: self.indices.clone(),
+        }
+    }
+
+    /// The hit distance of triangle `i` in (0, t_max), if any.
+    #[inline]
+    pub fn hit_distance(&self, i: u32, ray: &WatertightRay, t_max: f32) -> Option<f32> {
+        let [a, b, c] = self.corners(i);
+        ray.intersect(a, b, c, t_max).map(|(t, _)| t)
+    }
+
+    /// The surface record of triangle `i` where `ray` meets it before `t_max`.
+    pub fn surface_at(&self, i: u32, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let [a, b, c] = self.corners(i);
+        let (t, bary) = WatertightRay::new(ray).intersect(a, b, c, t_max)?;
+        let tri = self.indices[i as usize];
+        // The barycentric point is more accurate than o + t·d.
+        let point = bary[0] * a + bary[1] * b + bary[2] * c;
+        let face = (b - a).cross(c - a).normalize();
+        let uv_at = |k: usize| -> Vec2 {
+            if self.uvs.is_empty() {
+                [Vec2::ZERO, Vec2::X, Vec2::Y][k]
+            } else {
+                self.uvs[tri[k] as usize]
+            }
+        };
+        let (uv0, uv1, uv2) = (uv_at(0), uv_at(1), uv_at(2));
+        let uv = bary[0] * uv0 + bary[1] * uv1 + bary[2] * uv2;
+        // ∂p/∂u, ∂p/∂v from the uv deltas (pbrt-v4 section 6.5.3); for a
+        // degenerate uv mapping, any frame around the normal.
+        let (duv02, duv12) = (uv0 - uv2, uv1 - uv2);
+        let (dp02, dp12) = (a - c, b - c);
+        let det = duv02.x * duv12.y - duv02.y * duv12.x;
+        let (mut dpdu, mut dpdv) = if det.abs() > 1e-12 {
+            let inv = 1.0 / det;
+            (
+                (duv12.y * dp02 - duv02.y * dp12) * inv,
+                (duv02.x * dp12 - duv12.x * dp02) * inv,
+            )
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        if !(dpdu.is_finite() && dpdv.is_finite()) || dpdu.cross(dpdv).length_squared() == 0.0 {
+            (dpdu, dpdv) = face.any_orthonormal_pair();
+        }
+        let (shading_normal, dndu, dndv) = if self.normals.is_empty() {
+            (face, Vec3::ZERO, Vec3::ZERO)
+        } else {
+            let n = tri.map(|v| self.normals[v as usize]);
+            let interpolated =
+                (bary[0] * n[0] + bary[1] * n[1] + bary[2] * n[2]).normalize_or_zero();
+            if interpolated == Vec3::ZERO {
+                (face, Vec3::ZERO, Vec3::ZERO)
+            } else {
+                let (dn02, dn12) = (n[0] - n[2], n[1] - n[2]);
+                let (dndu, dndv) = if det.abs() > 1e-12 {
+                    let inv = 1.0 / det;
+                    (
+                        (duv12.y * dn02 - duv02.y * dn12) * inv,
+                        (duv02.x * dn12 - duv12.x * dn02) * inv,
+                    )
+                } else {
+                    (Vec3::ZERO, Vec3::ZERO)
+                };
+                // The shading normal on the geometric normal's side.
+                let s = if interpolated.dot(face) < 0.0 {
+                    -interpolated
+                } else {
+                    interpolated
+                };
+                (s, dndu, dndv)
+            }
+        };
+        Some(Hit {
+            t,
+            point,
+            geometric_normal: face,
+            shading_normal,
+            uv,
+            dpdu,
+            dpdv,
+            dndu,
+            dndv,
+            front_face: face.dot(ray.direction) < 0.0,
+            shape: 0,
+            primitive: 0,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad() -> TriangleMesh {
+        TriangleMesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            vec![[0, 1, 2], [0, 2, 3]],
+            vec![],
+            vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn invalid_meshes_are_refused() {
+        assert_eq!(
+            TriangleMesh::new(vec![Vec3::ZERO], vec![], vec![], vec![]),
+            Err(MeshError::Empty)
+        );
+        let e =
+            TriangleMesh::new(vec![Vec3::ZERO; 3], vec![[0, 1, 3]], vec![], vec![]).unwrap_err();
+        assert_eq!(
+            e,
+            MeshError::IndexOutOfRange {
+                triangle: 0,
+                index: 3,
+                count: 3
+            }
+        );
+        let e = TriangleMesh::new(vec![Vec3::ZERO; 3], vec![[0, 1, 2]], vec![Vec3::Z], vec![])
+            .unwrap_err();
+        assert!(matches!(
+            e,
+            MeshError::AttributeCount {
+                what: "normals",
+                ..
+            }
+        ));
+        let e = TriangleMesh::new(vec![Vec3::NAN; 3], vec![[0, 1, 2]], vec![], vec![]).unwrap_err();
+        assert_eq!(e, MeshError::NonFinite(0));
+    }
+
+    #[test]
+    fn hit_interpolates_uv_and_has_a_consistent_frame() {
+        let mesh = quad();
+        let ray = Ray::new(Vec3::new(0.25, 0.6, 1.0), -Vec3::Z);
+        let hit = (0..2)
+            .find_map(|i| mesh.surface_at(i, &ray, f32::INFINITY))
+            .unwrap();
+        assert!((hit.point - Vec3::new(0.25, 0.6, 0.0)).length() < 1e-6);
+        assert!((hit.uv - Vec2::new(0.25, 0.6)).length() < 1e-6);
+        assert!((hit.dpdu - Vec3::X).length() < 1e-6 && (hit.dpdv - Vec3::Y).length() < 1e-6);
+        assert_eq!(hit.geometric_normal, Vec3::Z);
+        assert!(hit.front_face);
+    }
+
+    #[test]
+    fn angle_weighted_normals_of_a_tetrahedron_point_outwards() {
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        // Outward winding.
+        let idx = vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+        let mesh = TriangleMesh::new(p.clone(), idx, vec![], vec![])
+            .unwrap()
+            .with_angle_weighted_normals();
+        let centre = Vec3::splat(0.25);
+        for (v, n) in p.iter().zip(&mesh.normals) {
+            assert!((n.length() - 1.0).abs() < 1e-5);
+            assert!(n.dot(*v - centre) > 0.0, "vertex {v} normal {n}");
+        }
+        // The origin's three faces meet at right angles with equal weights: the
+        // normal is the diagonal.
+        assert!((mesh.normals[0] + Vec3::splat(1.0 / 3f32.sqrt())).length() < 1e-5);
+    }
+
+    #[test]
+    fn transforms_move_points_and_keep_normals_perpendicular() {
+        let mesh = quad().with_angle_weighted_normals();
+        let m = Affine3A::from_scale_rotation_translation(
+            Vec3::new(2.0, 0.5, 1.0),
+            glam::Quat::from_rotation_y(0.7),
+            Vec3::new(1.0, 2.0, 3.0),
+        );
+        let t = mesh.transformed(&m);
+        assert!((t.positions[1] - m.transform_point3(Vec3::X)).length() < 1e-6);
+        let [a, b, c] = t.corners(0);
+        let face = (b - a).cross(c - a).normalize();
+        assert!((t.normals[0] - face).length() < 1e-5);
+    }
+}

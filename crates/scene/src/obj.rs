@@ -1,0 +1,165 @@
+//! Wavefront OBJ meshes (with their MTL materials) read through tobj.
+
+use glam::{Vec2, Vec3};
+use glint_lighting::PhongMaterial;
+use glint_texture::{load_image, ImageTexture, Texture, TextureFilter, TextureImage, WrapMode};
+use std::path::Path;
+
+/// One OBJ file as Glint uses it: all of its triangles in one list, the MTL
+/// material each triangle uses (if any), and those materials as Phong materials.
+pub struct ObjMesh {
+    pub positions: Vec<Vec3>,
+    /// Empty when the file has no normals (they are then generated).
+    pub normals: Vec<Vec3>,
+    /// Empty when the file has no texture coordinates.
+    pub uvs: Vec<Vec2>,
+    pub indices: Vec<[u32; 3]>,
+    /// Per triangle: an index into `materials`, or `None`.
+    pub triangle_materials: Vec<Option<u32>>,
+    pub materials: Vec<(String, PhongMaterial)>,
+}
+
+/// Reads `path`: polygons are triangulated (as fans), vertices de-duplicated per
+/// (position, normal, uv) triple. MTL materials map to Phong: `Kd` → diffuse
+/// (or `map_Kd`, an image relative to the OBJ, filtered trilinearly), `Ks` →
+/// specular, `Ns` → shininess. Errors are one line naming the file.
+pub fn load_obj(path: &Path) -> Result<ObjMesh, String> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, materials) = tobj::load_obj(path, &options)
+        .map_err(|e| format!("{}: cannot read the OBJ file: {e}", path.display()))?;
+    // A missing or broken MTL file: the faces use the scene's material.
+    let materials = materials.unwrap_or_default();
+    let base = path.parent().unwrap_or(Path::new(""));
+    let phong = materials
+        .iter()
+        .map(|m| Ok((m.name.clone(), mtl_to_phong(m, base)?)))
+        .collect::<Result<Vec<_>, String>>()?;
+
+    let mut mesh = ObjMesh {
+        positions: Vec::new(),
+        normals: Vec::new(),
+        uvs: Vec::new(),
+        indices: Vec::new(),
+        triangle_materials: Vec::new(),
+        materials: phong,
+    };
+    let all_have = |f: fn(&tobj::Mesh) -> bool| models.iter().all(|m| f(&m.mesh));
+    let keep_normals = all_have(|m| !m.normals.is_empty());
+    let keep_uvs = all_have(|m| !m.texcoords.is_empty());
+    for model in &models {
+        let m = &model.mesh;
+        let first = mesh.positions.len() as u32;
+        let vertices = m.positions.len() / 3;
+        mesh.positions.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|p| Vec3::new(p[0], p[1], p[2])),
+        );
+        if keep_normals {
+            mesh.normals.extend(
+                m.normals
+                    .chunks_exact(3)
+                    .map(|n| Vec3::new(n[0], n[1], n[2])),
+            );
+        }
+        if keep_uvs {
+            mesh.uvs
+                .extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
+        }
+        for tri in m.indices.chunks_exact(3) {
+            if let Some(&bad) = tri.iter().find(|&&i| i as usize >= vertices) {
+                return Err(format!(
+                    "{}: object \"{}\" refers to vertex {bad}, but it has only {vertices}",
+                    path.display(),
+                    model.name
+                ));
+            }
+            mesh.indices
+                .push([tri[0] + first, tri[1] + first, tri[2] + first]);
+            let material = m
+                .material_id
+                .filter(|&id| id < mesh.materials.len())
+                .map(|id| id as u32);
+            mesh.triangle_materials.push(material);
+        }
+    }
+    if mesh.indices.is_empty() {
+        return Err(format!("{}: the OBJ file has no faces", path.display()));
+    }
+    Ok(mesh)
+}
+
+fn mtl_to_phong(m: &tobj::Material, base: &Path) -> Result<PhongMaterial, String> {
+    let color = |c: Option<[f32; 3]>, default: Vec3| {
+        c.map(Vec3::from_array).unwrap_or(default).max(Vec3::ZERO)
+    };
+    let kd = color(m.diffuse, Vec3::splat(0.8));
+    let diffuse = match &m.diffuse_texture {
+        Some(file) => {
+            let image = load_image(&base.join(file))
+                .map_err(|e| format!("material \"{}\": {e}", m.name))?;
+            Texture::Image(ImageTexture::new(
+                TextureImage::new(image),
+                WrapMode::Repeat,
+                TextureFilter::Trilinear,
+            ))
+        }
+        None => Texture::Constant(kd),
+    };
+    let shininess = m
+        .shininess
+        .filter(|s| s.is_finite() && *s >= 0.0)
+        .unwrap_or(1.0);
+    Ok(PhongMaterial {
+        diffuse,
+        specular: Some(Texture::Constant(color(m.specular, Vec3::ZERO))),
+        ..PhongMaterial::new(Vec3::ZERO, shininess)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_polygons_materials_and_reports_bad_files() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("quad.mtl"),
+            "newmtl red\nKd 0.8 0.1 0.1\nKs 0.2 0.2 0.2\nNs 30\n",
+        )
+        .unwrap();
+        let obj = dir.path().join("quad.obj");
+        std::fs::write(
+            &obj,
+            "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nusemtl red\nf 1 2 3 4\nf 1 2 5\n",
+        )
+        .unwrap();
+        let mesh = load_obj(&obj).unwrap();
+        assert_eq!(mesh.indices.len(), 3, "a quad is two triangles, plus one");
+        assert!(mesh.normals.is_empty() && mesh.uvs.is_empty());
+        assert_eq!(mesh.materials.len(), 1);
+        let (name, red) = &mesh.materials[0];
+        assert_eq!(name, "red");
+        assert_eq!(red.diffuse, Texture::Constant(Vec3::new(0.8, 0.1, 0.1)));
+        assert_eq!(red.shininess, 30.0);
+        assert!(mesh.triangle_materials.iter().all(|m| *m == Some(0)));
+
+        let missing = load_obj(&dir.path().join("nope.obj")).err().unwrap();
+        assert!(
+            missing.contains("nope.obj: cannot read the OBJ file"),
+            "{missing}"
+        );
+        let empty = dir.path().join("empty.obj");
+        std::fs::write(&empty, "v 0 0 0\nv 1 0 0\n").unwrap();
+        assert!(load_obj(&empty).err().unwrap().contains("has no faces"));
+        let bad = dir.path().join("bad.obj");
+        std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
+        assert!(load_obj(&bad).is_err());
+    }
+}

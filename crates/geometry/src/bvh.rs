@@ -419,6 +419,16 @@ impl Bvh {
         }
     }
 
+    /// Makes the queries report primitives by their position in leaf order, and
+    /// returns that order: `order[k]` is the primitive (an index into the slice
+    /// given to [`Bvh::build`]) at position `k`. A caller that stores its primitive
+    /// data in this order reads a leaf's primitives from adjacent memory.
+    /// Primitives left out of the tree (empty or non-finite bounds) are not listed.
+    pub fn take_primitive_order(&mut self) -> Vec<u32> {
+        let identity = (0..self.indices.len() as u32).collect();
+        std::mem::replace(&mut self.indices, identity)
+    }
+
     fn leaf_primitives(&self, leaf: &BvhNode) -> &[u32] {
         let first = leaf.offset as usize;
         &self.indices[first..first + leaf.count as usize]

@@ -1,5 +1,6 @@
-//! The second stage of Glint: rays, the shapes they can hit, and the
-//! closest-hit and any-hit (shadow) queries over a collection of shapes.
+//! The second stage of Glint: rays, the shapes they can hit (spheres,
+//! parallelograms, planes, boxes, triangle meshes), and the closest-hit and
+//! any-hit (shadow) queries over a collection of them, answered through a BVH.
 //!
 //! # Conventions
 //! - World space is right-handed with y up; `f32` throughout, glam vectors.
@@ -16,6 +17,9 @@
 //!   unit of uv), the Jacobian later stages use for texture filtering.
 //! - New rays leaving a surface start at [`offset_ray_origin`], never at a fixed
 //!   epsilon: the offset scales with the magnitude of the hit point.
+//! - Triangles are intersected watertightly ([`triangle`]): rays through shared
+//!   edges and vertices of a closed mesh never slip through. Hits at exactly equal
+//!   distances go to the lowest object index, with or without the BVH.
 
 mod aabox;
 pub mod bvh;

@@ -1,6 +1,7 @@
 use crate::bvh::{Bounds3, Bvh, BvhStats};
 use crate::triangle::WatertightRay;
 use crate::{Hit, Ray, Shape, TriangleMesh};
+use glam::Vec3;
 
 /// What an object index names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,7 +40,11 @@ pub struct ShapeList {
     meshes: Vec<TriangleMesh>,
     objects: Vec<Object>,
     bvh: Option<Bvh>,
+    /// The BVH's primitives in its leaf order (so a leaf's are adjacent)…
     primitives: Vec<Primitive>,
+    /// …and, for triangles, their corners in the same order: one contiguous read
+    /// per triangle test instead of an index triple and three vertices.
+    corners: Vec<[Vec3; 3]>,
     unbounded: Vec<u32>,
 }
 
@@ -126,8 +131,31 @@ impl ShapeList {
                 }
             }
         }
-        self.bvh = Some(Bvh::build(&bounds));
-        self.primitives = primitives;
+        let mut bvh = Bvh::build(&bounds);
+        let order = bvh.take_primitive_order();
+        self.primitives = order.iter().map(|&i| primitives[i as usize]).collect();
+        self.corners = self
+            .primitives
+            .iter()
+            .map(|p| match self.objects[p.object as usize] {
+                Object::Mesh(m) => self.meshes[m as usize].corners(p.triangle),
+                Object::Shape(_) => [Vec3::ZERO; 3],
+            })
+            .collect();
+        self.bvh = Some(bvh);
+    }
+
+    /// The hit distance of the BVH's primitive at leaf position `k`.
+    #[inline]
+    fn slot_distance(&self, k: u32, ray: &Ray, watertight: &WatertightRay, t_max: f32) -> Option<f32> {
+        let p = self.primitives[k as usize];
+        match self.objects[p.object as usize] {
+            Object::Shape(s) => self.shapes[s as usize].hit_distance(ray, t_max),
+            Object::Mesh(_) => {
+                let [a, b, c] = self.corners[k as usize];
+                watertight.intersect(a, b, c, t_max).map(|(t, _)| t)
+            }
+        }
     }
 
     /// Statistics of the BVH, once built.
@@ -182,9 +210,8 @@ impl ShapeList {
             // tie rule and reports only primitives that became the best.
             let start = limit(&best);
             bvh.closest_hit(ray, start, |i, ray, _| {
-                let p = self.primitives[i as usize];
-                let t = self.primitive_distance(p, ray, &watertight, limit(&best))?;
-                consider(p, t, &mut best).then_some(t)
+                let t = self.slot_distance(i, ray, &watertight, limit(&best))?;
+                consider(self.primitives[i as usize], t, &mut best).then_some(t)
             });
         }
         let (t, p) = best?;
@@ -216,8 +243,7 @@ impl ShapeList {
                     self.primitive_distance(p, ray, &watertight, t_max)
                         .is_some()
                 }) || bvh.any_hit(ray, t_max, |i, ray, t_max| {
-                    self.primitive_distance(self.primitives[i as usize], ray, &watertight, t_max)
-                        .is_some()
+                    self.slot_distance(i, ray, &watertight, t_max).is_some()
                 })
             }
             None => self.all_primitives().any(|p| {

@@ -133,10 +133,16 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
     let mut default_mesh_material = None;
     for (i, m) in file.mesh.iter().enumerate() {
         let field = format!("mesh[{i}]");
+        // Names before files: a typo is reported without reading the mesh.
+        let material = m
+            .material
+            .as_ref()
+            .map(|name| lookup(format!("{field}.material"), name))
+            .transpose()?;
         let obj = load_obj(&base_dir.join(m.file.get_ref()))
             .map_err(|e| Problem::new(m.file.span(), format!("{field}.file"), e))?;
-        let triangle_materials: Vec<u32> = match &m.material {
-            Some(name) => vec![lookup(format!("{field}.material"), name)?; obj.indices.len()],
+        let triangle_materials: Vec<u32> = match material {
+            Some(id) => vec![id; obj.indices.len()],
             None => {
                 // The OBJ's own materials, named FILE:NAME; faces without one get a
                 // light gray diffuse material.

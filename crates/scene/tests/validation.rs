@@ -66,6 +66,9 @@ fn each_kind_of_bad_input_has_its_own_message() {
         ("reflectivity above one", format!("{CAMERA}[materials.m]\ndiffuse = [1, 1, 1]\nreflectivity = 1.5\n")),
         ("max depth above the limit", format!("{CAMERA}[render]\nmax_depth = 1000\n")),
         ("box with five face materials", format!("{CAMERA}{MATERIAL}[[box]]\nmin = [0, 0, 0]\nmax = [1, 1, 1]\nface_materials = [\"m\", \"m\", \"m\", \"m\", \"m\"]\n")),
+        ("missing mesh file", format!("{CAMERA}[[mesh]]\nfile = \"no/such.obj\"\n")),
+        ("mesh with zero scale", format!("{CAMERA}[[mesh]]\nfile = \"x.obj\"\nscale = [1, 0, 1]\n")),
+        ("mesh with an unknown material", format!("{CAMERA}{MATERIAL}[[mesh]]\nfile = \"x.obj\"\nmaterial = \"mm\"\n")),
         ("zero tile size", format!("{CAMERA}{MATERIAL}[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\ntile_size = 0\nmaterial = \"m\"\n")),
     ];
     let mut report = String::new();
@@ -158,4 +161,48 @@ fn image_paths_are_relative_to_the_scene_file_and_loaded_once() {
     );
     assert_eq!(m.uv_transform.scale, glam::Vec2::new(2.0, 3.0));
     assert_eq!(m.uv_transform.offset, glam::Vec2::new(0.5, 0.0));
+}
+
+#[test]
+fn meshes_load_with_their_materials_and_bad_files_get_located_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, body: &str| std::fs::write(dir.path().join(name), body).unwrap();
+    write(
+        "tri.mtl",
+        "newmtl shiny\nKd 0.2 0.4 0.6\nKs 0.5 0.5 0.5\nNs 50\n",
+    );
+    write(
+        "tri.obj",
+        "mtllib tri.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl shiny\nf 1 2 3\nusemtl missing\nf 2 4 3\n",
+    );
+    write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n");
+    write("empty.obj", "v 0 0 0\n");
+    let scene = |mesh: &str| {
+        let path = dir.path().join("scene.toml");
+        std::fs::write(&path, format!("{CAMERA}[[mesh]]\n{mesh}")).unwrap();
+        glint_scene::load(&path)
+    };
+    let d = scene("file = \"tri.obj\"\ntranslate = [0, 0, -2]\nrotate = [0, 90, 0]\nscale = 2\n")
+        .unwrap();
+    let mesh = &d.scene.shapes.meshes()[0];
+    assert_eq!(mesh.triangle_count(), 2);
+    // Scaled by 2, turned 90° about y (x → −z), moved to z = −2.
+    let [a, b, _] = mesh.corners(0);
+    assert!((a - glam::Vec3::new(0.0, 0.0, -2.0)).length() < 1e-5, "{a}");
+    assert!((b - glam::Vec3::new(0.0, 0.0, -4.0)).length() < 1e-5, "{b}");
+    let names = &d.material_names;
+    assert!(names.iter().any(|n| n == "tri.obj:shiny"), "{names:?}");
+    assert!(
+        names.iter().any(|n| n == "(default mesh material)"),
+        "{names:?}"
+    );
+    let per_triangle = &d.scene.mesh_materials[0];
+    let shiny = &d.scene.materials[per_triangle[0] as usize];
+    assert_eq!(shiny.shininess, 50.0);
+    assert_ne!(per_triangle[0], per_triangle[1]);
+
+    let e = scene("file = \"bad.obj\"\n").unwrap_err().to_string();
+    assert!(e.contains("mesh[0].file") && e.contains("bad.obj"), "{e}");
+    let e = scene("file = \"empty.obj\"\n").unwrap_err().to_string();
+    assert!(e.contains("mesh[0].file") && e.contains("no faces"), "{e}");
 }

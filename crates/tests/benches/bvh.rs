@@ -2,7 +2,8 @@
 //! meshes of 10k to 4M triangles, for coherent (camera) and incoherent (random)
 //! rays, on every core.
 //!
-//! `cargo bench -p glint-tests --bench bvh`
+//! `cargo bench -p glint-tests --bench bvh [-- TRIANGLES...]` (default: 10k, 100k,
+//! 1M and 4M triangles)
 //!
 //! Each figure is the median of 3 runs. Rays are traced in parallel (rayon) over
 //! batches; the rays themselves are made before the clock starts.
@@ -21,7 +22,16 @@ fn main() {
         "| triangles | BVH build | coherent rays/s | incoherent rays/s | incoherent µs/ray (one core) |"
     );
     println!("|---|---|---|---|---|");
-    for triangles in [10_000, 100_000, 1_000_000, 4_000_000] {
+    let sizes: Vec<usize> = std::env::args()
+        .skip(1)
+        .filter_map(|a| a.parse().ok())
+        .collect();
+    let sizes = if sizes.is_empty() {
+        vec![10_000, 100_000, 1_000_000, 4_000_000]
+    } else {
+        sizes
+    };
+    for triangles in sizes {
         let mesh = displaced_grid(triangles);
         let actual = mesh.triangle_count();
         let mut list = ShapeList::new();

@@ -14,6 +14,19 @@ fn cornell(set: u32) -> SceneDescription {
     load(&scene_path(&format!("cornell-set{set}"))).unwrap()
 }
 
+/// Every pixel's RGB, rounded to five significant digits, one line per pixel.
+fn pixel_table(film: &Film) -> String {
+    let mut s = String::new();
+    let size = film.resolution();
+    for y in 0..size.y {
+        for x in 0..size.x {
+            let p = film.pixel(x, y);
+            writeln!(s, "({x:2},{y:2}) {} {} {}", sig5(p.x), sig5(p.y), sig5(p.z)).unwrap();
+        }
+    }
+    s
+}
+
 /// Renders a loaded scene at another resolution, with its settings changed by `tweak`.
 fn render_at(
     d: &SceneDescription,
@@ -108,14 +121,7 @@ fn cornell_set1_16x16_render_snapshot() {
         (s.spp, s.pixel_pattern) = (4, SamplePattern::Grid);
         (s.light_samples, s.light_pattern) = (4, SamplePattern::Grid);
     });
-    let mut s = String::new();
-    for y in 0..16 {
-        for x in 0..16 {
-            let p = film.pixel(x, y);
-            writeln!(s, "({x:2},{y:2}) {} {} {}", sig5(p.x), sig5(p.y), sig5(p.z)).unwrap();
-        }
-    }
-    insta::assert_snapshot!(s);
+    insta::assert_snapshot!(pixel_table(&film));
 }
 
 #[test]
@@ -171,12 +177,5 @@ fn environment_16x16_render_snapshot() {
         (s.spp, s.pixel_pattern) = (4, SamplePattern::Grid);
         s.environment_samples = 4;
     });
-    let mut s = String::new();
-    for y in 0..16 {
-        for x in 0..16 {
-            let p = film.pixel(x, y);
-            writeln!(s, "({x:2},{y:2}) {} {} {}", sig5(p.x), sig5(p.y), sig5(p.z)).unwrap();
-        }
-    }
-    insta::assert_snapshot!(s);
+    insta::assert_snapshot!(pixel_table(&film));
 }

@@ -3,6 +3,9 @@ use crate::triangle::WatertightRay;
 use crate::{Hit, Ray, Shape, TriangleMesh};
 use glam::Vec3;
 
+/// Below this many primitives [`ShapeList::build_acceleration`] builds no BVH.
+pub const LINEAR_LIMIT: usize = 32;
+
 /// What an object index names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Object {
@@ -103,6 +106,25 @@ impl ShapeList {
         self.objects.is_empty()
     }
 
+    /// Builds the BVH if the scene is large enough for it to pay: below
+    /// [`LINEAR_LIMIT`] primitives the linear loop is faster (and gives the same
+    /// answers), so none is built.
+    pub fn build_acceleration(&mut self) {
+        let primitives: usize = self
+            .objects
+            .iter()
+            .map(|o| match *o {
+                Object::Shape(_) => 1,
+                Object::Mesh(m) => self.meshes[m as usize].triangle_count(),
+            })
+            .sum();
+        if primitives >= LINEAR_LIMIT {
+            self.build_bvh();
+        } else {
+            self.bvh = None;
+        }
+    }
+
     /// Builds the BVH over every bounded primitive (binned SAH; see [`Bvh`]).
     pub fn build_bvh(&mut self) {
         let mut primitives = Vec::new();
@@ -147,7 +169,13 @@ impl ShapeList {
 
     /// The hit distance of the BVH's primitive at leaf position `k`.
     #[inline]
-    fn slot_distance(&self, k: u32, ray: &Ray, watertight: &WatertightRay, t_max: f32) -> Option<f32> {
+    fn slot_distance(
+        &self,
+        k: u32,
+        ray: &Ray,
+        watertight: &WatertightRay,
+        t_max: f32,
+    ) -> Option<f32> {
         let p = self.primitives[k as usize];
         match self.objects[p.object as usize] {
             Object::Shape(s) => self.shapes[s as usize].hit_distance(ray, t_max),
@@ -232,9 +260,9 @@ impl ShapeList {
 
     /// Whether anything lies on the ray with `0 < t < t_max` (shadow query).
     pub fn any_hit(&self, ray: &Ray, t_max: f32) -> bool {
-        let watertight = WatertightRay::new(ray);
         match &self.bvh {
             Some(bvh) => {
+                let watertight = WatertightRay::new(ray);
                 self.unbounded.iter().any(|&object| {
                     let p = Primitive {
                         object,
@@ -246,10 +274,22 @@ impl ShapeList {
                     self.slot_distance(i, ray, &watertight, t_max).is_some()
                 })
             }
-            None => self.all_primitives().any(|p| {
-                self.primitive_distance(p, ray, &watertight, t_max)
-                    .is_some()
-            }),
+            // Without meshes the objects are the shapes, in order: the course's loop.
+            None if self.meshes.is_empty() => self
+                .shapes
+                .iter()
+                .any(|s| s.hit_distance(ray, t_max).is_some()),
+            None => {
+                let watertight = WatertightRay::new(ray);
+                self.objects.iter().any(|object| match *object {
+                    Object::Shape(s) => self.shapes[s as usize].hit_distance(ray, t_max).is_some(),
+                    Object::Mesh(m) => {
+                        let mesh = &self.meshes[m as usize];
+                        (0..mesh.triangle_count() as u32)
+                            .any(|t| mesh.hit_distance(t, &watertight, t_max).is_some())
+                    }
+                })
+            }
         }
     }
 

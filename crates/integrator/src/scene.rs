@@ -165,7 +165,7 @@ impl SceneBuilder {
                 });
             }
         }
-        self.shapes.build_bvh();
+        self.shapes.build_acceleration();
         Ok(Scene {
             camera,
             shapes: self.shapes,

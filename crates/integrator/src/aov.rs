@@ -5,7 +5,7 @@ use crate::direct::texture_footprint;
 use crate::{Scene, SurfaceKind};
 use glam::Vec3;
 use glint_camera::Film;
-use glint_geometry::{reflect, Ray, RayDifferential};
+use glint_geometry::{reflect, Hit, Ray, RayDifferential};
 use glint_lighting::Light;
 use glint_texture::srgb_to_linear;
 
@@ -75,7 +75,9 @@ impl Aov {
             Aov::MipLevel => Vec3::splat(material.map_or(0.0, |m| {
                 m.diffuse_mip_level(&texture_footprint(m, &hit, diff))
             })),
-            Aov::ReflectionDepth => Vec3::splat(reflection_depth(scene, *ray, max_depth) as f32),
+            Aov::ReflectionDepth => {
+                Vec3::splat(reflection_depth(scene, *ray, hit, max_depth) as f32)
+            }
             Aov::Albedo => match surface {
                 SurfaceKind::Material(m) => m.reflectances(&texture_footprint(m, &hit, diff)).0,
                 SurfaceKind::Emitter(Light::Area(a)) => a.color,
@@ -112,13 +114,12 @@ impl Aov {
     }
 }
 
-/// The number of mirror reflections along the path of `ray`.
-fn reflection_depth(scene: &Scene, mut ray: Ray, max_depth: u32) -> u32 {
+/// The number of mirror reflections along the path of `ray`, whose first hit is
+/// `first`.
+fn reflection_depth(scene: &Scene, mut ray: Ray, first: Hit, max_depth: u32) -> u32 {
+    let mut hit = first;
     let mut depth = 0;
     while depth < max_depth {
-        let Some(hit) = scene.shapes.closest_hit(&ray, f32::INFINITY) else {
-            break;
-        };
         let reflective = match scene.surface_of(&hit) {
             SurfaceKind::Material(m) => m.reflectivity > 0.0,
             SurfaceKind::Emitter(_) => false,
@@ -129,6 +130,10 @@ fn reflection_depth(scene: &Scene, mut ray: Ray, max_depth: u32) -> u32 {
         let wo = -ray.direction.normalize();
         ray = glint_geometry::spawn_ray(&hit, reflect(wo, hit.facing_normal(ray.direction)));
         depth += 1;
+        match scene.shapes.closest_hit(&ray, f32::INFINITY) {
+            Some(next) => hit = next,
+            None => break,
+        }
     }
     depth
 }

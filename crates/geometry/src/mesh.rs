@@ -81,6 +81,28 @@ impl TriangleMesh {
         })
     }
 
+    /// The triangles of a grid of `columns × rows` quads whose `(columns + 1) ×
+    /// (rows + 1)` vertices are stored row by row: two triangles per quad, wound
+    /// counter-clockwise seen from the side where rows grow towards the viewer
+    /// (for vertices in x, z with z = row, the normal is +y).
+    pub fn grid_indices(columns: u32, rows: u32) -> Vec<[u32; 3]> {
+        let row = columns + 1;
+        let mut indices = Vec::with_capacity(2 * columns as usize * rows as usize);
+        for j in 0..rows {
+            for i in 0..columns {
+                let (a, b, c, d) = (
+                    j * row + i,
+                    j * row + i + 1,
+                    (j + 1) * row + i,
+                    (j + 1) * row + i + 1,
+                );
+                indices.push([a, c, b]);
+                indices.push([b, c, d]);
+            }
+        }
+        indices
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.indices.len()
     }

@@ -426,20 +426,7 @@ mod bvh_agreement {
                 );
             }
         }
-        let row = 2 * n + 1;
-        let mut indices = Vec::new();
-        for j in 0..n {
-            for i in 0..2 * n {
-                let (a, b, c, d) = (
-                    j * row + i,
-                    j * row + i + 1,
-                    (j + 1) * row + i,
-                    (j + 1) * row + i + 1,
-                );
-                indices.push([a, c, b]);
-                indices.push([b, c, d]);
-            }
-        }
+        let indices = TriangleMesh::grid_indices(2 * n, n);
         TriangleMesh::new(positions, indices, vec![], vec![]).unwrap()
     }
 

@@ -46,19 +46,6 @@ pub fn displaced_grid(triangles: usize) -> glint_geometry::TriangleMesh {
             positions.push(Vec3::new(x, height(x, z), z));
         }
     }
-    let row = n + 1;
-    let mut indices = Vec::with_capacity((2 * n * n) as usize);
-    for j in 0..n {
-        for i in 0..n {
-            let (a, b, c, d) = (
-                j * row + i,
-                j * row + i + 1,
-                (j + 1) * row + i,
-                (j + 1) * row + i + 1,
-            );
-            indices.push([a, c, b]);
-            indices.push([b, c, d]);
-        }
-    }
+    let indices = glint_geometry::TriangleMesh::grid_indices(n, n);
     glint_geometry::TriangleMesh::new(positions, indices, vec![], vec![]).expect("a valid grid")
 }

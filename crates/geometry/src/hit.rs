@@ -29,13 +29,43 @@ pub struct Hit {
 }
 
 impl Hit {
-    /// The shading normal flipped, if need be, to face back along `direction`
-    /// (the side the ray came from).
+    /// The shading normal turned, if need be, to the side the ray came from,
+    /// that side decided by the *geometric* normal: at a silhouette an
+    /// interpolated normal can face away while the surface itself faces the ray.
+    /// (Shapes keep the shading normal on the geometric normal's side.)
     pub fn facing_normal(&self, direction: Vec3) -> Vec3 {
-        if self.shading_normal.dot(direction) > 0.0 {
+        if self.geometric_normal.dot(direction) > 0.0 {
             -self.shading_normal
         } else {
             self.shading_normal
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_facing_side_is_decided_by_the_geometric_normal() {
+        // At a silhouette the interpolated normal can face away from the viewer
+        // while the triangle faces it: the surface is still seen from the front.
+        let hit = Hit {
+            t: 1.0,
+            point: Vec3::ZERO,
+            geometric_normal: Vec3::Z,
+            shading_normal: Vec3::new(0.0, 0.9, -0.1).normalize(),
+            uv: Vec2::ZERO,
+            dpdu: Vec3::X,
+            dpdv: Vec3::Y,
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
+            front_face: true,
+            shape: 0,
+            primitive: 0,
+        };
+        let towards_surface = -Vec3::Z;
+        assert_eq!(hit.facing_normal(towards_surface), hit.shading_normal);
+        assert_eq!(hit.facing_normal(Vec3::Z), -hit.shading_normal);
     }
 }

@@ -134,11 +134,13 @@ impl TriangleMesh {
 
     /// The same mesh with angle-weighted vertex normals (Thürmer and Wüthrich,
     /// "Computing Vertex Normals from Polygonal Facets", JGT 1998): each face adds
-    /// its unit normal times its corner angle to its three vertices. Degenerate
-    /// faces add nothing; a vertex with no valid face keeps a zero normal and falls
-    /// back to the face normal when shaded.
+    /// its unit normal times its corner angle to its three vertices. Vertices at the
+    /// same position share the sum (an OBJ's objects and material groups split
+    /// vertices, which would otherwise show seams). Degenerate faces add nothing; a
+    /// vertex with no valid face keeps a zero normal and is shaded flat.
     pub fn with_angle_weighted_normals(mut self) -> Self {
-        let mut normals = vec![Vec3::ZERO; self.positions.len()];
+        let key = |p: Vec3| p.to_array().map(f32::to_bits);
+        let mut sums: std::collections::HashMap<[u32; 3], Vec3> = std::collections::HashMap::new();
         for tri in &self.indices {
             let p = tri.map(|v| self.positions[v as usize]);
             let Some(n) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
@@ -148,17 +150,30 @@ impl TriangleMesh {
                 let (e1, e2) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
                 let angle = e1.angle_between(e2);
                 if angle.is_finite() {
-                    normals[tri[k] as usize] += angle * n;
+                    *sums.entry(key(p[k])).or_default() += angle * n;
                 }
             }
         }
-        self.normals = normals.into_iter().map(|n| n.normalize_or_zero()).collect();
+        self.normals = self
+            .positions
+            .iter()
+            .map(|p| {
+                sums.get(&key(*p))
+                    .copied()
+                    .unwrap_or_default()
+                    .normalize_or_zero()
+            })
+            .collect();
         self
     }
 
-    /// The mesh under an affine transform; normals by the inverse transpose.
+    /// The mesh under an affine transform; normals by the inverse transpose. A
+    /// mirroring transform (negative determinant, e.g. one negative scale) also
+    /// reverses each triangle's winding, so that geometric normals keep pointing
+    /// the way they did.
     pub fn transformed(&self, m: &Affine3A) -> Self {
         let normal_matrix: Mat3 = Mat3::from(m.matrix3).inverse().transpose();
+        let mirrored = m.matrix3.determinant() < 0.0;
         Self {
             positions: self
                 .positions
@@ -171,8 +186,23 @@ impl TriangleMesh {
                 .map(|n| (normal_matrix * *n).normalize_or_zero())
                 .collect(),
             uvs: self.uvs.clone(),
-            indices: self.indices.clone(),
+            indices: if mirrored {
+                self.indices.iter().map(|&[a, b, c]| [a, c, b]).collect()
+            } else {
+                self.indices.clone()
+            },
         }
+    }
+
+    /// The largest coordinate magnitude of any vertex (∞ or NaN if one is not finite).
+    pub fn max_coordinate(&self) -> f32 {
+        self.positions.iter().fold(0.0f32, |m, p| {
+            if p.is_finite() {
+                m.max(p.abs().max_element())
+            } else {
+                f32::INFINITY
+            }
+        })
     }
 
     /// The hit distance of triangle `i` in (0, t_max), if any.
@@ -189,7 +219,13 @@ impl TriangleMesh {
         let tri = self.indices[i as usize];
         // The barycentric point is more accurate than o + t·d.
         let point = bary[0] * a + bary[1] * b + bary[2] * c;
-        let face = (b - a).cross(c - a).normalize();
+        // Normalising the edges first keeps tiny (but hit) triangles from
+        // underflowing to a zero cross product.
+        let face = (b - a)
+            .normalize_or_zero()
+            .cross((c - a).normalize_or_zero())
+            .try_normalize()
+            .unwrap_or(Vec3::Z);
         let uv_at = |k: usize| -> Vec2 {
             if self.uvs.is_empty() {
                 [Vec2::ZERO, Vec2::X, Vec2::Y][k]
@@ -314,7 +350,7 @@ mod tests {
         assert!((hit.point - Vec3::new(0.25, 0.6, 0.0)).length() < 1e-6);
         assert!((hit.uv - Vec2::new(0.25, 0.6)).length() < 1e-6);
         assert!((hit.dpdu - Vec3::X).length() < 1e-6 && (hit.dpdv - Vec3::Y).length() < 1e-6);
-        assert_eq!(hit.geometric_normal, Vec3::Z);
+        assert!((hit.geometric_normal - Vec3::Z).length() < 1e-6);
         assert!(hit.front_face);
     }
 
@@ -337,6 +373,21 @@ mod tests {
     }
 
     #[test]
+    fn a_mirroring_transform_keeps_faces_pointing_outwards() {
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let idx = vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+        let tetra = TriangleMesh::new(p, idx, vec![], vec![]).unwrap();
+        let mirror = Affine3A::from_scale(Vec3::new(-1.0, 2.0, 1.0));
+        let t = tetra.transformed(&mirror);
+        let centre = mirror.transform_point3(Vec3::splat(0.25));
+        for i in 0..4 {
+            let [a, b, c] = t.corners(i);
+            let outward = (b - a).cross(c - a).dot((a + b + c) / 3.0 - centre);
+            assert!(outward > 0.0, "triangle {i} points inwards");
+        }
+    }
+
+    #[test]
     fn transforms_move_points_and_keep_normals_perpendicular() {
         let mesh = quad().with_angle_weighted_normals();
         let m = Affine3A::from_scale_rotation_translation(
@@ -347,7 +398,13 @@ mod tests {
         let t = mesh.transformed(&m);
         assert!((t.positions[1] - m.transform_point3(Vec3::X)).length() < 1e-6);
         let [a, b, c] = t.corners(0);
-        let face = (b - a).cross(c - a).normalize();
+        // Normalising the edges first keeps tiny (but hit) triangles from
+        // underflowing to a zero cross product.
+        let face = (b - a)
+            .normalize_or_zero()
+            .cross((c - a).normalize_or_zero())
+            .try_normalize()
+            .unwrap_or(Vec3::Z);
         assert!((t.normals[0] - face).length() < 1e-5);
     }
 }

@@ -28,7 +28,7 @@ pub enum SurfaceKind<'a> {
 pub struct Scene {
     pub camera: Camera,
     pub shapes: ShapeList,
-    /// `surfaces[i]` describes `shapes.shapes()[i]`.
+    /// `surfaces[i]` describes object `i` of `shapes` (a shape or a mesh).
     pub surfaces: Vec<Surface>,
     pub materials: Vec<PhongMaterial>,
     pub lights: Vec<Light>,

@@ -139,7 +139,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
             .as_ref()
             .map(|name| lookup(format!("{field}.material"), name))
             .transpose()?;
-        let obj = load_obj(&base_dir.join(m.file.get_ref()))
+        let obj = load_obj(&base_dir.join(m.file.get_ref()), material.is_none())
             .map_err(|e| Problem::new(m.file.span(), format!("{field}.file"), e))?;
         let triangle_materials: Vec<u32> = match material {
             Some(id) => vec![id; obj.indices.len()],
@@ -185,7 +185,20 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         let (r, s) = (m.rotate.0 * std::f32::consts::PI / 180.0, m.scale.0);
         let rotation = Quat::from_euler(EulerRot::ZYX, r.z, r.y, r.x);
         let transform = Affine3A::from_scale_rotation_translation(s, rotation, m.translate.0);
-        builder.mesh(mesh.transformed(&transform), triangle_materials);
+        let mesh = mesh.transformed(&transform);
+        let extent = mesh.max_coordinate();
+        if extent.is_nan() || extent > crate::values::MAX_MAGNITUDE {
+            return Err(Problem::new(
+                m.file.span(),
+                format!("{field}.file"),
+                format!(
+                    "{}: after the transform a vertex lies beyond {:e} (or is not finite)",
+                    m.file.get_ref(),
+                    crate::values::MAX_MAGNITUDE
+                ),
+            ));
+        }
+        builder.mesh(mesh, triangle_materials);
     }
     for p in &file.point_light {
         builder.point_light(PointLight {

@@ -3,7 +3,12 @@
 use glam::{Vec2, Vec3};
 use glint_lighting::PhongMaterial;
 use glint_texture::{load_image, ImageTexture, Texture, TextureFilter, TextureImage, WrapMode};
-use std::path::Path;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// The most vertices, and the most triangles, an OBJ file may have.
+pub const MAX_ELEMENTS: usize = 1 << 26;
 
 /// One OBJ file as Glint uses it: all of its triangles in one list, the MTL
 /// material each triangle uses (if any), and those materials as Phong materials.
@@ -23,7 +28,7 @@ pub struct ObjMesh {
 /// (position, normal, uv) triple. MTL materials map to Phong: `Kd` → diffuse
 /// (or `map_Kd`, an image relative to the OBJ, filtered trilinearly), `Ks` →
 /// specular, `Ns` → shininess. Errors are one line naming the file.
-pub fn load_obj(path: &Path) -> Result<ObjMesh, String> {
+pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -35,10 +40,16 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh, String> {
     // A missing or broken MTL file: the faces use the scene's material.
     let materials = materials.unwrap_or_default();
     let base = path.parent().unwrap_or(Path::new(""));
-    let phong = materials
-        .iter()
-        .map(|m| Ok((m.name.clone(), mtl_to_phong(m, base)?)))
-        .collect::<Result<Vec<_>, String>>()?;
+    // MTL images are read only when the scene uses the MTL materials, each once.
+    let mut images = HashMap::new();
+    let phong = if with_materials {
+        materials
+            .iter()
+            .map(|m| Ok((m.name.clone(), mtl_to_phong(m, base, &mut images)?)))
+            .collect::<Result<Vec<_>, String>>()?
+    } else {
+        Vec::new()
+    };
 
     let mut mesh = ObjMesh {
         positions: Vec::new(),
@@ -48,9 +59,19 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh, String> {
         triangle_materials: Vec::new(),
         materials: phong,
     };
+    // Normals and uvs are kept only if every vertex of every object has them (an
+    // OBJ may give them to some faces only); otherwise normals are generated.
     let all_have = |f: fn(&tobj::Mesh) -> bool| models.iter().all(|m| f(&m.mesh));
-    let keep_normals = all_have(|m| !m.normals.is_empty());
-    let keep_uvs = all_have(|m| !m.texcoords.is_empty());
+    let keep_normals = all_have(|m| m.normals.len() == m.positions.len());
+    let keep_uvs = all_have(|m| m.texcoords.len() / 2 == m.positions.len() / 3);
+    let vertices: usize = models.iter().map(|m| m.mesh.positions.len() / 3).sum();
+    let triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    if vertices > MAX_ELEMENTS || triangles > MAX_ELEMENTS {
+        return Err(format!(
+            "{}: {vertices} vertices and {triangles} triangles, more than the limit of {MAX_ELEMENTS}",
+            path.display()
+        ));
+    }
     for model in &models {
         let m = &model.mesh;
         let first = mesh.positions.len() as u32;
@@ -94,17 +115,31 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh, String> {
     Ok(mesh)
 }
 
-fn mtl_to_phong(m: &tobj::Material, base: &Path) -> Result<PhongMaterial, String> {
+fn mtl_to_phong(
+    m: &tobj::Material,
+    base: &Path,
+    images: &mut HashMap<PathBuf, Arc<TextureImage>>,
+) -> Result<PhongMaterial, String> {
     let color = |c: Option<[f32; 3]>, default: Vec3| {
         c.map(Vec3::from_array).unwrap_or(default).max(Vec3::ZERO)
     };
     let kd = color(m.diffuse, Vec3::splat(0.8));
     let diffuse = match &m.diffuse_texture {
         Some(file) => {
-            let image = load_image(&base.join(file))
-                .map_err(|e| format!("material \"{}\": {e}", m.name))?;
+            let path = base.join(file);
+            let image = match images.get(&path) {
+                Some(image) => image.clone(),
+                None => {
+                    let loaded =
+                        load_image(&path).map_err(|e| format!("material \"{}\": {e}", m.name))?;
+                    let image = TextureImage::new(loaded);
+                    images.insert(path, image.clone());
+                    image
+                }
+            };
+            // As in most renderers, map_Kd replaces Kd (rather than scaling it).
             Texture::Image(ImageTexture::new(
-                TextureImage::new(image),
+                image,
                 WrapMode::Repeat,
                 TextureFilter::Trilinear,
             ))
@@ -140,7 +175,7 @@ mod tests {
             "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nusemtl red\nf 1 2 3 4\nf 1 2 5\n",
         )
         .unwrap();
-        let mesh = load_obj(&obj).unwrap();
+        let mesh = load_obj(&obj, true).unwrap();
         assert_eq!(mesh.indices.len(), 3, "a quad is two triangles, plus one");
         assert!(mesh.normals.is_empty() && mesh.uvs.is_empty());
         assert_eq!(mesh.materials.len(), 1);
@@ -150,16 +185,30 @@ mod tests {
         assert_eq!(red.shininess, 30.0);
         assert!(mesh.triangle_materials.iter().all(|m| *m == Some(0)));
 
-        let missing = load_obj(&dir.path().join("nope.obj")).err().unwrap();
+        // Normals on some faces only: dropped (and generated later), not an error.
+        let partial = dir.path().join("partial.obj");
+        std::fs::write(
+            &partial,
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\nf 2 4 3\n",
+        )
+        .unwrap();
+        let p = load_obj(&partial, true).unwrap();
+        assert_eq!(p.indices.len(), 2);
+        assert!(p.normals.is_empty());
+
+        let missing = load_obj(&dir.path().join("nope.obj"), true).err().unwrap();
         assert!(
             missing.contains("nope.obj: cannot read the OBJ file"),
             "{missing}"
         );
         let empty = dir.path().join("empty.obj");
         std::fs::write(&empty, "v 0 0 0\nv 1 0 0\n").unwrap();
-        assert!(load_obj(&empty).err().unwrap().contains("has no faces"));
+        assert!(load_obj(&empty, true)
+            .err()
+            .unwrap()
+            .contains("has no faces"));
         let bad = dir.path().join("bad.obj");
         std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
-        assert!(load_obj(&bad).is_err());
+        assert!(load_obj(&bad, true).is_err());
     }
 }

@@ -5,6 +5,7 @@
 //! Exit status: 0 on success, 2 for bad input (usage, scene file, settings,
 //! output path), 1 for anything else. Errors are one line on stderr.
 
+use clap::builder::TypedValueParser;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::UVec2;
 use glint_camera::ImageFormat;
@@ -83,44 +84,30 @@ struct RenderArgs {
     #[arg(long, value_name = "WxH", value_parser = parse_resolution)]
     resolution: Option<UVec2>,
 
-    /// Filter for every image texture (overrides each texture's `filter`)
-    #[arg(long, value_name = "FILTER")]
-    texture_filter: Option<Filter>,
+    /// Filter for every image texture (overrides each texture's `filter`):
+    /// nearest or bilinear (full resolution), trilinear (the two MIP levels around
+    /// the footprint), ewa (elliptically weighted average, anisotropic)
+    #[arg(long, value_name = "FILTER", value_parser = named(&TextureFilter::NAMES, TextureFilter::from_name))]
+    texture_filter: Option<TextureFilter>,
 
-    /// Write this buffer instead of the shaded image: raw values in .exr/.pfm,
-    /// false color in .png (normals as 0.5·n + 0.5, uv as its fractional part,
-    /// depth as gray from near to far, MIP level and reflection depth as a
-    /// blue-green-red ramp)
-    #[arg(long, value_name = "BUFFER")]
-    aov: Option<AovName>,
+    /// Write this buffer instead of the shaded image: uv (surface coordinates),
+    /// mip-level (the level the diffuse texture is read at), normal, depth
+    /// (distance from the camera), albedo (filtered diffuse color),
+    /// reflection-depth (mirror reflections taken). Raw values in .exr/.pfm, false
+    /// color in .png (normals as 0.5·n + 0.5, uv as its fractional part, depth as
+    /// gray from near to far, MIP level and reflection depth as a blue-green-red ramp)
+    #[arg(long, value_name = "BUFFER", value_parser = named(&Aov::NAMES, Aov::from_name))]
+    aov: Option<Aov>,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum Filter {
-    /// The texel under the point, full resolution
-    Nearest,
-    /// Bilinear at full resolution
-    Bilinear,
-    /// Bilinear in the two MIP levels around the footprint, blended
-    Trilinear,
-    /// Elliptically weighted average over the footprint (anisotropic)
-    Ewa,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum AovName {
-    /// Surface texture coordinates (u, v, 0)
-    Uv,
-    /// The MIP level the diffuse texture is read at
-    MipLevel,
-    /// Shading normal
-    Normal,
-    /// Distance from the camera
-    Depth,
-    /// Filtered diffuse color
-    Albedo,
-    /// How many mirror reflections the path took
-    ReflectionDepth,
+/// A clap parser for one of the library's named values: the names are its own
+/// list (so help and errors show them), the value its own `from_name`.
+fn named<T: Clone + Send + Sync + 'static>(
+    names: &'static [&'static str],
+    from_name: fn(&str) -> Option<T>,
+) -> impl TypedValueParser<Value = T> {
+    clap::builder::PossibleValuesParser::new(names)
+        .map(move |name: String| from_name(&name).expect("clap accepted only listed names"))
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -218,7 +205,7 @@ fn render(args: &RenderArgs) -> Result<(), Failure> {
     } = glint_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
     apply_overrides(args, &mut settings);
     if let Some(filter) = args.texture_filter {
-        scene.override_texture_filter(texture_filter(filter));
+        scene.override_texture_filter(filter);
     }
     if let Some(resolution) = args.resolution {
         scene.camera = scene
@@ -337,24 +324,8 @@ fn apply_overrides(args: &RenderArgs, settings: &mut RenderSettings) {
     if args.threads.is_some() {
         settings.threads = args.threads;
     }
-    if let Some(aov) = args.aov {
-        settings.aov = Some(match aov {
-            AovName::Uv => Aov::Uv,
-            AovName::MipLevel => Aov::MipLevel,
-            AovName::Normal => Aov::Normal,
-            AovName::Depth => Aov::Depth,
-            AovName::Albedo => Aov::Albedo,
-            AovName::ReflectionDepth => Aov::ReflectionDepth,
-        });
-    }
-}
-
-fn texture_filter(filter: Filter) -> TextureFilter {
-    match filter {
-        Filter::Nearest => TextureFilter::Nearest,
-        Filter::Bilinear => TextureFilter::Bilinear,
-        Filter::Trilinear => TextureFilter::Trilinear,
-        Filter::Ewa => TextureFilter::Ewa,
+    if args.aov.is_some() {
+        settings.aov = args.aov;
     }
 }
 

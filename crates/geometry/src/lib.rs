@@ -34,6 +34,7 @@ mod shape;
 mod shape_list;
 mod sphere;
 pub mod triangle;
+pub mod triangle_packet;
 
 pub use aabox::AaBox;
 pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceDifferentials};
@@ -44,5 +45,6 @@ pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use ray::Ray;
 pub use shape::Shape;
-pub use shape_list::{ObjectRef, ShapeList};
+pub use shape_list::{ObjectRef, PrimitiveHit, ShapeList};
 pub use sphere::Sphere;
+pub use triangle_packet::TrianglePacket;

@@ -1,7 +1,8 @@
-use crate::bvh::{Bounds3, Bvh, BvhStats};
+use crate::bvh::{Bounds3, Bvh, BvhStats, LEAF_WIDTH};
 use crate::triangle::WatertightRay;
-use crate::{Hit, Ray, Shape, TriangleMesh};
-use glam::Vec3;
+use crate::{Hit, Ray, Shape, TriangleMesh, TrianglePacket};
+use glam::Vec4;
+use std::ops::ControlFlow;
 
 /// Below this many primitives [`ShapeList::build_acceleration`] builds no BVH.
 pub const LINEAR_LIMIT: usize = 32;
@@ -27,6 +28,38 @@ struct Primitive {
     triangle: u32,
 }
 
+/// A candidate for the closest hit: a primitive, or a position in the BVH's leaf
+/// order, looked up only when needed.
+#[derive(Clone, Copy, Debug)]
+enum Found {
+    Primitive(Primitive),
+    Slot(u32),
+}
+
+/// The closest hit as [`ShapeList::closest_primitive`] reports it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimitiveHit {
+    /// Distance along the ray, in multiples of its direction.
+    pub t: f32,
+    /// The object hit, as [`crate::Hit::shape`].
+    pub object: u32,
+    /// The triangle of a mesh hit (0 for a shape), as [`crate::Hit::primitive`].
+    pub primitive: u32,
+}
+
+impl Primitive {
+    /// The order of the tie rule: object, then triangle.
+    fn key(self) -> (u32, u32) {
+        (self.object, self.triangle)
+    }
+
+    /// What fills the BVH's leaf order where a leaf is padded.
+    const PADDING: Primitive = Primitive {
+        object: u32::MAX,
+        triangle: u32::MAX,
+    };
+}
+
 /// Every object of a scene — analytic shapes and triangle meshes — and the two
 /// queries the integrator asks of them: [`ShapeList::closest_hit`] and
 /// [`ShapeList::any_hit`].
@@ -43,11 +76,15 @@ pub struct ShapeList {
     meshes: Vec<TriangleMesh>,
     objects: Vec<Object>,
     bvh: Option<Bvh>,
-    /// The BVH's primitives in its leaf order (so a leaf's are adjacent)…
+    /// The BVH's primitives in its padded leaf order (a leaf's adjacent, each
+    /// leaf's run [`LEAF_WIDTH`] long, [`Primitive::PADDING`] in the gaps)…
     primitives: Vec<Primitive>,
-    /// …and, for triangles, their corners in the same order: one contiguous read
-    /// per triangle test instead of an index triple and three vertices.
-    corners: Vec<[Vec3; 3]>,
+    /// …one packet per leaf with its triangles' corners (NaN in lanes holding an
+    /// analytic shape or padding): a leaf's triangles are one contiguous read and
+    /// one four-wide test…
+    packets: Vec<TrianglePacket>,
+    /// …and per leaf, the lanes holding analytic shapes, tested one by one.
+    shape_lanes: Vec<u8>,
     unbounded: Vec<u32>,
 }
 
@@ -155,35 +192,72 @@ impl ShapeList {
         }
         let mut bvh = Bvh::build(&bounds);
         let order = bvh.take_primitive_order();
-        self.primitives = order.iter().map(|&i| primitives[i as usize]).collect();
-        self.corners = self
-            .primitives
+        self.primitives = order
             .iter()
-            .map(|p| match self.objects[p.object as usize] {
-                Object::Mesh(m) => self.meshes[m as usize].corners(p.triangle),
-                Object::Shape(_) => [Vec3::ZERO; 3],
+            .map(|&i| {
+                primitives
+                    .get(i as usize)
+                    .copied()
+                    .unwrap_or(Primitive::PADDING)
+            })
+            .collect();
+        let leaves = self.primitives.chunks_exact(LEAF_WIDTH);
+        self.packets = leaves.clone().map(|leaf| self.packet_of(leaf)).collect();
+        self.shape_lanes = leaves
+            .map(|leaf| {
+                leaf.iter().enumerate().fold(0u8, |lanes, (lane, p)| {
+                    match self.objects.get(p.object as usize) {
+                        Some(Object::Shape(_)) => lanes | 1 << lane,
+                        _ => lanes,
+                    }
+                })
             })
             .collect();
         self.bvh = Some(bvh);
     }
 
-    /// The hit distance of the BVH's primitive at leaf position `k`.
+    /// The triangles of one leaf as a packet; other lanes NaN.
+    fn packet_of(&self, leaf: &[Primitive]) -> TrianglePacket {
+        let mut packet = TrianglePacket::EMPTY;
+        for (lane, p) in leaf.iter().enumerate() {
+            if let Some(Object::Mesh(m)) = self.objects.get(p.object as usize) {
+                let corners = self.meshes[*m as usize].corners(p.triangle);
+                for (vertex, corner) in packet.corners.iter_mut().zip(corners) {
+                    for (axis, lanes) in vertex.iter_mut().enumerate() {
+                        lanes[lane] = corner[axis];
+                    }
+                }
+            }
+        }
+        packet
+    }
+
+    /// The hits of the leaf at `first` (a multiple of [`LEAF_WIDTH`]) in
+    /// (0, t_max): bit `k` of the mask for the primitive at `first + k`, lane `k`
+    /// its distance. Triangles are tested four at a time, shapes one by one.
     #[inline]
-    fn slot_distance(
+    fn leaf_hits(
         &self,
-        k: u32,
+        first: u32,
         ray: &Ray,
         watertight: &WatertightRay,
         t_max: f32,
-    ) -> Option<f32> {
-        let p = self.primitives[k as usize];
-        match self.objects[p.object as usize] {
-            Object::Shape(s) => self.shapes[s as usize].hit_distance(ray, t_max),
-            Object::Mesh(_) => {
-                let [a, b, c] = self.corners[k as usize];
-                watertight.intersect(a, b, c, t_max).map(|(t, _)| t)
+    ) -> (u32, Vec4) {
+        let leaf = first as usize / LEAF_WIDTH;
+        let (mut hits, mut t) = watertight.intersect4(&self.packets[leaf], t_max);
+        let mut shapes = self.shape_lanes[leaf];
+        while shapes != 0 {
+            let lane = shapes.trailing_zeros() as usize;
+            shapes &= shapes - 1;
+            let p = self.primitives[first as usize + lane];
+            if let Object::Shape(s) = self.objects[p.object as usize] {
+                if let Some(d) = self.shapes[s as usize].hit_distance(ray, t_max) {
+                    hits |= 1 << lane;
+                    t[lane] = d;
+                }
             }
         }
+        (hits, t)
     }
 
     /// Statistics of the BVH, once built.
@@ -191,74 +265,96 @@ impl ShapeList {
         self.bvh.as_ref().map(Bvh::stats)
     }
 
-    /// The nearest hit with `0 < t < t_max`, if any. Hits at exactly the same
-    /// distance (a ray through an edge where two surfaces meet) go to the lowest
-    /// object index, then the lowest triangle: the same answer with or without the
-    /// BVH, whatever its layout.
+    /// The nearest hit with `0 < t < t_max`, if any, with its surface record.
+    /// Hits at exactly the same distance (a ray through an edge where two surfaces
+    /// meet) go to the lowest object index, then the lowest triangle: the same
+    /// answer with or without the BVH, whatever its layout.
     pub fn closest_hit(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        // (Only triangle tests read it; a few divisions per query.)
-        let watertight = WatertightRay::new(ray);
-        let mut best: Option<(f32, Primitive)> = None;
-        // A candidate at distance t (found below the current best's t, or equal to
-        // it) becomes the best if nearer, or as near with a lower (object, triangle).
-        let consider = |p: Primitive, t: f32, best: &mut Option<(f32, Primitive)>| {
-            let better = match *best {
-                None => true,
-                Some((bt, bp)) => {
-                    t < bt || (t == bt && (p.object, p.triangle) < (bp.object, bp.triangle))
-                }
-            };
-            if better {
-                *best = Some((t, p));
-            }
-            better
-        };
-        let limit = |best: &Option<(f32, Primitive)>| best.map_or(t_max, |(t, _)| t.next_up());
-        match &self.bvh {
-            Some(_) => {
-                for &object in &self.unbounded {
-                    let p = Primitive {
-                        object,
-                        triangle: 0,
-                    };
-                    if let Some(t) = self.primitive_distance(p, ray, &watertight, limit(&best)) {
-                        consider(p, t, &mut best);
-                    }
-                }
-            }
-            None => {
-                for p in self.all_primitives() {
-                    if let Some(t) = self.primitive_distance(p, ray, &watertight, limit(&best)) {
-                        consider(p, t, &mut best);
-                    }
-                }
-            }
-        }
-        if let Some(bvh) = &self.bvh {
-            // The BVH prunes with the distance it is given; the closure keeps the
-            // tie rule and reports only primitives that became the best.
-            let start = limit(&best);
-            bvh.closest_hit(ray, start, |i, ray, _| {
-                let t = self.slot_distance(i, ray, &watertight, limit(&best))?;
-                // Report just past t, so that nodes entered exactly at t (which may
-                // hold a lower-index primitive at the same distance) are visited.
-                consider(self.primitives[i as usize], t, &mut best).then_some(t.next_up())
-            });
-        }
-        let (t, p) = best?;
-        let hit = match self.objects[p.object as usize] {
-            Object::Shape(s) => Some(self.shapes[s as usize].surface_at(ray, t)),
+        let found = self.closest_primitive(ray, t_max)?;
+        let hit = match self.objects[found.object as usize] {
+            Object::Shape(s) => Some(self.shapes[s as usize].surface_at(ray, found.t)),
             // Re-run the (same, deterministic) test for the barycentrics. Without an
             // upper limit: the test compares T < t_max·det before dividing, and
             // t = T/det rounded can make t_max·det fall just below T, turning a
             // found hit into a miss.
-            Object::Mesh(m) => self.meshes[m as usize].surface_at(p.triangle, ray, f32::INFINITY),
+            Object::Mesh(m) => {
+                self.meshes[m as usize].surface_at(found.primitive, ray, f32::INFINITY)
+            }
         }?;
         Some(Hit {
-            shape: p.object,
-            primitive: p.triangle,
+            shape: found.object,
+            primitive: found.primitive,
             ..hit
         })
+    }
+
+    /// The nearest hit with `0 < t < t_max` as [`ShapeList::closest_hit`] finds
+    /// it, without its surface record: which primitive, and where along the ray.
+    pub fn closest_primitive(&self, ray: &Ray, t_max: f32) -> Option<PrimitiveHit> {
+        // (Only triangle tests read it; a few divisions per query.)
+        let watertight = WatertightRay::new(ray);
+        let mut best: Option<(f32, Found)> = None;
+        // A candidate at distance t (found below the current best's t, or equal to
+        // it) becomes the best if nearer, or as near with a lower (object,
+        // triangle). Only ties read which primitive a BVH slot holds.
+        let consider = |found: Found, t: f32, best: &mut Option<(f32, Found)>| {
+            let better = match *best {
+                None => true,
+                Some((bt, bf)) => {
+                    t < bt || (t == bt && self.resolve(found).key() < self.resolve(bf).key())
+                }
+            };
+            if better {
+                *best = Some((t, found));
+            }
+        };
+        let limit = |best: &Option<(f32, Found)>| best.map_or(t_max, |(t, _)| t.next_up());
+        // Without a BVH every primitive is tested here; with one, the planes.
+        let mut test = |p: Primitive| {
+            if let Some(t) = self.primitive_distance(p, ray, &watertight, limit(&best)) {
+                consider(Found::Primitive(p), t, &mut best);
+            }
+        };
+        match &self.bvh {
+            Some(_) => self.unbounded.iter().for_each(|&object| {
+                test(Primitive {
+                    object,
+                    triangle: 0,
+                })
+            }),
+            None => self.all_primitives().for_each(test),
+        }
+        if let Some(bvh) = &self.bvh {
+            // The BVH prunes with the distance it is given, just past the best
+            // hit's, so that nodes entered exactly at it (which may hold a
+            // lower-index primitive at the same distance) are visited; `consider`
+            // keeps the tie rule.
+            let _ = bvh.traverse_leaves(ray, limit(&best), |first, _, t_max| {
+                let (mut hits, t) = self.leaf_hits(first, ray, &watertight, t_max);
+                while hits != 0 {
+                    let lane = hits.trailing_zeros();
+                    hits &= hits - 1;
+                    consider(Found::Slot(first + lane), t[lane as usize], &mut best);
+                }
+                ControlFlow::Continue(limit(&best))
+            });
+        }
+        let (t, found) = best?;
+        let p = self.resolve(found);
+        Some(PrimitiveHit {
+            t,
+            object: p.object,
+            primitive: p.triangle,
+        })
+    }
+
+    /// The primitive a candidate names.
+    #[inline]
+    fn resolve(&self, found: Found) -> Primitive {
+        match found {
+            Found::Primitive(p) => p,
+            Found::Slot(k) => self.primitives[k as usize],
+        }
     }
 
     /// Whether anything lies on the ray with `0 < t < t_max` (shadow query).
@@ -273,9 +369,14 @@ impl ShapeList {
                     };
                     self.primitive_distance(p, ray, &watertight, t_max)
                         .is_some()
-                }) || bvh.any_hit(ray, t_max, |i, ray, t_max| {
-                    self.slot_distance(i, ray, &watertight, t_max).is_some()
-                })
+                }) || bvh
+                    .traverse_leaves(ray, t_max, |first, _, t_max| {
+                        match self.leaf_hits(first, ray, &watertight, t_max) {
+                            (0, _) => ControlFlow::Continue(t_max),
+                            _ => ControlFlow::Break(()),
+                        }
+                    })
+                    .is_break()
             }
             // Without meshes the objects are the shapes, in order: the course's loop.
             None if self.meshes.is_empty() => self

@@ -14,17 +14,20 @@ use glam::Vec3;
 
 /// The per-ray part of the watertight test, computed once and reused for every
 /// triangle the ray is tested against.
+///
+/// The fields are visible to the crate so that the four-wide test of
+/// [`crate::triangle_packet`] can repeat exactly the same operations lane-wise.
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
-    origin: Vec3,
+    pub(crate) origin: Vec3,
     /// Axis permutation: the ray's dominant axis becomes z.
-    kx: usize,
-    ky: usize,
-    kz: usize,
+    pub(crate) kx: usize,
+    pub(crate) ky: usize,
+    pub(crate) kz: usize,
     /// Shear that makes the ray direction (0, 0, 1).
-    sx: f32,
-    sy: f32,
-    sz: f32,
+    pub(crate) sx: f32,
+    pub(crate) sy: f32,
+    pub(crate) sz: f32,
 }
 
 impl WatertightRay {

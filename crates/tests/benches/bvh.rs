@@ -1,6 +1,9 @@
 //! The BVH, measured: build time and closest-hit rays per second on generated
 //! meshes of 10k to 4M triangles, for coherent (camera) and incoherent (random)
-//! rays, on every core.
+//! rays, on every core. A closest hit is the nearest primitive and its distance
+//! ([`ShapeList::closest_primitive`], what Embree's `rtcIntersect1` reports); the
+//! last column adds the surface record the integrator shades with
+//! ([`ShapeList::closest_hit`]: normals, uv, derivatives).
 //!
 //! `cargo bench -p glint-tests --bench bvh [-- TRIANGLES...]` (default: 10k, 100k,
 //! 1M and 4M triangles)
@@ -19,9 +22,9 @@ const RAYS: usize = 2_000_000;
 
 fn main() {
     println!(
-        "| triangles | BVH build | coherent rays/s | incoherent rays/s | incoherent µs/ray (one core) |"
+        "| triangles | BVH build | coherent rays/s | incoherent rays/s | incoherent µs/ray (one core) | incoherent with surface rays/s |"
     );
-    println!("|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|");
     let sizes: Vec<usize> = std::env::args()
         .skip(1)
         .filter_map(|a| a.parse().ok())
@@ -45,29 +48,42 @@ fn main() {
         list.build_bvh();
         let coherent = camera_rays(RAYS);
         let incoherent = random_rays(RAYS);
-        let coherent_time = median(|| trace(&list, &coherent));
-        let incoherent_time = median(|| trace(&list, &incoherent));
+        let coherent_time = median(|| trace(&list, &coherent, Query::Primitive));
+        let incoherent_time = median(|| trace(&list, &incoherent, Query::Primitive));
+        let surface_time = median(|| trace(&list, &incoherent, Query::Surface));
         let per_second = |t: Duration| RAYS as f64 / t.as_secs_f64();
         let threads = rayon::current_num_threads() as f64;
         println!(
-            "| {actual} | {:.0} ms | {:.1} M | {:.1} M | {:.3} |",
+            "| {actual} | {:.0} ms | {:.1} M | {:.1} M | {:.3} | {:.1} M |",
             build.as_secs_f64() * 1e3,
             per_second(coherent_time) / 1e6,
             per_second(incoherent_time) / 1e6,
             incoherent_time.as_secs_f64() * 1e6 * threads / RAYS as f64,
+            per_second(surface_time) / 1e6,
         );
     }
 }
 
+#[derive(Clone, Copy)]
+enum Query {
+    /// [`ShapeList::closest_primitive`]
+    Primitive,
+    /// [`ShapeList::closest_hit`]
+    Surface,
+}
+
 /// Traces every ray for its closest hit, in parallel; returns the wall time.
-fn trace(list: &ShapeList, rays: &[Ray]) -> Duration {
+fn trace(list: &ShapeList, rays: &[Ray], query: Query) -> Duration {
     let start = Instant::now();
     let hits: usize = rays
         .par_chunks(4096)
         .map(|chunk| {
             chunk
                 .iter()
-                .filter(|r| list.closest_hit(r, f32::INFINITY).is_some())
+                .filter(|r| match query {
+                    Query::Primitive => list.closest_primitive(r, f32::INFINITY).is_some(),
+                    Query::Surface => list.closest_hit(r, f32::INFINITY).is_some(),
+                })
                 .count()
         })
         .sum();

@@ -126,8 +126,8 @@ fn leaves_again(list: &ShapeList, ray: &Ray, mut t: f32) -> bool {
 #[test]
 fn bunny_bvh_statistics() {
     let stats = closed_bunny().bvh_stats().unwrap();
-    assert!(stats.max_leaf_size <= 8);
-    assert!(stats.leaves >= 5648 / 8);
+    assert!(stats.max_leaf_size <= 4);
+    assert!(stats.leaves >= 5648 / 4);
     let s = format!(
         "nodes {}\nleaves {}\nmax depth {}\nmax leaf size {}\nSAH cost {}\n",
         stats.nodes,

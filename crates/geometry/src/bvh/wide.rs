@@ -126,6 +126,17 @@ impl WideNode {
         }
     }
 
+    #[inline(always)]
+    pub(super) fn link(&self, lane: usize) -> Link {
+        self.links[lane]
+    }
+
+    /// The node's first word, for reading it ahead of time.
+    #[inline(always)]
+    pub(super) fn first_word(&self) -> f32 {
+        self.planes[0].x
+    }
+
     /// The used children: (lane, link).
     pub(super) fn children(&self) -> impl Iterator<Item = (usize, Link)> + '_ {
         self.links

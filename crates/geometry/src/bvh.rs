@@ -1383,6 +1383,51 @@ mod tests {
     }
 
     #[test]
+    fn traverse_leaves_hands_over_padded_runs_and_finds_the_same_hits() {
+        let bounds = random_boxes(3000, 20.0, 0.1, 2.0, 8);
+        let bvh = Bvh::build(&bounds);
+        let mut taken = bvh.clone();
+        let order = taken.take_primitive_order();
+        let mut rng = XorShift(21);
+        let mut leaves = 0;
+        for _ in 0..2000 {
+            let origin = rng.vec3(-5.0, 25.0);
+            let ray = Ray::new(origin, rng.vec3(0.0, 20.0) - origin);
+            let mut nearest: Option<(u32, f32)> = None;
+            let _ = taken.traverse_leaves(&ray, f32::INFINITY, |first, count, mut t_max| {
+                leaves += 1;
+                assert_eq!(first as usize % LEAF_WIDTH, 0);
+                assert!((1..=LEAF_WIDTH as u32).contains(&count));
+                let run = &order[first as usize..first as usize + LEAF_WIDTH];
+                assert!(run[..count as usize].iter().all(|&i| i != u32::MAX));
+                assert!(run[count as usize..].iter().all(|&i| i == u32::MAX));
+                for &prim in &run[..count as usize] {
+                    if let Some(t) = box_hit(&bounds[prim as usize], &ray, t_max) {
+                        if t > 0.0 {
+                            t_max = t;
+                            nearest = Some((prim, t));
+                        }
+                    }
+                }
+                ControlFlow::Continue(t_max)
+            });
+            let want = bvh.closest_hit(&ray, f32::INFINITY, |i, r, t| {
+                box_hit(&bounds[i as usize], r, t).filter(|&t| t > 0.0)
+            });
+            assert_eq!(nearest.map(|n| n.1), want.map(|w| w.1));
+            // Breaking ends the traversal at the first leaf.
+            let mut visits = 0;
+            let broke = taken.traverse_leaves(&ray, f32::INFINITY, |_, _, _| {
+                visits += 1;
+                ControlFlow::Break(())
+            });
+            assert_eq!(broke.is_break(), visits == 1);
+            assert!(visits <= 1);
+        }
+        assert!(leaves > 2000, "{leaves} leaves visited");
+    }
+
+    #[test]
     fn after_take_primitive_order_queries_report_leaf_positions() {
         let bounds = random_boxes(3000, 20.0, 0.1, 2.0, 5);
         let bvh = Bvh::build(&bounds);

@@ -20,6 +20,8 @@
 //! - Triangles are intersected watertightly ([`triangle`]): rays through shared
 //!   edges and vertices of a closed mesh never slip through. Hits at exactly equal
 //!   distances go to the lowest object index, with or without the BVH.
+//! - The BVH ([`bvh`]) is 4-wide; meshes' triangles sit in its leaves as
+//!   [`TrianglePacket`]s of four, tested together ([`triangle_packet`]).
 
 mod aabox;
 pub mod bvh;

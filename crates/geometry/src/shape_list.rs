@@ -587,6 +587,14 @@ mod bvh_agreement {
                     linear.closest_hit(&ray, f32::INFINITY),
                     accelerated.closest_hit(&ray, f32::INFINITY),
                 );
+                // The query without a surface record finds the same hit.
+                for (list, hit) in [(&linear, a), (&accelerated, b)] {
+                    let found = list.closest_primitive(&ray, f32::INFINITY);
+                    assert_eq!(
+                        found.map(|f| (f.t, f.object, f.primitive)),
+                        hit.map(|h| (h.t, h.shape, h.primitive))
+                    );
+                }
                 match (a, b) {
                     (None, None) => {}
                     (Some(a), Some(b)) => {

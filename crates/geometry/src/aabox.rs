@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 ///
 /// Each face carries its own uv square, upright as seen from outside the box: on the
 /// four side faces u runs to the viewer's right and v up (+y); on the top face v
-/// runs towards −z, on the bottom face towards +z (see [`FACES`]).
+/// runs towards −z, on the bottom face towards +z (see `FACES`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AaBox {
     min: Vec3,

@@ -5,7 +5,7 @@
 //! Symposium on Interactive Ray Tracing, 2007), as in pbrt-v4 §7.3.2, as a binary
 //! tree of 32-byte nodes in depth-first order (pbrt-v4 §7.3.4), with leaves of at
 //! most four primitives priced as one four-wide intersection test. The binary
-//! tree is then collapsed into a 4-wide BVH ([`wide`]; Wald, Benthin and Boulos
+//! tree is then collapsed into a 4-wide BVH (module `wide`; Wald, Benthin and Boulos
 //! 2008, Embree's BVH4): each node holds the boxes of up to four children axis by
 //! axis, so that one run of four-wide SIMD operations tests them all, and leaf
 //! runs are padded to multiples of four so that a caller can test a leaf's
@@ -231,7 +231,7 @@ fn index_u32(i: usize) -> u32 {
 
 impl Bvh {
     /// Builds with binned SAH (Wald 2007; pbrt-v4 §7.3.2), then collapses the
-    /// binary tree into a 4-wide one ([`wide`]).
+    /// binary tree into a 4-wide one (module `wide`).
     ///
     /// At each node the primitive centroids are sorted into 12 equal bins along
     /// each of the three axes of the centroid bounds, and every plane between bins

@@ -62,7 +62,7 @@ impl Parallelogram {
     pub fn center(&self) -> Vec3 {
         self.origin + 0.5 * (self.edge1 + self.edge2)
     }
-    /// The point with coordinates `(α, β)` ∈ [0,1]².
+    /// The point with coordinates `(α, β)` ∈ `[0, 1]²`.
     pub fn point_at(&self, ab: Vec2) -> Vec3 {
         self.origin + ab.x * self.edge1 + ab.y * self.edge2
     }

@@ -144,7 +144,7 @@ impl ShapeList {
     }
 
     /// Builds the BVH if the scene is large enough for it to pay: below
-    /// [`LINEAR_LIMIT`] primitives the linear loop is faster (and gives the same
+    /// 32 primitives (`LINEAR_LIMIT`) the linear loop is faster (and gives the same
     /// answers), so none is built.
     pub fn build_acceleration(&mut self) {
         let primitives: usize = self

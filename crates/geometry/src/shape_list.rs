@@ -221,12 +221,7 @@ impl ShapeList {
         let mut packet = TrianglePacket::EMPTY;
         for (lane, p) in leaf.iter().enumerate() {
             if let Some(Object::Mesh(m)) = self.objects.get(p.object as usize) {
-                let corners = self.meshes[*m as usize].corners(p.triangle);
-                for (vertex, corner) in packet.corners.iter_mut().zip(corners) {
-                    for (axis, lanes) in vertex.iter_mut().enumerate() {
-                        lanes[lane] = corner[axis];
-                    }
-                }
+                packet.set_lane(lane, &self.meshes[*m as usize].corners(p.triangle));
             }
         }
         packet

@@ -52,13 +52,21 @@ impl TrianglePacket {
         );
         let mut packet = Self::EMPTY;
         for (lane, triangle) in triangles.iter().enumerate() {
-            for (vertex, p) in triangle.iter().enumerate() {
-                for axis in 0..3 {
-                    packet.corners[vertex][axis][lane] = p[axis];
-                }
-            }
+            packet.set_lane(lane, triangle);
         }
         packet
+    }
+
+    /// Puts `triangle` (`[p0, p1, p2]`) in `lane`.
+    ///
+    /// # Panics
+    /// If `lane >= 4`.
+    pub fn set_lane(&mut self, lane: usize, triangle: &[Vec3; 3]) {
+        for (vertex, p) in self.corners.iter_mut().zip(triangle) {
+            for (axis, lanes) in vertex.iter_mut().enumerate() {
+                lanes[lane] = p[axis];
+            }
+        }
     }
 
     /// The triangle in `lane`, as given (NaN corners for an unused lane).

@@ -21,12 +21,18 @@
 //! primitives by their index in the slice given to [`Bvh::build`] (or by their
 //! position in leaf order, after [`Bvh::take_primitive_order`]);
 //! [`Bvh::traverse_leaves`] hands over whole leaves.
+//!
+//! [`Bvh::traverse_stream`] traverses a batch of rays several at a time,
+//! interleaved, with each next node prefetched (module `stream`): the same
+//! answers, with the waits on memory of large trees overlapped.
 
+mod stream;
 mod wide;
 
 use crate::Ray;
 use glam::{Vec3, Vec3A};
 use std::ops::ControlFlow;
+pub use stream::{RayStream, STREAM_LANES};
 pub use wide::LEAF_WIDTH;
 use wide::{Link, PreparedRay, TraversalStack, WideBvh};
 
@@ -406,29 +412,53 @@ impl Bvh {
         if ray.origin.is_nan() || ray.direction.is_nan() || self.is_empty() {
             return ControlFlow::Continue(());
         }
-        let nodes = &self.tree.nodes;
         let ray = PreparedRay::new(ray);
         let mut t_max = t_max;
         let mut stack = TraversalStack::new();
         let mut next = Some(Link::ROOT);
         while let Some(link) = next {
-            next = if link.is_leaf() {
-                t_max = visit_leaf(link, t_max)?;
-                stack.pop_before(t_max)
-            } else {
-                let node = &nodes[link.node()];
-                match ray.enters(node, t_max) {
-                    (0, _) => stack.pop_before(t_max),
-                    (hits, enter) => {
-                        if hits & (hits - 1) != 0 {
-                            self.touch_children(node, hits);
-                        }
-                        Some(stack.order(node, hits, enter))
+            next = self.step(
+                &ray,
+                &mut stack,
+                link,
+                &mut t_max,
+                &mut visit_leaf,
+                |node, hits| {
+                    if hits & (hits - 1) != 0 {
+                        self.touch_children(node, hits);
                     }
-                }
-            };
+                },
+            )?;
         }
         ControlFlow::Continue(())
+    }
+
+    /// One step of a ray's traversal: visits leaf `link`, or tests the children of
+    /// node `link` (and hands the node and the mask of children hit to
+    /// `read_ahead`). Returns the link to take next, `None` once the stack is
+    /// empty, or the leaf visit's break.
+    #[inline(always)]
+    fn step(
+        &self,
+        ray: &PreparedRay,
+        stack: &mut TraversalStack,
+        link: Link,
+        t_max: &mut f32,
+        visit_leaf: impl FnOnce(Link, f32) -> ControlFlow<(), f32>,
+        read_ahead: impl FnOnce(&wide::WideNode, u32),
+    ) -> ControlFlow<(), Option<Link>> {
+        if link.is_leaf() {
+            *t_max = visit_leaf(link, *t_max)?;
+            return ControlFlow::Continue(stack.pop_before(*t_max));
+        }
+        let node = &self.tree.nodes[link.node()];
+        ControlFlow::Continue(match ray.enters(node, *t_max) {
+            (0, _) => stack.pop_before(*t_max),
+            (hits, enter) => {
+                read_ahead(node, hits);
+                Some(stack.order(node, hits, enter))
+            }
+        })
     }
 
     /// Reads one word of each interior child in `hits` through
@@ -1035,7 +1065,7 @@ mod tests {
     use std::time::Instant;
 
     /// Marsaglia's xorshift64 ("Xorshift RNGs", 2003): tiny, seeded, deterministic.
-    struct XorShift(u64);
+    pub(super) struct XorShift(pub(super) u64);
 
     impl XorShift {
         fn next_u64(&mut self) -> u64 {
@@ -1046,7 +1076,7 @@ mod tests {
         }
 
         /// Uniform in [0, 1), from the top 24 bits.
-        fn unit(&mut self) -> f32 {
+        pub(super) fn unit(&mut self) -> f32 {
             (self.next_u64() >> 40) as f32 / (1u32 << 24) as f32
         }
 
@@ -1054,7 +1084,7 @@ mod tests {
             lo + (hi - lo) * self.unit()
         }
 
-        fn vec3(&mut self, lo: f32, hi: f32) -> Vec3 {
+        pub(super) fn vec3(&mut self, lo: f32, hi: f32) -> Vec3 {
             Vec3::new(self.range(lo, hi), self.range(lo, hi), self.range(lo, hi))
         }
     }
@@ -1079,7 +1109,7 @@ mod tests {
 
     /// `count` boxes with sides of `min_size`–`max_size`, corners scattered
     /// uniformly over `[0, extent]³`.
-    fn random_boxes(
+    pub(super) fn random_boxes(
         count: usize,
         extent: f32,
         min_size: f32,
@@ -1211,7 +1241,7 @@ mod tests {
         depth(&nodes, 0)
     }
 
-    fn box_hit(b: &Bounds3, ray: &Ray, t_max: f32) -> Option<f32> {
+    pub(super) fn box_hit(b: &Bounds3, ray: &Ray, t_max: f32) -> Option<f32> {
         b.hit(ray.origin, ray.direction.recip(), t_max)
     }
 

@@ -31,6 +31,7 @@ mod mesh;
 mod offset;
 mod parallelogram;
 mod plane;
+mod prefetch;
 mod ray;
 mod shape;
 mod shape_list;

@@ -1,7 +1,8 @@
-use crate::bvh::{Bounds3, Bvh, BvhStats, LEAF_WIDTH};
+use crate::bvh::{Bounds3, Bvh, BvhStats, RayStream, LEAF_WIDTH};
+use crate::prefetch::prefetch;
 use crate::triangle::WatertightRay;
 use crate::{Hit, Ray, Shape, TriangleMesh, TrianglePacket};
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 use std::ops::ControlFlow;
 
 /// Below this many primitives [`ShapeList::build_acceleration`] builds no BVH.
@@ -69,7 +70,9 @@ impl Primitive {
 /// triangle in [`Hit::primitive`]. After [`ShapeList::build_bvh`], bounded
 /// primitives (each shape, each triangle) are found through a BVH and only
 /// unbounded planes are tested one by one; before it, every object is tested in
-/// turn (the course's linear loop), with the same answers.
+/// turn (the course's linear loop), with the same answers. Batches of rays can be
+/// handed over at once ([`ShapeList::closest_primitives`], [`ShapeList::any_hits`]),
+/// to be traced several at a time.
 #[derive(Clone, Debug, Default)]
 pub struct ShapeList {
     shapes: Vec<Shape>,
@@ -286,61 +289,89 @@ impl ShapeList {
     /// The nearest hit with `0 < t < t_max` as [`ShapeList::closest_hit`] finds
     /// it, without its surface record: which primitive, and where along the ray.
     pub fn closest_primitive(&self, ray: &Ray, t_max: f32) -> Option<PrimitiveHit> {
-        // (Only triangle tests read it; a few divisions per query.)
-        let watertight = WatertightRay::new(ray);
-        let mut best: Option<(f32, Found)> = None;
-        // A candidate at distance t (found below the current best's t, or equal to
-        // it) becomes the best if nearer, or as near with a lower (object,
-        // triangle). Only ties read which primitive a BVH slot holds.
-        let consider = |found: Found, t: f32, best: &mut Option<(f32, Found)>| {
-            let better = match *best {
-                None => true,
-                Some((bt, bf)) => {
-                    t < bt || (t == bt && self.resolve(found).key() < self.resolve(bf).key())
-                }
-            };
-            if better {
-                *best = Some((t, found));
-            }
-        };
-        let limit = |best: &Option<(f32, Found)>| best.map_or(t_max, |(t, _)| t.next_up());
-        // Without a BVH every primitive is tested here; with one, the planes.
-        let mut test = |p: Primitive| {
-            if let Some(t) = self.primitive_distance(p, ray, &watertight, limit(&best)) {
-                consider(Found::Primitive(p), t, &mut best);
-            }
-        };
+        let mut search = ClosestSearch::new(ray, t_max);
         match &self.bvh {
-            Some(_) => self.unbounded.iter().for_each(|&object| {
-                test(Primitive {
-                    object,
-                    triangle: 0,
-                })
-            }),
-            None => self.all_primitives().for_each(test),
+            Some(bvh) => {
+                search.test_unbounded(self);
+                let _ = bvh.traverse_leaves(ray, search.limit(), |first, _, _| {
+                    ControlFlow::Continue(search.visit_leaf(self, first))
+                });
+            }
+            None => self.all_primitives().for_each(|p| search.test(self, p)),
         }
-        if let Some(bvh) = &self.bvh {
-            // The BVH prunes with the distance it is given, just past the best
-            // hit's, so that nodes entered exactly at it (which may hold a
-            // lower-index primitive at the same distance) are visited; `consider`
-            // keeps the tie rule.
-            let _ = bvh.traverse_leaves(ray, limit(&best), |first, _, t_max| {
-                let (mut hits, t) = self.leaf_hits(first, ray, &watertight, t_max);
-                while hits != 0 {
-                    let lane = hits.trailing_zeros();
-                    hits &= hits - 1;
-                    consider(Found::Slot(first + lane), t[lane as usize], &mut best);
+        search.finish(self)
+    }
+
+    /// [`ShapeList::closest_primitive`] for each of `rays`, with its own
+    /// `t_max`, into `hits`: the same answers, found
+    /// [`STREAM_LANES`](crate::bvh::STREAM_LANES) rays at a time with their
+    /// traversals interleaved ([`Bvh::traverse_stream`]), which overlaps their
+    /// waits on memory. It pays for batches of incoherent rays (hundreds or more)
+    /// on scenes that outgrow the caches.
+    ///
+    /// Panics unless `t_max` and `hits` are as long as `rays`.
+    pub fn closest_primitives(
+        &self,
+        rays: &[Ray],
+        t_max: &[f32],
+        hits: &mut [Option<PrimitiveHit>],
+    ) {
+        assert!(
+            t_max.len() == rays.len() && hits.len() == rays.len(),
+            "one t_max and one answer per ray"
+        );
+        match &self.bvh {
+            Some(bvh) => bvh.traverse_stream(
+                rays.len(),
+                &mut ClosestStream {
+                    list: self,
+                    rays,
+                    t_max,
+                    hits,
+                },
+            ),
+            None => {
+                for ((ray, &t_max), hit) in rays.iter().zip(t_max).zip(hits) {
+                    *hit = self.closest_primitive(ray, t_max);
                 }
-                ControlFlow::Continue(limit(&best))
-            });
+            }
         }
-        let (t, found) = best?;
-        let p = self.resolve(found);
-        Some(PrimitiveHit {
-            t,
-            object: p.object,
-            primitive: p.triangle,
-        })
+    }
+
+    /// [`ShapeList::any_hit`] for each of `rays`, with its own `t_max`, into
+    /// `occluded`: the same answers, found as [`ShapeList::closest_primitives`]
+    /// finds its own (shadow rays of many shading points, say).
+    ///
+    /// Panics unless `t_max` and `occluded` are as long as `rays`.
+    pub fn any_hits(&self, rays: &[Ray], t_max: &[f32], occluded: &mut [bool]) {
+        assert!(
+            t_max.len() == rays.len() && occluded.len() == rays.len(),
+            "one t_max and one answer per ray"
+        );
+        match &self.bvh {
+            Some(bvh) => bvh.traverse_stream(
+                rays.len(),
+                &mut AnyHitStream {
+                    list: self,
+                    rays,
+                    t_max,
+                    occluded,
+                },
+            ),
+            None => {
+                for ((ray, &t_max), occluded) in rays.iter().zip(t_max).zip(occluded) {
+                    *occluded = self.any_hit(ray, t_max);
+                }
+            }
+        }
+    }
+
+    /// Reads the packet of the leaf at `first` ahead of its test.
+    #[inline(always)]
+    fn prefetch_leaf(&self, first: u32) {
+        if let Some(packet) = self.packets.get(first as usize / LEAF_WIDTH) {
+            prefetch(packet);
+        }
     }
 
     /// The primitive a candidate names.
@@ -357,21 +388,15 @@ impl ShapeList {
         match &self.bvh {
             Some(bvh) => {
                 let watertight = WatertightRay::new(ray);
-                self.unbounded.iter().any(|&object| {
-                    let p = Primitive {
-                        object,
-                        triangle: 0,
-                    };
-                    self.primitive_distance(p, ray, &watertight, t_max)
-                        .is_some()
-                }) || bvh
-                    .traverse_leaves(ray, t_max, |first, _, t_max| {
-                        match self.leaf_hits(first, ray, &watertight, t_max) {
-                            (0, _) => ControlFlow::Continue(t_max),
-                            _ => ControlFlow::Break(()),
-                        }
-                    })
-                    .is_break()
+                self.unbounded_hit(ray, &watertight, t_max)
+                    || bvh
+                        .traverse_leaves(ray, t_max, |first, _, t_max| {
+                            match self.leaf_hits(first, ray, &watertight, t_max) {
+                                (0, _) => ControlFlow::Continue(t_max),
+                                _ => ControlFlow::Break(()),
+                            }
+                        })
+                        .is_break()
             }
             // Without meshes the objects are the shapes, in order: the course's loop.
             None if self.meshes.is_empty() => self
@@ -390,6 +415,18 @@ impl ShapeList {
                 })
             }
         }
+    }
+
+    /// Whether an unbounded plane (which the BVH leaves out) lies on the ray in
+    /// (0, t_max).
+    fn unbounded_hit(&self, ray: &Ray, watertight: &WatertightRay, t_max: f32) -> bool {
+        self.unbounded.iter().any(|&object| {
+            let p = Primitive {
+                object,
+                triangle: 0,
+            };
+            self.primitive_distance(p, ray, watertight, t_max).is_some()
+        })
     }
 
     /// Every primitive, object by object (the linear loop's order).
@@ -421,6 +458,213 @@ impl ShapeList {
             Object::Shape(s) => self.shapes[s as usize].hit_distance(ray, t_max),
             Object::Mesh(m) => self.meshes[m as usize].hit_distance(p.triangle, watertight, t_max),
         }
+    }
+}
+
+/// One closest-hit query in progress: the ray, and the best hit so far.
+///
+/// A candidate at distance t (found below the best's t, or equal to it) becomes
+/// the best if nearer, or as near with a lower (object, triangle). Only ties read
+/// which primitive a BVH slot holds.
+struct ClosestSearch {
+    ray: Ray,
+    /// (Only triangle tests read it; a few divisions per query.)
+    watertight: WatertightRay,
+    t_max: f32,
+    best: Option<(f32, Found)>,
+}
+
+/// An empty slot of a stream's lane.
+impl Default for ClosestSearch {
+    fn default() -> Self {
+        Self::new(&Ray::new(Vec3::ZERO, Vec3::Z), 0.0)
+    }
+}
+
+impl ClosestSearch {
+    fn new(ray: &Ray, t_max: f32) -> Self {
+        Self {
+            ray: *ray,
+            watertight: WatertightRay::new(ray),
+            t_max,
+            best: None,
+        }
+    }
+
+    /// How far a hit may still be: the query's `t_max`, or just past the best
+    /// hit, so that the BVH still visits nodes entered exactly at its distance
+    /// (which may hold a lower-index primitive at the same distance).
+    #[inline]
+    fn limit(&self) -> f32 {
+        self.best.map_or(self.t_max, |(t, _)| t.next_up())
+    }
+
+    #[inline]
+    fn consider(&mut self, list: &ShapeList, found: Found, t: f32) {
+        let better = match self.best {
+            None => true,
+            Some((bt, bf)) => {
+                t < bt || (t == bt && list.resolve(found).key() < list.resolve(bf).key())
+            }
+        };
+        if better {
+            self.best = Some((t, found));
+        }
+    }
+
+    /// Tests one primitive on its own.
+    fn test(&mut self, list: &ShapeList, p: Primitive) {
+        if let Some(t) = list.primitive_distance(p, &self.ray, &self.watertight, self.limit()) {
+            self.consider(list, Found::Primitive(p), t);
+        }
+    }
+
+    /// Tests the primitives the BVH leaves out: unbounded planes.
+    fn test_unbounded(&mut self, list: &ShapeList) {
+        for &object in &list.unbounded {
+            self.test(
+                list,
+                Primitive {
+                    object,
+                    triangle: 0,
+                },
+            );
+        }
+    }
+
+    /// Tests the leaf at `first`; returns the new limit.
+    #[inline]
+    fn visit_leaf(&mut self, list: &ShapeList, first: u32) -> f32 {
+        let (mut hits, t) = list.leaf_hits(first, &self.ray, &self.watertight, self.limit());
+        if hits != 0 {
+            // What the slot holds is read at the end of the query.
+            if let Some(slot) = list.primitives.get(first as usize) {
+                prefetch(slot);
+            }
+        }
+        while hits != 0 {
+            let lane = hits.trailing_zeros();
+            hits &= hits - 1;
+            self.consider(list, Found::Slot(first + lane), t[lane as usize]);
+        }
+        self.limit()
+    }
+
+    fn finish(&self, list: &ShapeList) -> Option<PrimitiveHit> {
+        let (t, found) = self.best?;
+        let p = list.resolve(found);
+        Some(PrimitiveHit {
+            t,
+            object: p.object,
+            primitive: p.triangle,
+        })
+    }
+}
+
+/// [`ShapeList::closest_primitives`] as a [`RayStream`].
+struct ClosestStream<'a> {
+    list: &'a ShapeList,
+    rays: &'a [Ray],
+    t_max: &'a [f32],
+    hits: &'a mut [Option<PrimitiveHit>],
+}
+
+impl RayStream for ClosestStream<'_> {
+    type State = ClosestSearch;
+
+    fn begin(&self, index: usize, search: &mut ClosestSearch) -> Option<(Ray, f32)> {
+        let ray = &self.rays[index];
+        *search = ClosestSearch::new(ray, self.t_max[index]);
+        search.test_unbounded(self.list);
+        Some((*ray, search.limit()))
+    }
+
+    #[inline(always)]
+    fn prefetch_leaf(&self, first: u32) {
+        self.list.prefetch_leaf(first);
+    }
+
+    #[inline(always)]
+    fn visit_leaf(
+        &self,
+        search: &mut ClosestSearch,
+        first: u32,
+        _: u32,
+        _: f32,
+    ) -> ControlFlow<(), f32> {
+        ControlFlow::Continue(search.visit_leaf(self.list, first))
+    }
+
+    fn end(&mut self, index: usize, search: &ClosestSearch) {
+        self.hits[index] = search.finish(self.list);
+    }
+}
+
+/// One shadow ray in flight in [`ShapeList::any_hits`].
+struct AnyHitSearch {
+    ray: Ray,
+    watertight: WatertightRay,
+    occluded: bool,
+}
+
+/// An empty slot of a stream's lane.
+impl Default for AnyHitSearch {
+    fn default() -> Self {
+        let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+        Self {
+            ray,
+            watertight: WatertightRay::new(&ray),
+            occluded: false,
+        }
+    }
+}
+
+/// [`ShapeList::any_hits`] as a [`RayStream`].
+struct AnyHitStream<'a> {
+    list: &'a ShapeList,
+    rays: &'a [Ray],
+    t_max: &'a [f32],
+    occluded: &'a mut [bool],
+}
+
+impl RayStream for AnyHitStream<'_> {
+    type State = AnyHitSearch;
+
+    fn begin(&self, index: usize, search: &mut AnyHitSearch) -> Option<(Ray, f32)> {
+        let (ray, t_max) = (self.rays[index], self.t_max[index]);
+        search.ray = ray;
+        search.watertight = WatertightRay::new(&ray);
+        search.occluded = self.list.unbounded_hit(&ray, &search.watertight, t_max);
+        (!search.occluded).then_some((ray, t_max))
+    }
+
+    #[inline(always)]
+    fn prefetch_leaf(&self, first: u32) {
+        self.list.prefetch_leaf(first);
+    }
+
+    #[inline(always)]
+    fn visit_leaf(
+        &self,
+        search: &mut AnyHitSearch,
+        first: u32,
+        _: u32,
+        t_max: f32,
+    ) -> ControlFlow<(), f32> {
+        match self
+            .list
+            .leaf_hits(first, &search.ray, &search.watertight, t_max)
+        {
+            (0, _) => ControlFlow::Continue(t_max),
+            _ => {
+                search.occluded = true;
+                ControlFlow::Break(())
+            }
+        }
+    }
+
+    fn end(&mut self, index: usize, search: &AnyHitSearch) {
+        self.occluded[index] = search.occluded;
     }
 }
 
@@ -488,7 +732,7 @@ mod tests {
 #[cfg(test)]
 mod bvh_agreement {
     use super::*;
-    use crate::{AaBox, Parallelogram, Sphere, TriangleMesh};
+    use crate::{AaBox, Parallelogram, Plane, Sphere, TriangleMesh};
     use glam::{Vec2, Vec3};
 
     /// xorshift64*: a tiny deterministic generator for test scenes.
@@ -610,6 +854,45 @@ mod bvh_agreement {
                     linear.any_hit(&ray, t_max),
                     accelerated.any_hit(&ray, t_max)
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn streams_of_rays_get_the_answers_of_rays_traced_alone() {
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        for scene in 0..10 {
+            let mut linear = random_scene(&mut rng);
+            if scene % 2 == 0 {
+                linear
+                    .push(Plane::new(rng.in_cube(4.0), rng.in_cube(1.0), scene % 4 == 0).unwrap());
+            }
+            let mut accelerated = linear.clone();
+            accelerated.build_bvh();
+            let mut rays: Vec<Ray> = (0..300)
+                .map(|_| {
+                    let origin = rng.in_cube(8.0);
+                    Ray::new(origin, rng.in_cube(5.0) - origin)
+                })
+                .collect();
+            rays[7] = Ray::new(Vec3::NAN, Vec3::X);
+            let t_max: Vec<f32> = (0..rays.len())
+                .map(|i| match i % 3 {
+                    0 => f32::INFINITY,
+                    _ => 0.5 + rng.next() * 20.0,
+                })
+                .collect();
+            for list in [&linear, &accelerated] {
+                let mut hits = vec![None; rays.len()];
+                list.closest_primitives(&rays, &t_max, &mut hits);
+                let mut occluded = vec![false; rays.len()];
+                list.any_hits(&rays, &t_max, &mut occluded);
+                for (i, ray) in rays.iter().enumerate() {
+                    assert_eq!(hits[i], list.closest_primitive(ray, t_max[i]), "ray {i}");
+                    assert_eq!(occluded[i], list.any_hit(ray, t_max[i]), "ray {i}");
+                }
+                assert!(hits.iter().filter(|h| h.is_some()).count() > 30);
+                assert!(occluded.iter().filter(|&&o| o).count() > 30);
             }
         }
     }

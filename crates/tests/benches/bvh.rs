@@ -2,8 +2,10 @@
 //! meshes of 10k to 4M triangles, for coherent (camera) and incoherent (random)
 //! rays, on every core. A closest hit is the nearest primitive and its distance
 //! ([`ShapeList::closest_primitive`], what Embree's `rtcIntersect1` reports); the
-//! last column adds the surface record the integrator shades with
-//! ([`ShapeList::closest_hit`]: normals, uv, derivatives).
+//! surface column adds the surface record the integrator shades with
+//! ([`ShapeList::closest_hit`]: normals, uv, derivatives), and the stream column
+//! hands the rays over in batches ([`ShapeList::closest_primitives`]), which
+//! traces several at once with their memory reads overlapped.
 //!
 //! `cargo bench -p glint-tests --bench bvh [-- TRIANGLES...]` (default: 10k, 100k,
 //! 1M and 4M triangles)
@@ -19,12 +21,14 @@ use std::time::{Duration, Instant};
 
 const RUNS: usize = 3;
 const RAYS: usize = 2_000_000;
+/// Rays per parallel task, and per stream.
+const BATCH: usize = 4096;
 
 fn main() {
     println!(
-        "| triangles | BVH build | coherent rays/s | incoherent rays/s | incoherent µs/ray (one core) | incoherent with surface rays/s |"
+        "| triangles | BVH build | coherent rays/s | incoherent rays/s | incoherent µs/ray (one core) | incoherent with surface rays/s | incoherent stream rays/s |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|");
     let sizes: Vec<usize> = std::env::args()
         .skip(1)
         .filter_map(|a| a.parse().ok())
@@ -51,15 +55,17 @@ fn main() {
         let coherent_time = median(|| trace(&list, &coherent, Query::Primitive));
         let incoherent_time = median(|| trace(&list, &incoherent, Query::Primitive));
         let surface_time = median(|| trace(&list, &incoherent, Query::Surface));
+        let stream_time = median(|| trace(&list, &incoherent, Query::Stream));
         let per_second = |t: Duration| RAYS as f64 / t.as_secs_f64();
         let threads = rayon::current_num_threads() as f64;
         println!(
-            "| {actual} | {:.0} ms | {:.1} M | {:.1} M | {:.3} | {:.1} M |",
+            "| {actual} | {:.0} ms | {:.1} M | {:.1} M | {:.3} | {:.1} M | {:.1} M |",
             build.as_secs_f64() * 1e3,
             per_second(coherent_time) / 1e6,
             per_second(incoherent_time) / 1e6,
             incoherent_time.as_secs_f64() * 1e6 * threads / RAYS as f64,
             per_second(surface_time) / 1e6,
+            per_second(stream_time) / 1e6,
         );
     }
 }
@@ -70,21 +76,30 @@ enum Query {
     Primitive,
     /// [`ShapeList::closest_hit`]
     Surface,
+    /// [`ShapeList::closest_primitives`] over each batch
+    Stream,
 }
 
 /// Traces every ray for its closest hit, in parallel; returns the wall time.
 fn trace(list: &ShapeList, rays: &[Ray], query: Query) -> Duration {
     let start = Instant::now();
     let hits: usize = rays
-        .par_chunks(4096)
-        .map(|chunk| {
-            chunk
+        .par_chunks(BATCH)
+        .map(|chunk| match query {
+            Query::Primitive => chunk
                 .iter()
-                .filter(|r| match query {
-                    Query::Primitive => list.closest_primitive(r, f32::INFINITY).is_some(),
-                    Query::Surface => list.closest_hit(r, f32::INFINITY).is_some(),
-                })
-                .count()
+                .filter(|r| list.closest_primitive(r, f32::INFINITY).is_some())
+                .count(),
+            Query::Surface => chunk
+                .iter()
+                .filter(|r| list.closest_hit(r, f32::INFINITY).is_some())
+                .count(),
+            Query::Stream => {
+                let mut hits = [None; BATCH];
+                let hits = &mut hits[..chunk.len()];
+                list.closest_primitives(chunk, &[f32::INFINITY; BATCH][..chunk.len()], hits);
+                hits.iter().filter(|h| h.is_some()).count()
+            }
         })
         .sum();
     let elapsed = start.elapsed();

@@ -366,6 +366,12 @@ impl TraversalStack {
         }
     }
 
+    /// Empties the stack for a new ray.
+    #[inline]
+    pub(super) fn clear(&mut self) {
+        self.len = 0;
+    }
+
     #[inline]
     fn push(&mut self, link: Link, t_enter: f32) {
         self.links[self.len] = link;

@@ -468,8 +468,9 @@ impl ShapeList {
 /// which primitive a BVH slot holds.
 struct ClosestSearch {
     ray: Ray,
-    /// (Only triangle tests read it; a few divisions per query.)
-    watertight: WatertightRay,
+    /// The ray prepared for triangle tests, made on first use: a third of
+    /// incoherent rays meet no leaf, and it costs three divisions.
+    watertight: Option<WatertightRay>,
     t_max: f32,
     best: Option<(f32, Found)>,
 }
@@ -485,7 +486,7 @@ impl ClosestSearch {
     fn new(ray: &Ray, t_max: f32) -> Self {
         Self {
             ray: *ray,
-            watertight: WatertightRay::new(ray),
+            watertight: None,
             t_max,
             best: None,
         }
@@ -514,7 +515,11 @@ impl ClosestSearch {
 
     /// Tests one primitive on its own.
     fn test(&mut self, list: &ShapeList, p: Primitive) {
-        if let Some(t) = list.primitive_distance(p, &self.ray, &self.watertight, self.limit()) {
+        let ray = self.ray;
+        let watertight = *self
+            .watertight
+            .get_or_insert_with(|| WatertightRay::new(&ray));
+        if let Some(t) = list.primitive_distance(p, &self.ray, &watertight, self.limit()) {
             self.consider(list, Found::Primitive(p), t);
         }
     }
@@ -535,7 +540,11 @@ impl ClosestSearch {
     /// Tests the leaf at `first`; returns the new limit.
     #[inline]
     fn visit_leaf(&mut self, list: &ShapeList, first: u32) -> f32 {
-        let (mut hits, t) = list.leaf_hits(first, &self.ray, &self.watertight, self.limit());
+        let (ray, limit) = (self.ray, self.limit());
+        let watertight = self
+            .watertight
+            .get_or_insert_with(|| WatertightRay::new(&ray));
+        let (mut hits, t) = list.leaf_hits(first, &ray, watertight, limit);
         if hits != 0 {
             // What the slot holds is read at the end of the query.
             if let Some(slot) = list.primitives.get(first as usize) {

@@ -70,6 +70,11 @@ struct Lane<S> {
     ray: PreparedRay,
     t_max: f32,
     next: Link,
+    /// The traversal is over. The ray ends on the lane's next turn, so that what
+    /// the caller prefetched in its last leaf visit (the hit primitive's record,
+    /// read at the end) has arrived: 10–13% faster on 1M and 4M triangles in two
+    /// of three A/B runs in one process, the same in the third.
+    done: bool,
     state: S,
 }
 
@@ -83,6 +88,7 @@ impl<S: Default> Lane<S> {
             ray: PreparedRay::new(&Ray::new(Vec3::ZERO, Vec3::ONE)),
             t_max: 0.0,
             next: Link::ROOT,
+            done: false,
             state: S::default(),
         }
     }
@@ -108,7 +114,11 @@ impl Bvh {
         }
         while in_flight > 0 {
             for (lane, stack) in lanes.iter_mut().zip(&mut stacks) {
-                if lane.index == Lane::<S::State>::IDLE || self.advance(lane, stack, stream) {
+                if lane.index == Lane::<S::State>::IDLE {
+                    continue;
+                }
+                if !lane.done {
+                    lane.done = !self.advance(lane, stack, stream);
                     continue;
                 }
                 stream.end(lane.index, &lane.state);
@@ -142,6 +152,7 @@ impl Bvh {
                     lane.ray = PreparedRay::new(&ray);
                     lane.t_max = t_max;
                     lane.next = Link::ROOT;
+                    lane.done = false;
                     return true;
                 }
                 _ => stream.end(index, &lane.state),

@@ -22,6 +22,9 @@
 //!   distances go to the lowest object index, with or without the BVH.
 //! - The BVH ([`bvh`]) is 4-wide; meshes' triangles sit in its leaves as
 //!   [`TrianglePacket`]s of four, tested together ([`triangle_packet`]).
+//! - Batches of rays ([`ShapeList::closest_primitives`], [`ShapeList::any_hits`])
+//!   are traced several at a time, interleaved so that their waits on memory
+//!   overlap; each answer is the one the ray would get alone.
 
 mod aabox;
 pub mod bvh;

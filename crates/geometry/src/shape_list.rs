@@ -391,9 +391,10 @@ impl ShapeList {
                 self.unbounded_hit(ray, &watertight, t_max)
                     || bvh
                         .traverse_leaves(ray, t_max, |first, _, t_max| {
-                            match self.leaf_hits(first, ray, &watertight, t_max) {
-                                (0, _) => ControlFlow::Continue(t_max),
-                                _ => ControlFlow::Break(()),
+                            if self.leaf_occludes(first, ray, &watertight, t_max) {
+                                ControlFlow::Break(())
+                            } else {
+                                ControlFlow::Continue(t_max)
                             }
                         })
                         .is_break()
@@ -420,13 +421,22 @@ impl ShapeList {
     /// Whether an unbounded plane (which the BVH leaves out) lies on the ray in
     /// (0, t_max).
     fn unbounded_hit(&self, ray: &Ray, watertight: &WatertightRay, t_max: f32) -> bool {
-        self.unbounded.iter().any(|&object| {
-            let p = Primitive {
-                object,
-                triangle: 0,
-            };
-            self.primitive_distance(p, ray, watertight, t_max).is_some()
+        self.unbounded_primitives()
+            .any(|p| self.primitive_distance(p, ray, watertight, t_max).is_some())
+    }
+
+    /// The primitives the BVH leaves out: unbounded planes.
+    fn unbounded_primitives(&self) -> impl Iterator<Item = Primitive> + '_ {
+        self.unbounded.iter().map(|&object| Primitive {
+            object,
+            triangle: 0,
         })
+    }
+
+    /// Whether the leaf at `first` holds a primitive on the ray in (0, t_max).
+    #[inline]
+    fn leaf_occludes(&self, first: u32, ray: &Ray, watertight: &WatertightRay, t_max: f32) -> bool {
+        self.leaf_hits(first, ray, watertight, t_max).0 != 0
     }
 
     /// Every primitive, object by object (the linear loop's order).
@@ -526,14 +536,8 @@ impl ClosestSearch {
 
     /// Tests the primitives the BVH leaves out: unbounded planes.
     fn test_unbounded(&mut self, list: &ShapeList) {
-        for &object in &list.unbounded {
-            self.test(
-                list,
-                Primitive {
-                    object,
-                    triangle: 0,
-                },
-            );
+        for p in list.unbounded_primitives() {
+            self.test(list, p);
         }
     }
 
@@ -660,15 +664,14 @@ impl RayStream for AnyHitStream<'_> {
         _: u32,
         t_max: f32,
     ) -> ControlFlow<(), f32> {
-        match self
+        if self
             .list
-            .leaf_hits(first, &search.ray, &search.watertight, t_max)
+            .leaf_occludes(first, &search.ray, &search.watertight, t_max)
         {
-            (0, _) => ControlFlow::Continue(t_max),
-            _ => {
-                search.occluded = true;
-                ControlFlow::Break(())
-            }
+            search.occluded = true;
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(t_max)
         }
     }
 

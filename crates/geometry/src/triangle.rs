@@ -21,33 +21,60 @@ use glam::Vec3;
 pub struct WatertightRay {
     pub(crate) origin: Vec3,
     /// Axis permutation: the ray's dominant axis becomes z.
-    pub(crate) kx: usize,
-    pub(crate) ky: usize,
-    pub(crate) kz: usize,
+    pub(crate) kx: Axis,
+    pub(crate) ky: Axis,
+    pub(crate) kz: Axis,
     /// Shear that makes the ray direction (0, 0, 1).
     pub(crate) sx: f32,
     pub(crate) sy: f32,
     pub(crate) sz: f32,
 }
 
+/// A coordinate axis. An index that is known to be below 3, so that indexing a
+/// three-element array with it needs no bounds check (the permutation is applied
+/// for every triangle tested).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub(crate) enum Axis {
+    X = 0,
+    Y = 1,
+    Z = 2,
+}
+
+impl Axis {
+    const ALL: [Axis; 3] = [Axis::X, Axis::Y, Axis::Z];
+
+    /// The axis after this one, cyclically.
+    fn next(self) -> Axis {
+        Axis::ALL[(self as usize + 1) % 3]
+    }
+
+    #[inline(always)]
+    pub(crate) fn index(self) -> usize {
+        self as usize
+    }
+}
+
 impl WatertightRay {
+    #[inline]
     pub fn new(ray: &Ray) -> Self {
-        let d = ray.direction;
-        let kz = d.abs().max_position();
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
+        let d = ray.direction.to_array();
+        let kz = Axis::ALL[ray.direction.abs().max_position()];
+        let mut kx = kz.next();
+        let mut ky = kx.next();
         // Keep the winding: swapping x and y when the ray points down z.
-        if d[kz] < 0.0 {
+        if d[kz.index()] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        let dz = d[kz.index()];
         Self {
             origin: ray.origin,
             kx,
             ky,
             kz,
-            sx: d[kx] / d[kz],
-            sy: d[ky] / d[kz],
-            sz: 1.0 / d[kz],
+            sx: d[kx.index()] / dz,
+            sy: d[ky.index()] / dz,
+            sz: 1.0 / dz,
         }
     }
 
@@ -57,7 +84,8 @@ impl WatertightRay {
     #[inline]
     pub fn intersect(&self, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<(f32, [f32; 3])> {
         let (a, b, c) = (p0 - self.origin, p1 - self.origin, p2 - self.origin);
-        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
+        let (a, b, c) = (a.to_array(), b.to_array(), c.to_array());
+        let (kx, ky, kz) = (self.kx.index(), self.ky.index(), self.kz.index());
         let ax = a[kx] - self.sx * a[kz];
         let ay = a[ky] - self.sy * a[kz];
         let bx = b[kx] - self.sx * b[kz];

@@ -117,11 +117,11 @@ impl WatertightRay {
     /// of exactly zero are reported in `on_edge`; their `hits` bits are meaningless.
     #[inline]
     fn intersect4_simd(&self, packet: &TrianglePacket, t_max: f32) -> SimdResult {
-        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
+        let (kx, ky, kz) = (self.kx.index(), self.ky.index(), self.kz.index());
         let [p0, p1, p2] = &packet.corners;
         // Translate to the ray origin (as `p - origin` in the scalar code), keeping
         // only the permuted axes: index the axis arrays with kx, ky, kz.
-        let o = self.origin;
+        let o = self.origin.to_array();
         let (ox, oy, oz) = (Vec4::splat(o[kx]), Vec4::splat(o[ky]), Vec4::splat(o[kz]));
         let (a_x, a_y, a_z) = (p0[kx] - ox, p0[ky] - oy, p0[kz] - oz);
         let (b_x, b_y, b_z) = (p1[kx] - ox, p1[ky] - oy, p1[kz] - oz);

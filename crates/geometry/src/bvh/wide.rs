@@ -271,21 +271,28 @@ fn open_children(binary: &[BvhNode], index: usize) -> [Option<usize>; WIDTH] {
 pub(super) struct PreparedRay {
     origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
-    near: [usize; 3],
-    far: [usize; 3],
+    /// Per axis: the ray meets the minima first (`1/dᵢ ≥ 0`).
+    min_first: [bool; 3],
 }
 
 impl PreparedRay {
+    #[inline]
     pub(super) fn new(ray: &Ray) -> Self {
-        let inv_dir = ray.direction.recip();
-        // The sign of 1/d, not of d: d = −0 gives −∞, for which the maxima are near.
-        let near = [0, 1, 2].map(|i| if inv_dir[i] >= 0.0 { i } else { 3 + i });
+        // Spelt out axis by axis: `[0, 1, 2].map` is not always inlined.
+        let (o, inv) = (ray.origin, ray.direction.recip());
         Self {
-            origin: [0, 1, 2].map(|i| Vec4::splat(ray.origin[i])),
-            inv_dir: [0, 1, 2].map(|i| Vec4::splat(inv_dir[i])),
-            near,
-            far: near.map(|p| (p + 3) % 6),
+            origin: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
+            inv_dir: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            // The sign of 1/d, not of d: d = −0 gives −∞, for which the maxima are near.
+            min_first: [inv.x >= 0.0, inv.y >= 0.0, inv.z >= 0.0],
         }
+    }
+
+    /// The indices into [`WideNode::planes`] of the near and the far plane on `axis`.
+    #[inline(always)]
+    fn planes(&self, axis: usize) -> (usize, usize) {
+        let min_first = self.min_first[axis] as usize;
+        (axis + 3 * (1 - min_first), axis + 3 * min_first)
     }
 
     /// The slab test of [`super::Bounds3::hit`] for the four children of a node:
@@ -306,8 +313,9 @@ impl PreparedRay {
         let mut enter = Vec4::ZERO;
         let mut exit = Vec4::splat(t_max);
         for axis in 0..3 {
-            let near = (node.planes[self.near[axis]] - self.origin[axis]) * self.inv_dir[axis];
-            let far = (node.planes[self.far[axis]] - self.origin[axis]) * self.inv_dir[axis];
+            let (near, far) = self.planes(axis);
+            let near = (node.planes[near] - self.origin[axis]) * self.inv_dir[axis];
+            let far = (node.planes[far] - self.origin[axis]) * self.inv_dir[axis];
             enter = max_or_second(near, enter);
             exit = min_or_second(far, exit);
         }
@@ -399,10 +407,24 @@ impl TraversalStack {
     #[inline(always)]
     pub(super) fn order(&mut self, node: &WideNode, hits: u32, enter: Vec4) -> Link {
         debug_assert!(hits != 0);
-        if hits & (hits - 1) == 0 {
-            return node.links[hits.trailing_zeros() as usize];
+        let first = hits.trailing_zeros() as usize;
+        let rest = hits & (hits - 1);
+        if rest == 0 {
+            return node.links[first];
         }
         let enter = enter.to_array();
+        if rest & (rest - 1) == 0 {
+            // Two children, the commonest case past one: no sort. On a tie the
+            // later lane goes first, as in the sort below.
+            let second = rest.trailing_zeros() as usize;
+            let (near, far) = if enter[second] <= enter[first] {
+                (second, first)
+            } else {
+                (first, second)
+            };
+            self.push(node.links[far], enter[far]);
+            return node.links[near];
+        }
         let mut lanes = [0usize; WIDTH];
         let mut n = 0;
         let mut bits = hits;

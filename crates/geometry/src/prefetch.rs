@@ -18,6 +18,15 @@ pub(crate) fn prefetch<T>(item: &T) {
     prefetch_line(start.wrapping_add(size.saturating_sub(1)));
 }
 
+/// Asks for the `count` 64-byte cache lines from the one holding `start`: a hint
+/// as [`prefetch`] gives, for an address that need not point to anything.
+#[inline(always)]
+pub(crate) fn prefetch_lines(start: *const u8, count: usize) {
+    for line in 0..count {
+        prefetch_line(start.wrapping_add(64 * line));
+    }
+}
+
 #[inline(always)]
 fn prefetch_line(address: *const u8) {
     #[cfg(target_arch = "x86_64")]
@@ -25,7 +34,7 @@ fn prefetch_line(address: *const u8) {
     // `#[target_feature(enable = "sse")]`, and SSE is part of the x86_64 baseline:
     // the feature is always present. The instruction itself is a hint: it never
     // faults, whatever the address, and writes no memory or register the program
-    // can observe. (The addresses come from references anyway.)
+    // can observe: any address is fine, even one that points to nothing.
     unsafe {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
         _mm_prefetch::<_MM_HINT_T0>(address.cast::<i8>());

@@ -366,12 +366,12 @@ impl ShapeList {
         }
     }
 
-    /// Reads the packet of the leaf at `first` ahead of its test.
+    /// Where the packet of the leaf at `first` is, for prefetching: only an
+    /// address (see [`RayStream::leaf_address`]).
     #[inline(always)]
-    fn prefetch_leaf(&self, first: u32) {
-        if let Some(packet) = self.packets.get(first as usize / LEAF_WIDTH) {
-            prefetch(packet);
-        }
+    fn leaf_address(&self, first: u32) -> *const u8 {
+        let packets = self.packets.as_ptr();
+        packets.wrapping_add(first as usize / LEAF_WIDTH).cast()
     }
 
     /// The primitive a candidate names.
@@ -593,8 +593,8 @@ impl RayStream for ClosestStream<'_> {
     }
 
     #[inline(always)]
-    fn prefetch_leaf(&self, first: u32) {
-        self.list.prefetch_leaf(first);
+    fn leaf_address(&self, first: u32) -> *const u8 {
+        self.list.leaf_address(first)
     }
 
     #[inline(always)]
@@ -652,8 +652,8 @@ impl RayStream for AnyHitStream<'_> {
     }
 
     #[inline(always)]
-    fn prefetch_leaf(&self, first: u32) {
-        self.list.prefetch_leaf(first);
+    fn leaf_address(&self, first: u32) -> *const u8 {
+        self.list.leaf_address(first)
     }
 
     #[inline(always)]

@@ -355,8 +355,9 @@ fn min_or_second(a: Vec4, b: Vec4) -> Vec4 {
 /// Entries in the traversal stack. A visit pushes at most three children (the
 /// fourth is visited next), and a node at depth `d` is visited with at most `3d`
 /// entries on the stack; the depth of the wide tree is at most the binary tree's,
-/// at most [`super::MAX_DEPTH`].
-const STACK_SIZE: usize = 3 * super::MAX_DEPTH;
+/// at most [`super::MAX_DEPTH`]. One more slot takes the write above the top that
+/// [`TraversalStack::order`] does not keep.
+const STACK_SIZE: usize = 3 * super::MAX_DEPTH + 1;
 
 /// Children still to visit with their entry distances, in a fixed array.
 pub(super) struct TraversalStack {
@@ -404,34 +405,45 @@ impl TraversalStack {
     /// returns the one entered first and pushes the others, farthest first, so that
     /// they are popped front to back. (Which of two equally near children goes
     /// first changes no query's answer; see [`super::Bvh::closest_hit`].)
+    ///
+    /// One or two children (95% of the nodes an incoherent ray enters) take the
+    /// same path, without a branch on which: the far child is written just above
+    /// the top of the stack and kept only if it is not the near one. Measured (A/B
+    /// in one process, incoherent streams, one core): 6–10% more rays per second on
+    /// 10k, 1M and 4M triangles than branching on the count.
     #[inline(always)]
     pub(super) fn order(&mut self, node: &WideNode, hits: u32, enter: Vec4) -> Link {
         debug_assert!(hits != 0);
-        let first = hits.trailing_zeros() as usize;
         let rest = hits & (hits - 1);
-        if rest == 0 {
-            return node.links[first];
+        if rest & (rest - 1) != 0 {
+            return self.order_many(node, hits, enter);
         }
+        let first = hits.trailing_zeros() as usize;
+        let last = (31 - hits.leading_zeros()) as usize;
         let enter = enter.to_array();
-        if rest & (rest - 1) == 0 {
-            // Two children, the commonest case past one: no sort. On a tie the
-            // later lane goes first, as in the sort below.
-            let second = rest.trailing_zeros() as usize;
-            let (near, far) = if enter[second] <= enter[first] {
-                (second, first)
-            } else {
-                (first, second)
-            };
-            self.push(node.links[far], enter[far]);
-            return node.links[near];
-        }
+        // On a tie the later lane goes first, as in `order_many`.
+        let (near, far) = if enter[last] <= enter[first] {
+            (last, first)
+        } else {
+            (first, last)
+        };
+        self.links[self.len] = node.links[far];
+        self.enter[self.len] = enter[far];
+        self.len += usize::from(rest != 0);
+        node.links[near]
+    }
+
+    /// [`TraversalStack::order`] for three or four children: an insertion sort.
+    #[inline(never)]
+    fn order_many(&mut self, node: &WideNode, hits: u32, enter: Vec4) -> Link {
+        let enter = enter.to_array();
         let mut lanes = [0usize; WIDTH];
         let mut n = 0;
         let mut bits = hits;
         while bits != 0 {
             let lane = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            // Insertion sort, farthest first.
+            // Farthest first.
             let mut j = n;
             while j > 0 && enter[lanes[j - 1]] < enter[lane] {
                 lanes[j] = lanes[j - 1];

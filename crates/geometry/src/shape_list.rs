@@ -481,7 +481,10 @@ struct ClosestSearch {
     /// The ray prepared for triangle tests, made on first use: a third of
     /// incoherent rays meet no leaf, and it costs three divisions.
     watertight: Option<WatertightRay>,
-    t_max: f32,
+    /// How far a hit may still be: the query's `t_max`, or just past the best
+    /// hit, so that the BVH still visits nodes entered exactly at its distance
+    /// (which may hold a lower-index primitive at the same distance).
+    limit: f32,
     best: Option<(f32, Found)>,
 }
 
@@ -497,17 +500,14 @@ impl ClosestSearch {
         Self {
             ray: *ray,
             watertight: None,
-            t_max,
+            limit: t_max,
             best: None,
         }
     }
 
-    /// How far a hit may still be: the query's `t_max`, or just past the best
-    /// hit, so that the BVH still visits nodes entered exactly at its distance
-    /// (which may hold a lower-index primitive at the same distance).
     #[inline]
     fn limit(&self) -> f32 {
-        self.best.map_or(self.t_max, |(t, _)| t.next_up())
+        self.limit
     }
 
     #[inline]
@@ -520,6 +520,7 @@ impl ClosestSearch {
         };
         if better {
             self.best = Some((t, found));
+            self.limit = t.next_up();
         }
     }
 

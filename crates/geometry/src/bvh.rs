@@ -29,6 +29,7 @@
 mod stream;
 mod wide;
 
+use crate::prefetch::prefetch;
 use crate::Ray;
 use glam::{Vec3, Vec3A};
 use std::ops::ControlFlow;
@@ -425,7 +426,7 @@ impl Bvh {
                 &mut visit_leaf,
                 |node, hits| {
                     if hits & (hits - 1) != 0 {
-                        self.touch_children(node, hits);
+                        self.prefetch_children(node, hits);
                     }
                 },
             )?;
@@ -461,14 +462,13 @@ impl Bvh {
         })
     }
 
-    /// Reads one word of each interior child in `hits` through
-    /// [`std::hint::black_box`], so that the read is kept: the cache lines are then
-    /// on their way while the nearest child is traversed, and usually still cached
-    /// when the others' turn comes. The safe stand-in for a prefetch instruction;
-    /// measured (A/B in one process, median of 5) at +6% incoherent rays per
-    /// second on 1M and 4M triangles, and within noise (−1%) on 10k.
+    /// Prefetches each interior child in `hits`: the cache lines are then on their
+    /// way while the nearest child is traversed, and usually cached when the
+    /// others' turn comes. Measured (A/B in one process, one ray at a time): +4–7%
+    /// incoherent rays per second on 1M and 4M triangles over reading one word of
+    /// each child through `black_box`, which had itself gained 6% over nothing.
     #[inline(always)]
-    fn touch_children(&self, node: &wide::WideNode, hits: u32) {
+    fn prefetch_children(&self, node: &wide::WideNode, hits: u32) {
         let mut bits = hits;
         while bits != 0 {
             let lane = bits.trailing_zeros() as usize;
@@ -476,7 +476,7 @@ impl Bvh {
             let link = node.link(lane);
             if !link.is_leaf() {
                 if let Some(child) = self.tree.nodes.get(link.node()) {
-                    std::hint::black_box(child.first_word());
+                    prefetch(child);
                 }
             }
         }

@@ -131,12 +131,6 @@ impl WideNode {
         self.links[lane]
     }
 
-    /// The node's first word, for reading it ahead of time.
-    #[inline(always)]
-    pub(super) fn first_word(&self) -> f32 {
-        self.planes[0].x
-    }
-
     /// The used children: (lane, link).
     pub(super) fn children(&self) -> impl Iterator<Item = (usize, Link)> + '_ {
         self.links
@@ -481,5 +475,52 @@ pub(super) mod tests {
         assert!(!interior.is_leaf());
         assert_eq!(interior.node(), 777);
         assert_eq!(Link::ROOT.node(), 0);
+    }
+
+    /// The children `order` hands back for `hits` with entry distances `enter`:
+    /// the one to visit now, then the stack's, as popped (with no pruning).
+    fn visit_order(hits: u32, enter: [f32; 4], stacked: &[(Link, f32)]) -> Vec<usize> {
+        let mut node = WideNode::EMPTY;
+        for lane in 0..WIDTH {
+            node.links[lane] = Link::interior(100 + lane);
+        }
+        let mut stack = TraversalStack::new();
+        for &(link, t) in stacked {
+            stack.push(link, t);
+        }
+        let first = stack.order(&node, hits, Vec4::from_array(enter));
+        let mut order = vec![first.node() - 100];
+        while let Some(link) = stack.pop_before(f32::INFINITY) {
+            if link.node() < 100 {
+                break;
+            }
+            order.push(link.node() - 100);
+        }
+        order
+    }
+
+    #[test]
+    fn order_visits_the_hit_children_front_to_back_whatever_their_count() {
+        let enter = [3.0, 1.0, 4.0, 2.0];
+        // One child: nothing pushed, although the far slot is written above the top.
+        let below = [(Link::interior(7), 9.0)];
+        assert_eq!(visit_order(0b0100, enter, &below), [2]);
+        let mut stack = TraversalStack::new();
+        stack.push(Link::interior(7), 9.0);
+        let node = WideNode::EMPTY;
+        stack.order(&node, 0b0100, Vec4::from_array(enter));
+        assert_eq!(stack.len, 1, "a lone child leaves the stack as it was");
+        // Two children, in either lane order.
+        assert_eq!(visit_order(0b0011, enter, &below), [1, 0]);
+        assert_eq!(visit_order(0b0101, enter, &below), [0, 2]);
+        assert_eq!(visit_order(0b1100, enter, &below), [3, 2]);
+        // Three and four: sorted.
+        assert_eq!(visit_order(0b0111, enter, &below), [1, 0, 2]);
+        assert_eq!(visit_order(0b1111, enter, &below), [1, 3, 0, 2]);
+        // Ties: the later lane first, with two children as with more.
+        let tied = [2.0, 2.0, 2.0, 2.0];
+        assert_eq!(visit_order(0b0011, tied, &[]), [1, 0]);
+        assert_eq!(visit_order(0b1010, tied, &[]), [3, 1]);
+        assert_eq!(visit_order(0b1011, tied, &[]), [3, 1, 0]);
     }
 }

@@ -409,7 +409,7 @@ impl TraversalStack {
     pub(super) fn order(&mut self, node: &WideNode, hits: u32, enter: Vec4) -> Link {
         debug_assert!(hits != 0);
         let rest = hits & (hits - 1);
-        if rest & (rest - 1) != 0 {
+        if rest & rest.wrapping_sub(1) != 0 {
             return self.order_many(node, hits, enter);
         }
         let first = hits.trailing_zeros() as usize;

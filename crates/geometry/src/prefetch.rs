@@ -9,11 +9,7 @@
 pub(crate) fn prefetch<T>(item: &T) {
     let start = (item as *const T).cast::<u8>();
     let size = std::mem::size_of::<T>();
-    let mut offset = 0;
-    while offset < size {
-        prefetch_line(start.wrapping_add(offset));
-        offset += 64;
-    }
+    prefetch_lines(start, size.div_ceil(64));
     // The last line, which an unaligned `item` reaches past the ones above.
     prefetch_line(start.wrapping_add(size.saturating_sub(1)));
 }

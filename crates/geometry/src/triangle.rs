@@ -62,11 +62,11 @@ impl WatertightRay {
         let kz = Axis::ALL[ray.direction.abs().max_position()];
         let mut kx = kz.next();
         let mut ky = kx.next();
+        let dz = d[kz.index()];
         // Keep the winding: swapping x and y when the ray points down z.
-        if d[kz.index()] < 0.0 {
+        if dz < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        let dz = d[kz.index()];
         Self {
             origin: ray.origin,
             kx,

@@ -26,31 +26,21 @@
 //!   are traced several at a time, interleaved so that their waits on memory
 //!   overlap; each answer is the one the ray would get alone.
 
-mod aabox;
 pub mod bvh;
 mod differentials;
 mod hit;
-mod mesh;
 mod offset;
-mod parallelogram;
-mod plane;
 mod prefetch;
 mod ray;
-mod shape;
 mod shape_list;
-mod sphere;
-pub mod triangle;
-pub mod triangle_packet;
+mod shapes;
 
-pub use aabox::AaBox;
 pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceDifferentials};
 pub use hit::Hit;
-pub use mesh::{MeshError, TriangleMesh};
 pub use offset::{offset_ray_origin, spawn_ray, spawn_ray_to, SHADOW_EPSILON};
-pub use parallelogram::Parallelogram;
-pub use plane::Plane;
 pub use ray::Ray;
-pub use shape::Shape;
 pub use shape_list::{ObjectRef, PrimitiveHit, ShapeList};
-pub use sphere::Sphere;
-pub use triangle_packet::TrianglePacket;
+pub use shapes::{triangle, triangle_packet};
+pub use shapes::{
+    AaBox, MeshError, Parallelogram, Plane, Shape, Sphere, TriangleMesh, TrianglePacket,
+};

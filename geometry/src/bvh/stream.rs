@@ -18,7 +18,9 @@
 //! at every step), so every answer is the same, bit for bit. Nothing is
 //! allocated: the lanes and their stacks live in the call's frame.
 
-use super::wide::{Link, PreparedRay, TraversalStack};
+use super::prepared_ray::PreparedRay;
+use super::traversal_stack::TraversalStack;
+use super::wide::Link;
 use super::Bvh;
 use crate::prefetch::prefetch_lines;
 use crate::Ray;
@@ -219,8 +221,8 @@ impl Bvh {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{box_hit, random_boxes, XorShift};
     use super::*;
+    use crate::bvh::test_support::{box_hit, random_boxes, XorShift};
     use crate::bvh::{Bounds3, LEAF_WIDTH};
 
     /// A leaf visit as a traversal reports it: (first, count, t_max).

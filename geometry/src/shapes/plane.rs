@@ -1,3 +1,6 @@
+//! Infinite planes: the ray–plane test and the planar uv mapping that tiles
+//! texture to the horizon.
+
 use crate::{Hit, Ray};
 use glam::{Vec2, Vec3};
 

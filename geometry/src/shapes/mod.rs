@@ -1,5 +1,29 @@
+//! The shapes rays can hit, one file per primitive, each with its ray–shape test
+//! (`hit_distance`) beside its surface record and uv mapping (`surface_at`):
+//! [`Sphere`], [`Parallelogram`], [`Plane`], [`AaBox`], and triangle meshes
+//! ([`TriangleMesh`], intersected with the watertight test of [`triangle`], four
+//! at a time in BVH leaves by [`triangle_packet`]).
+//!
+//! [`Shape`] gathers the analytic shapes in one enum, so that intersection
+//! dispatch is a `match`, not a virtual call, and shapes sit in one flat array.
+
+mod aabox;
+mod mesh;
+mod parallelogram;
+mod plane;
+mod sphere;
+pub mod triangle;
+pub mod triangle_packet;
+
+pub use aabox::AaBox;
+pub use mesh::{MeshError, TriangleMesh};
+pub use parallelogram::Parallelogram;
+pub use plane::Plane;
+pub use sphere::Sphere;
+pub use triangle_packet::TrianglePacket;
+
 use crate::bvh::Bounds3;
-use crate::{AaBox, Hit, Parallelogram, Plane, Ray, Sphere};
+use crate::{Hit, Ray};
 
 /// Every kind of shape, as one enum so intersection dispatch is a `match`,
 /// not a virtual call, and shapes sit in one flat array.

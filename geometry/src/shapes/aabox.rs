@@ -1,3 +1,5 @@
+//! Axis-aligned boxes: the ray–box test and the per-face uv squares.
+
 use crate::{Hit, Parallelogram, Ray};
 use glam::{Vec2, Vec3};
 

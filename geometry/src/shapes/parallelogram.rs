@@ -1,3 +1,6 @@
+//! Parallelograms (the course's walls and area lights): the ray test and the
+//! uv mapping by edge coordinates.
+
 use crate::{Hit, Ray};
 use glam::{Vec2, Vec3};
 

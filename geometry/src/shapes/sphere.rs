@@ -1,3 +1,6 @@
+//! Spheres: the ray–sphere test in its precision-improved form, and the
+//! spherical uv mapping with its derivatives.
+
 use crate::{Hit, Ray};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};

@@ -1,0 +1,139 @@
+//! The acceleration structure of a [`ShapeList`]: a BVH over every bounded
+//! primitive (each analytic shape, each triangle), with the primitives stored in
+//! the BVH's leaf order and each leaf's triangles as one four-lane packet.
+
+use super::{Object, Primitive, ShapeList};
+use crate::bvh::{Bounds3, Bvh, BvhStats, LEAF_WIDTH};
+use crate::triangle::WatertightRay;
+use crate::{Ray, TrianglePacket};
+use glam::Vec4;
+
+/// Below this many primitives [`ShapeList::build_acceleration`] builds no BVH.
+pub const LINEAR_LIMIT: usize = 32;
+
+impl ShapeList {
+    /// Builds the BVH if the scene is large enough for it to pay: below
+    /// 32 primitives (`LINEAR_LIMIT`) the linear loop is faster (and gives the same
+    /// answers), so none is built.
+    pub fn build_acceleration(&mut self) {
+        let primitives: usize = self
+            .objects
+            .iter()
+            .map(|o| match *o {
+                Object::Shape(_) => 1,
+                Object::Mesh(m) => self.meshes[m as usize].triangle_count(),
+            })
+            .sum();
+        if primitives >= LINEAR_LIMIT {
+            self.build_bvh();
+        } else {
+            self.bvh = None;
+        }
+    }
+
+    /// Builds the BVH over every bounded primitive (binned SAH; see [`Bvh`]).
+    pub fn build_bvh(&mut self) {
+        let mut primitives = Vec::new();
+        let mut bounds = Vec::new();
+        self.unbounded.clear();
+        for (object, kind) in self.objects.iter().enumerate() {
+            let object = object as u32;
+            match *kind {
+                Object::Shape(s) => match self.shapes[s as usize].bounds() {
+                    Some(b) => {
+                        primitives.push(Primitive {
+                            object,
+                            triangle: 0,
+                        });
+                        bounds.push(b);
+                    }
+                    None => self.unbounded.push(object),
+                },
+                Object::Mesh(m) => {
+                    let mesh = &self.meshes[m as usize];
+                    for triangle in 0..mesh.triangle_count() as u32 {
+                        let (lo, hi) = mesh.triangle_bounds(triangle);
+                        primitives.push(Primitive { object, triangle });
+                        bounds.push(Bounds3::new(lo, hi));
+                    }
+                }
+            }
+        }
+        let mut bvh = Bvh::build(&bounds);
+        let order = bvh.take_primitive_order();
+        self.primitives = order
+            .iter()
+            .map(|&i| {
+                primitives
+                    .get(i as usize)
+                    .copied()
+                    .unwrap_or(Primitive::PADDING)
+            })
+            .collect();
+        let leaves = self.primitives.chunks_exact(LEAF_WIDTH);
+        self.packets = leaves.clone().map(|leaf| self.packet_of(leaf)).collect();
+        self.shape_lanes = leaves
+            .map(|leaf| {
+                leaf.iter().enumerate().fold(0u8, |lanes, (lane, p)| {
+                    match self.objects.get(p.object as usize) {
+                        Some(Object::Shape(_)) => lanes | 1 << lane,
+                        _ => lanes,
+                    }
+                })
+            })
+            .collect();
+        self.bvh = Some(bvh);
+    }
+
+    /// The triangles of one leaf as a packet; other lanes NaN.
+    fn packet_of(&self, leaf: &[Primitive]) -> TrianglePacket {
+        let mut packet = TrianglePacket::EMPTY;
+        for (lane, p) in leaf.iter().enumerate() {
+            if let Some(Object::Mesh(m)) = self.objects.get(p.object as usize) {
+                packet.set_lane(lane, &self.meshes[*m as usize].corners(p.triangle));
+            }
+        }
+        packet
+    }
+
+    /// The hits of the leaf at `first` (a multiple of [`LEAF_WIDTH`]) in
+    /// (0, t_max): bit `k` of the mask for the primitive at `first + k`, lane `k`
+    /// its distance. Triangles are tested four at a time, shapes one by one.
+    #[inline]
+    pub(super) fn leaf_hits(
+        &self,
+        first: u32,
+        ray: &Ray,
+        watertight: &WatertightRay,
+        t_max: f32,
+    ) -> (u32, Vec4) {
+        let leaf = first as usize / LEAF_WIDTH;
+        let (mut hits, mut t) = watertight.intersect4(&self.packets[leaf], t_max);
+        let mut shapes = self.shape_lanes[leaf];
+        while shapes != 0 {
+            let lane = shapes.trailing_zeros() as usize;
+            shapes &= shapes - 1;
+            let p = self.primitives[first as usize + lane];
+            if let Object::Shape(s) = self.objects[p.object as usize] {
+                if let Some(d) = self.shapes[s as usize].hit_distance(ray, t_max) {
+                    hits |= 1 << lane;
+                    t[lane] = d;
+                }
+            }
+        }
+        (hits, t)
+    }
+
+    /// Statistics of the BVH, once built.
+    pub fn bvh_stats(&self) -> Option<BvhStats> {
+        self.bvh.as_ref().map(Bvh::stats)
+    }
+
+    /// Where the packet of the leaf at `first` is, for prefetching: only an
+    /// address (see [`RayStream::leaf_address`](crate::bvh::RayStream::leaf_address)).
+    #[inline(always)]
+    pub(super) fn leaf_address(&self, first: u32) -> *const u8 {
+        let packets = self.packets.as_ptr();
+        packets.wrapping_add(first as usize / LEAF_WIDTH).cast()
+    }
+}

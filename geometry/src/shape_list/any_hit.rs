@@ -1,0 +1,154 @@
+//! Any-hit (shadow) queries: whether anything lies on a ray before `t_max`, for
+//! one ray or a batch traced as an interleaved stream.
+
+use super::{Object, ShapeList};
+use crate::bvh::RayStream;
+use crate::triangle::WatertightRay;
+use crate::Ray;
+use glam::Vec3;
+use std::ops::ControlFlow;
+
+impl ShapeList {
+    /// Whether anything lies on the ray with `0 < t < t_max` (shadow query).
+    pub fn any_hit(&self, ray: &Ray, t_max: f32) -> bool {
+        match &self.bvh {
+            Some(bvh) => {
+                let watertight = WatertightRay::new(ray);
+                self.unbounded_hit(ray, &watertight, t_max)
+                    || bvh
+                        .traverse_leaves(ray, t_max, |first, _, t_max| {
+                            if self.leaf_occludes(first, ray, &watertight, t_max) {
+                                ControlFlow::Break(())
+                            } else {
+                                ControlFlow::Continue(t_max)
+                            }
+                        })
+                        .is_break()
+            }
+            // Without meshes the objects are the shapes, in order: the course's loop.
+            None if self.meshes.is_empty() => self
+                .shapes
+                .iter()
+                .any(|s| s.hit_distance(ray, t_max).is_some()),
+            None => {
+                let watertight = WatertightRay::new(ray);
+                self.objects.iter().any(|object| match *object {
+                    Object::Shape(s) => self.shapes[s as usize].hit_distance(ray, t_max).is_some(),
+                    Object::Mesh(m) => {
+                        let mesh = &self.meshes[m as usize];
+                        (0..mesh.triangle_count() as u32)
+                            .any(|t| mesh.hit_distance(t, &watertight, t_max).is_some())
+                    }
+                })
+            }
+        }
+    }
+
+    /// [`ShapeList::any_hit`] for each of `rays`, with its own `t_max`, into
+    /// `occluded`: the same answers, found as [`ShapeList::closest_primitives`]
+    /// finds its own (shadow rays of many shading points, say).
+    ///
+    /// Panics unless `t_max` and `occluded` are as long as `rays`.
+    pub fn any_hits(&self, rays: &[Ray], t_max: &[f32], occluded: &mut [bool]) {
+        assert!(
+            t_max.len() == rays.len() && occluded.len() == rays.len(),
+            "one t_max and one answer per ray"
+        );
+        match &self.bvh {
+            Some(bvh) => bvh.traverse_stream(
+                rays.len(),
+                &mut AnyHitStream {
+                    list: self,
+                    rays,
+                    t_max,
+                    occluded,
+                },
+            ),
+            None => {
+                for ((ray, &t_max), occluded) in rays.iter().zip(t_max).zip(occluded) {
+                    *occluded = self.any_hit(ray, t_max);
+                }
+            }
+        }
+    }
+
+    /// Whether an unbounded plane (which the BVH leaves out) lies on the ray in
+    /// (0, t_max).
+    fn unbounded_hit(&self, ray: &Ray, watertight: &WatertightRay, t_max: f32) -> bool {
+        self.unbounded_primitives()
+            .any(|p| self.primitive_distance(p, ray, watertight, t_max).is_some())
+    }
+
+    /// Whether the leaf at `first` holds a primitive on the ray in (0, t_max).
+    #[inline]
+    fn leaf_occludes(&self, first: u32, ray: &Ray, watertight: &WatertightRay, t_max: f32) -> bool {
+        self.leaf_hits(first, ray, watertight, t_max).0 != 0
+    }
+}
+
+/// One shadow ray in flight in [`ShapeList::any_hits`].
+struct AnyHitSearch {
+    ray: Ray,
+    watertight: WatertightRay,
+    occluded: bool,
+}
+
+/// An empty slot of a stream's lane.
+impl Default for AnyHitSearch {
+    fn default() -> Self {
+        let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+        Self {
+            ray,
+            watertight: WatertightRay::new(&ray),
+            occluded: false,
+        }
+    }
+}
+
+/// [`ShapeList::any_hits`] as a [`RayStream`].
+struct AnyHitStream<'a> {
+    list: &'a ShapeList,
+    rays: &'a [Ray],
+    t_max: &'a [f32],
+    occluded: &'a mut [bool],
+}
+
+impl RayStream for AnyHitStream<'_> {
+    type State = AnyHitSearch;
+
+    fn begin(&self, index: usize, search: &mut AnyHitSearch) -> Option<(Ray, f32)> {
+        let (ray, t_max) = (self.rays[index], self.t_max[index]);
+        search.ray = ray;
+        search.watertight = WatertightRay::new(&ray);
+        search.occluded = self.list.unbounded_hit(&ray, &search.watertight, t_max);
+        (!search.occluded).then_some((ray, t_max))
+    }
+
+    #[inline(always)]
+    fn leaf_address(&self, first: u32) -> *const u8 {
+        self.list.leaf_address(first)
+    }
+
+    #[inline(always)]
+    fn visit_leaf(
+        &self,
+        search: &mut AnyHitSearch,
+        first: u32,
+        _: u32,
+        t_max: f32,
+    ) -> ControlFlow<(), f32> {
+        if self
+            .list
+            .leaf_occludes(first, &search.ray, &search.watertight, t_max)
+        {
+            search.occluded = true;
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(t_max)
+        }
+    }
+
+    fn end(&mut self, index: usize, search: &AnyHitSearch) {
+        self.occluded[index] = search.occluded;
+    }
+}

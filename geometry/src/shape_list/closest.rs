@@ -1,0 +1,260 @@
+//! Closest-hit queries: the nearest hit with its surface record, the nearest
+//! primitive alone, and batches of rays traced as an interleaved stream. Ties at
+//! exactly equal distances go to the lowest (object, triangle), with or without
+//! the BVH.
+
+use super::{Object, Primitive, ShapeList};
+use crate::bvh::RayStream;
+use crate::prefetch::prefetch;
+use crate::triangle::WatertightRay;
+use crate::{Hit, Ray};
+use glam::Vec3;
+use std::ops::ControlFlow;
+
+/// A candidate for the closest hit: a primitive, or a position in the BVH's leaf
+/// order, looked up only when needed.
+#[derive(Clone, Copy, Debug)]
+enum Found {
+    Primitive(Primitive),
+    Slot(u32),
+}
+
+/// The closest hit as [`ShapeList::closest_primitive`] reports it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimitiveHit {
+    /// Distance along the ray, in multiples of its direction.
+    pub t: f32,
+    /// The object hit, as [`crate::Hit::shape`].
+    pub object: u32,
+    /// The triangle of a mesh hit (0 for a shape), as [`crate::Hit::primitive`].
+    pub primitive: u32,
+}
+
+impl ShapeList {
+    /// The nearest hit with `0 < t < t_max`, if any, with its surface record.
+    /// Hits at exactly the same distance (a ray through an edge where two surfaces
+    /// meet) go to the lowest object index, then the lowest triangle: the same
+    /// answer with or without the BVH, whatever its layout.
+    pub fn closest_hit(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let found = self.closest_primitive(ray, t_max)?;
+        let hit = match self.objects[found.object as usize] {
+            Object::Shape(s) => Some(self.shapes[s as usize].surface_at(ray, found.t)),
+            // Re-run the (same, deterministic) test for the barycentrics. Without an
+            // upper limit: the test compares T < t_max·det before dividing, and
+            // t = T/det rounded can make t_max·det fall just below T, turning a
+            // found hit into a miss.
+            Object::Mesh(m) => {
+                self.meshes[m as usize].surface_at(found.primitive, ray, f32::INFINITY)
+            }
+        }?;
+        Some(Hit {
+            shape: found.object,
+            primitive: found.primitive,
+            ..hit
+        })
+    }
+
+    /// The nearest hit with `0 < t < t_max` as [`ShapeList::closest_hit`] finds
+    /// it, without its surface record: which primitive, and where along the ray.
+    pub fn closest_primitive(&self, ray: &Ray, t_max: f32) -> Option<PrimitiveHit> {
+        let mut search = ClosestSearch::new(ray, t_max);
+        match &self.bvh {
+            Some(bvh) => {
+                search.test_unbounded(self);
+                let _ = bvh.traverse_leaves(ray, search.limit(), |first, _, _| {
+                    ControlFlow::Continue(search.visit_leaf(self, first))
+                });
+            }
+            None => self.all_primitives().for_each(|p| search.test(self, p)),
+        }
+        search.finish(self)
+    }
+
+    /// [`ShapeList::closest_primitive`] for each of `rays`, with its own
+    /// `t_max`, into `hits`: the same answers, found
+    /// [`STREAM_LANES`](crate::bvh::STREAM_LANES) rays at a time with their
+    /// traversals interleaved ([`Bvh::traverse_stream`](crate::bvh::Bvh::traverse_stream)), which overlaps their
+    /// waits on memory. It pays for batches of incoherent rays (hundreds or more)
+    /// on scenes that outgrow the caches.
+    ///
+    /// Panics unless `t_max` and `hits` are as long as `rays`.
+    pub fn closest_primitives(
+        &self,
+        rays: &[Ray],
+        t_max: &[f32],
+        hits: &mut [Option<PrimitiveHit>],
+    ) {
+        assert!(
+            t_max.len() == rays.len() && hits.len() == rays.len(),
+            "one t_max and one answer per ray"
+        );
+        match &self.bvh {
+            Some(bvh) => bvh.traverse_stream(
+                rays.len(),
+                &mut ClosestStream {
+                    list: self,
+                    rays,
+                    t_max,
+                    hits,
+                },
+            ),
+            None => {
+                for ((ray, &t_max), hit) in rays.iter().zip(t_max).zip(hits) {
+                    *hit = self.closest_primitive(ray, t_max);
+                }
+            }
+        }
+    }
+
+    /// The primitive a candidate names.
+    #[inline]
+    fn resolve(&self, found: Found) -> Primitive {
+        match found {
+            Found::Primitive(p) => p,
+            Found::Slot(k) => self.primitives[k as usize],
+        }
+    }
+}
+
+/// One closest-hit query in progress: the ray, and the best hit so far.
+///
+/// A candidate at distance t (found below the best's t, or equal to it) becomes
+/// the best if nearer, or as near with a lower (object, triangle). Only ties read
+/// which primitive a BVH slot holds.
+struct ClosestSearch {
+    ray: Ray,
+    /// The ray prepared for triangle tests, made on first use: a third of
+    /// incoherent rays meet no leaf, and it costs three divisions.
+    watertight: Option<WatertightRay>,
+    /// How far a hit may still be: the query's `t_max`, or just past the best
+    /// hit, so that the BVH still visits nodes entered exactly at its distance
+    /// (which may hold a lower-index primitive at the same distance).
+    limit: f32,
+    best: Option<(f32, Found)>,
+}
+
+/// An empty slot of a stream's lane.
+impl Default for ClosestSearch {
+    fn default() -> Self {
+        Self::new(&Ray::new(Vec3::ZERO, Vec3::Z), 0.0)
+    }
+}
+
+impl ClosestSearch {
+    fn new(ray: &Ray, t_max: f32) -> Self {
+        Self {
+            ray: *ray,
+            watertight: None,
+            limit: t_max,
+            best: None,
+        }
+    }
+
+    #[inline]
+    fn limit(&self) -> f32 {
+        self.limit
+    }
+
+    #[inline]
+    fn consider(&mut self, list: &ShapeList, found: Found, t: f32) {
+        let better = match self.best {
+            None => true,
+            Some((bt, bf)) => {
+                t < bt || (t == bt && list.resolve(found).key() < list.resolve(bf).key())
+            }
+        };
+        if better {
+            self.best = Some((t, found));
+            self.limit = t.next_up();
+        }
+    }
+
+    /// Tests one primitive on its own.
+    fn test(&mut self, list: &ShapeList, p: Primitive) {
+        let ray = self.ray;
+        let watertight = *self
+            .watertight
+            .get_or_insert_with(|| WatertightRay::new(&ray));
+        if let Some(t) = list.primitive_distance(p, &self.ray, &watertight, self.limit()) {
+            self.consider(list, Found::Primitive(p), t);
+        }
+    }
+
+    /// Tests the primitives the BVH leaves out: unbounded planes.
+    fn test_unbounded(&mut self, list: &ShapeList) {
+        for p in list.unbounded_primitives() {
+            self.test(list, p);
+        }
+    }
+
+    /// Tests the leaf at `first`; returns the new limit.
+    #[inline]
+    fn visit_leaf(&mut self, list: &ShapeList, first: u32) -> f32 {
+        let (ray, limit) = (self.ray, self.limit());
+        let watertight = self
+            .watertight
+            .get_or_insert_with(|| WatertightRay::new(&ray));
+        let (mut hits, t) = list.leaf_hits(first, &ray, watertight, limit);
+        if hits != 0 {
+            // What the slot holds is read at the end of the query.
+            if let Some(slot) = list.primitives.get(first as usize) {
+                prefetch(slot);
+            }
+        }
+        while hits != 0 {
+            let lane = hits.trailing_zeros();
+            hits &= hits - 1;
+            self.consider(list, Found::Slot(first + lane), t[lane as usize]);
+        }
+        self.limit()
+    }
+
+    fn finish(&self, list: &ShapeList) -> Option<PrimitiveHit> {
+        let (t, found) = self.best?;
+        let p = list.resolve(found);
+        Some(PrimitiveHit {
+            t,
+            object: p.object,
+            primitive: p.triangle,
+        })
+    }
+}
+
+/// [`ShapeList::closest_primitives`] as a [`RayStream`].
+struct ClosestStream<'a> {
+    list: &'a ShapeList,
+    rays: &'a [Ray],
+    t_max: &'a [f32],
+    hits: &'a mut [Option<PrimitiveHit>],
+}
+
+impl RayStream for ClosestStream<'_> {
+    type State = ClosestSearch;
+
+    fn begin(&self, index: usize, search: &mut ClosestSearch) -> Option<(Ray, f32)> {
+        let ray = &self.rays[index];
+        *search = ClosestSearch::new(ray, self.t_max[index]);
+        search.test_unbounded(self.list);
+        Some((*ray, search.limit()))
+    }
+
+    #[inline(always)]
+    fn leaf_address(&self, first: u32) -> *const u8 {
+        self.list.leaf_address(first)
+    }
+
+    #[inline(always)]
+    fn visit_leaf(
+        &self,
+        search: &mut ClosestSearch,
+        first: u32,
+        _: u32,
+        _: f32,
+    ) -> ControlFlow<(), f32> {
+        ControlFlow::Continue(search.visit_leaf(self.list, first))
+    }
+
+    fn end(&mut self, index: usize, search: &ClosestSearch) {
+        self.hits[index] = search.finish(self.list);
+    }
+}

@@ -1,0 +1,255 @@
+//! Tests of the queries: nearest hits, `t_max`, and agreement between the BVH,
+//! the linear loop and batches of rays.
+
+use super::*;
+use crate::{Plane, Sphere};
+use glam::Vec3;
+
+fn scene() -> ShapeList {
+    let mut list = ShapeList::new();
+    list.push(Sphere::new(Vec3::new(0.0, 0.0, -10.0), 1.0).unwrap());
+    list.push(Sphere::new(Vec3::new(0.0, 0.0, -5.0), 1.0).unwrap());
+    list.push(Plane::new(Vec3::new(0.0, 0.0, -20.0), Vec3::Z, false).unwrap());
+    list
+}
+
+#[test]
+fn closest_hit_picks_the_nearest_shape_whatever_the_order() {
+    for with_bvh in [false, true] {
+        let ray = Ray::new(Vec3::ZERO, -Vec3::Z);
+        let mut list = scene();
+        if with_bvh {
+            list.build_bvh();
+        }
+        let hit = list.closest_hit(&ray, f32::INFINITY).unwrap();
+        assert_eq!(hit.shape, 1);
+        assert!((hit.t - 4.0).abs() < 1e-6);
+        let mut reversed: ShapeList = scene().shapes().iter().rev().copied().collect();
+        if with_bvh {
+            reversed.build_bvh();
+        }
+        assert_eq!(reversed.closest_hit(&ray, f32::INFINITY).unwrap().shape, 1);
+        // The plane, outside the BVH, is still found.
+        let sideways = Ray::new(Vec3::new(5.0, 0.0, 0.0), -Vec3::Z);
+        assert_eq!(list.closest_hit(&sideways, f32::INFINITY).unwrap().shape, 2);
+    }
+}
+
+#[test]
+fn any_hit_respects_t_max() {
+    for with_bvh in [false, true] {
+        let mut list = scene();
+        if with_bvh {
+            list.build_bvh();
+        }
+        let ray = Ray::new(Vec3::ZERO, -Vec3::Z);
+        assert!(list.any_hit(&ray, 4.5));
+        assert!(!list.any_hit(&ray, 3.5));
+        assert!(!list.any_hit(&Ray::new(Vec3::ZERO, Vec3::Z), f32::INFINITY));
+    }
+}
+
+mod bvh_agreement {
+    use super::*;
+    use crate::{AaBox, Parallelogram, Plane, Sphere, TriangleMesh};
+    use glam::{Vec2, Vec3};
+
+    /// xorshift64*: a tiny deterministic generator for test scenes.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f32 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            ((self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32) / (1u64 << 24) as f32
+        }
+        fn in_cube(&mut self, r: f32) -> Vec3 {
+            Vec3::new(self.next(), self.next(), self.next()) * 2.0 * r - r
+        }
+    }
+
+    /// A UV sphere of `n × 2n` quads (two triangles each).
+    fn tessellated_sphere(centre: Vec3, radius: f32, n: u32) -> TriangleMesh {
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..=2 * n {
+                let (theta, phi) = (
+                    j as f32 / n as f32 * std::f32::consts::PI,
+                    i as f32 / n as f32 * std::f32::consts::PI,
+                );
+                positions.push(
+                    centre
+                        + radius
+                            * Vec3::new(
+                                theta.sin() * phi.cos(),
+                                theta.cos(),
+                                theta.sin() * phi.sin(),
+                            ),
+                );
+            }
+        }
+        let indices = TriangleMesh::grid_indices(2 * n, n);
+        TriangleMesh::new(positions, indices, vec![], vec![]).unwrap()
+    }
+
+    fn random_scene(rng: &mut Rng) -> ShapeList {
+        let mut list = ShapeList::new();
+        for _ in 0..20 {
+            let c = rng.in_cube(5.0);
+            match (rng.next() * 4.0) as u32 {
+                0 => {
+                    list.push(Sphere::new(c, 0.2 + rng.next()).unwrap());
+                }
+                1 => {
+                    list.push(
+                        AaBox::new(c, c + Vec3::splat(0.3) + rng.in_cube(0.5).abs()).unwrap(),
+                    );
+                }
+                2 => {
+                    if let Some(p) = Parallelogram::new(c, rng.in_cube(1.0), rng.in_cube(1.0), true)
+                    {
+                        list.push(p);
+                    }
+                }
+                _ => {
+                    list.push_mesh(tessellated_sphere(c, 0.3 + rng.next(), 6));
+                }
+            }
+        }
+        // A few degenerate triangles: zero area, collinear, repeated vertices.
+        let p = rng.in_cube(3.0);
+        list.push_mesh(
+            TriangleMesh::new(
+                vec![p, p, p + Vec3::X, p + 2.0 * Vec3::X],
+                vec![[0, 1, 2], [0, 2, 3], [1, 1, 1]],
+                vec![],
+                vec![Vec2::ZERO; 4],
+            )
+            .unwrap(),
+        );
+        list
+    }
+
+    #[test]
+    fn bvh_and_brute_force_agree_on_random_rays_over_random_scenes() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        for _ in 0..20 {
+            let linear = random_scene(&mut rng);
+            let mut accelerated = linear.clone();
+            accelerated.build_bvh();
+            for _ in 0..500 {
+                let origin = rng.in_cube(8.0);
+                let toward = rng.in_cube(5.0);
+                let ray = Ray::new(origin, toward - origin);
+                let (a, b) = (
+                    linear.closest_hit(&ray, f32::INFINITY),
+                    accelerated.closest_hit(&ray, f32::INFINITY),
+                );
+                // The query without a surface record finds the same hit.
+                for (list, hit) in [(&linear, a), (&accelerated, b)] {
+                    let found = list.closest_primitive(&ray, f32::INFINITY);
+                    assert_eq!(
+                        found.map(|f| (f.t, f.object, f.primitive)),
+                        hit.map(|h| (h.t, h.shape, h.primitive))
+                    );
+                }
+                match (a, b) {
+                    (None, None) => {}
+                    (Some(a), Some(b)) => {
+                        assert!(
+                            (a.t - b.t).abs() <= 1e-5 * a.t.max(1.0),
+                            "t {} vs {}",
+                            a.t,
+                            b.t
+                        );
+                        assert!(a.point.is_finite() && a.geometric_normal.is_finite());
+                        // Ties go to the lowest index either way: the same primitive.
+                        assert_eq!((a.shape, a.primitive), (b.shape, b.primitive));
+                    }
+                    (a, b) => panic!("linear {:?} vs bvh {:?}", a.map(|h| h.t), b.map(|h| h.t)),
+                }
+                let t_max = 0.5 + rng.next() * 20.0;
+                assert_eq!(
+                    linear.any_hit(&ray, t_max),
+                    accelerated.any_hit(&ray, t_max)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn streams_of_rays_get_the_answers_of_rays_traced_alone() {
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        for scene in 0..10 {
+            let mut linear = random_scene(&mut rng);
+            if scene % 2 == 0 {
+                linear
+                    .push(Plane::new(rng.in_cube(4.0), rng.in_cube(1.0), scene % 4 == 0).unwrap());
+            }
+            let mut accelerated = linear.clone();
+            accelerated.build_bvh();
+            let mut rays: Vec<Ray> = (0..300)
+                .map(|_| {
+                    let origin = rng.in_cube(8.0);
+                    Ray::new(origin, rng.in_cube(5.0) - origin)
+                })
+                .collect();
+            rays[7] = Ray::new(Vec3::NAN, Vec3::X);
+            let t_max: Vec<f32> = (0..rays.len())
+                .map(|i| match i % 3 {
+                    0 => f32::INFINITY,
+                    _ => 0.5 + rng.next() * 20.0,
+                })
+                .collect();
+            for list in [&linear, &accelerated] {
+                let mut hits = vec![None; rays.len()];
+                list.closest_primitives(&rays, &t_max, &mut hits);
+                let mut occluded = vec![false; rays.len()];
+                list.any_hits(&rays, &t_max, &mut occluded);
+                for (i, ray) in rays.iter().enumerate() {
+                    assert_eq!(hits[i], list.closest_primitive(ray, t_max[i]), "ray {i}");
+                    assert_eq!(occluded[i], list.any_hit(ray, t_max[i]), "ray {i}");
+                }
+                assert!(hits.iter().filter(|h| h.is_some()).count() > 30);
+                assert!(occluded.iter().filter(|&&o| o).count() > 30);
+            }
+        }
+    }
+}
+
+mod found_hits_stay_found {
+    use super::*;
+    use crate::TriangleMesh;
+    use glam::Vec3;
+
+    #[test]
+    fn every_triangle_hit_found_yields_a_surface_record() {
+        // Many rays at a fine fan of triangles: whenever a distance is found, the
+        // surface record must exist too (rounding once turned such hits into misses).
+        let mut positions = vec![Vec3::new(0.0, 0.0, -3.0)];
+        for i in 0..64 {
+            let a = i as f32 / 64.0 * std::f32::consts::TAU;
+            positions.push(Vec3::new(a.cos(), a.sin(), -3.0));
+        }
+        let indices = (0..64u32).map(|i| [0, 1 + i, 1 + (i + 1) % 64]).collect();
+        let mut list = ShapeList::new();
+        list.push_mesh(TriangleMesh::new(positions, indices, vec![], vec![]).unwrap());
+        list.build_bvh();
+        let mut found = 0;
+        for j in 0..300 {
+            for i in 0..300 {
+                let d = Vec3::new(i as f32 / 300.0 - 0.5, j as f32 / 300.0 - 0.5, -1.0);
+                let ray = Ray::new(Vec3::new(0.013, -0.007, 0.0), d);
+                let hit = list.closest_hit(&ray, f32::INFINITY);
+                // The fan lies in z = −3 and covers the disk of radius cos(π/64).
+                let p = ray.at(3.0);
+                let inside = p.x * p.x + p.y * p.y < 0.99;
+                if inside {
+                    assert!(hit.is_some(), "ray {d} slipped through");
+                    found += 1;
+                }
+            }
+        }
+        assert!(found > 10_000);
+    }
+}

@@ -17,7 +17,7 @@ use glam::{Vec2, Vec3};
 /// with lines under a tenth of a check apart. Unlike filtering over the footprint's
 /// bounding box (Quilez, "filterable procedurals"), this keeps the real contrast of
 /// long thin footprints that run along the checks' diagonals. Footprints that would
-/// need more than [`MAX_STEPS`] steps (lines × crossings) use the separable
+/// need more than `MAX_STEPS` (2048) steps (lines × crossings) use the separable
 /// bounding-box integral instead, which is exact for axis-aligned boxes and tends to
 /// ½ as footprints grow.
 #[derive(Clone, Debug, PartialEq)]

@@ -76,7 +76,7 @@ impl Image {
     /// Bilinear interpolation between the four texel centres around `st`: with
     /// `(x, y) = (s·w − ½, t·h − ½)`, the texels around `(x, y)` blended by the
     /// fractional parts (pbrt-v4 `Image::Bilerp`, section 10.4.3). Written as nested
-    /// [`lerp`]s so that equal texels give exactly that texel back.
+    /// lerps `a + (b − a)·t` so that equal texels give exactly that texel back.
     #[inline]
     pub fn bilinear(&self, st: Vec2, wrap: WrapMode) -> Vec3 {
         self.bilinear_with(reduce_st(st, wrap), |x, y| self.texel_wrapped(x, y, wrap))

@@ -1,15 +1,27 @@
 //! The texture stage of Glint: functions from surface uv to a linear RGB color, and
 //! environment maps (cube maps, lat-long images) from direction to radiance.
 //!
+//! # Entry points
+//! - [`Texture`]: a color over a surface (constant, [`Checkerboard`] or
+//!   [`ImageTexture`]), evaluated with [`Texture::evaluate`] at a [`TexCoord`]
+//!   (a uv and its per-pixel footprint).
+//! - [`load_image`] reads a file into a linear [`Image`]; [`TextureImage::new`]
+//!   shares it between textures, and [`ImageTexture::new`] maps it with a
+//!   [`WrapMode`] and a [`TextureFilter`].
+//! - [`MipMap`]: the image pyramid and its lookups ([`MipMap::nearest`],
+//!   [`MipMap::bilinear`], [`MipMap::trilinear`], [`MipMap::ewa`]).
+//! - [`Environment`]: radiance by direction from a constant, a [`CubeMap`] or a
+//!   [`LatLongMap`], evaluated with [`Environment::radiance`].
+//!
 //! # Conventions
-//! - Colors are **linear** RGB `f32` (no sRGB decoding happens here for procedural
-//!   textures; image textures will decode sRGB once at load time).
-//! - uv comes from the geometry stage: [0, 1]² on bounded shapes, world units on
-//!   infinite planes. Procedural patterns repeat outside [0, 1]².
+//! - Colors are **linear** RGB `f32`. Procedural textures are defined in linear RGB;
+//!   image files are decoded once, at load time ([`load_image`]): 8/16-bit formats
+//!   as sRGB, float formats as linear.
+//! - uv comes from the geometry stage: \[0, 1\]² on bounded shapes, world units on
+//!   infinite planes. Procedural patterns repeat outside \[0, 1\]².
 //! - Textures are a closed `enum`, evaluated by `match`: no virtual call per lookup.
 //! - Image texture coordinates are `st = (u, 1 − v)` (v grows up the surface, image
-//!   rows grow down), so images appear upright; [0, 1]² is one copy of the image.
-//!   Image files are decoded once: 8/16-bit as sRGB, float formats as linear.
+//!   rows grow down), so images appear upright; \[0, 1\]² is one copy of the image.
 //! - MIP-map pyramids are built lazily, only for textures sampled with a filter
 //!   that reads them (trilinear, EWA), and shared by every texture of the same image.
 
@@ -31,6 +43,10 @@ pub use image_texture::{ImageTexture, TextureFilter, TextureImage};
 pub use io::{load_image, srgb_to_linear, ImageLoadError, MAX_IMAGE_SIDE, MAX_IMAGE_TEXELS};
 pub use mipmap::MipMap;
 pub use texcoord::TexCoord;
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
 
 use glam::Vec3;
 

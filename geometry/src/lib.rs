@@ -25,6 +25,19 @@
 //! - Batches of rays ([`ShapeList::closest_primitives`], [`ShapeList::any_hits`])
 //!   are traced several at a time, interleaved so that their waits on memory
 //!   overlap; each answer is the one the ray would get alone.
+//!
+//! # Entry points
+//! - Shapes: [`Sphere`], [`Parallelogram`], [`Plane`], [`AaBox`] (gathered in the
+//!   [`Shape`] enum) and [`TriangleMesh`]; each shape's `hit_distance` and
+//!   `surface_at` answer for one ray.
+//! - [`ShapeList`]: a scene's objects; [`ShapeList::build_acceleration`], then
+//!   [`ShapeList::closest_hit`] (a [`Hit`]), [`ShapeList::closest_primitive`] (a
+//!   [`PrimitiveHit`]) and [`ShapeList::any_hit`], or their batch forms.
+//! - [`spawn_ray`] and [`spawn_ray_to`] start secondary rays off a [`Hit`].
+//! - [`Hit::differentials`] turns a [`RayDifferential`] into the pixel's footprint
+//!   on the surface ([`SurfaceDifferentials`]); [`reflect_differential`] follows it
+//!   through a mirror.
+//! - [`bvh::Bvh`] on its own: a BVH over any primitives given by their bounds.
 
 pub mod bvh;
 mod differentials;
@@ -44,3 +57,7 @@ pub use shapes::{triangle, triangle_packet};
 pub use shapes::{
     AaBox, MeshError, Parallelogram, Plane, Shape, Sphere, TriangleMesh, TrianglePacket,
 };
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

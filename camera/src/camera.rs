@@ -106,8 +106,8 @@ impl Camera {
 
     /// The ray through continuous raster position `(x, y)`.
     ///
-    /// Raster → NDC: `(x / width, y / height)` in [0,1]², then to [−1,1]² with y
-    /// flipped so that raster-down is world-down. The film point is
+    /// Raster → NDC: `(x / width, y / height)` in `[0, 1]²`, then to `[−1, 1]²` with
+    /// y flipped so that raster-down is world-down. The film point is
     /// `position + f·forward + ndc.x·half_width·right + ndc.y·half_height·up`.
     pub fn generate_ray(&self, x: f32, y: f32) -> CameraRay {
         let ndc_x = 2.0 * x / self.resolution.x as f32 - 1.0;

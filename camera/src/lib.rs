@@ -13,9 +13,22 @@
 //!
 //! This crate does not depend on the geometry stage: a camera ray is a plain
 //! [`CameraRay`] (origin and unit direction) that later stages wrap in their own type.
+//!
+//! # Entry points
+//! - [`Camera::new`], then [`Camera::generate_ray`] (a [`CameraRay`]) or
+//!   [`Camera::generate_ray_differential`] (a [`CameraRayDifferential`]) per raster
+//!   position; [`Camera::with_resolution`] changes the film size and keeps the view.
+//! - [`Film::new`], [`Film::set_pixel`] or [`Film::pixels_mut`] to fill it, and
+//!   [`Film::save`], whose format ([`ImageFormat`]) follows the file extension;
+//!   [`linear_to_srgb8`] is the PNG writer's transfer curve.
+//! - Errors: [`CameraError`] and [`FilmError`].
 
 mod camera;
 mod film;
 
 pub use camera::{Camera, CameraError, CameraRay, CameraRayDifferential};
 pub use film::{linear_to_srgb8, Film, FilmError, ImageFormat};
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -3,7 +3,15 @@
 //! crate) and write the film (camera crate).
 //!
 //! Exit status: 0 on success, 2 for bad input (usage, scene file, settings,
-//! output path), 1 for anything else. Errors are one line on stderr.
+//! output path), 1 for anything else. Errors are one line on stderr, prefixed
+//! `glint: error: `.
+//!
+//! # Entry points
+//! The command line is the clap parser [`Cli`] with one subcommand, `render`
+//! ([`RenderArgs`]). [`main`] maps every failure to its exit status; [`render`] runs
+//! the pipeline: [`output_path`] checks the output before any work,
+//! [`glint_scene::load`] reads the scene, [`apply_overrides`] applies the flags,
+//! [`glint_integrator::render`] renders, and [`glint_camera::Film::save`] writes.
 
 use clap::builder::TypedValueParser;
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -38,7 +46,7 @@ enum Command {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// The scene file (TOML; see the README's "Scene format")
+    /// The scene file (TOML; every key is described in docs/scene-format.md)
     scene: PathBuf,
 
     /// Output image; the extension picks the format: .png (8-bit sRGB),

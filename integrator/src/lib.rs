@@ -10,6 +10,18 @@
 //! - Work is split into tiles of [`TILE_SIZE`] full rows, rendered in parallel with
 //!   rayon straight into the film; scratch buffers are allocated once per tile,
 //!   never per ray.
+//!
+//! # Entry points
+//! - [`SceneBuilder`] assembles a [`Scene`] (materials, shapes, meshes, lights,
+//!   ambient, environment) and builds its BVH; [`SceneBuilder::build`] fails with a
+//!   [`SceneError`] if a shape names a missing material.
+//! - [`render`] renders a scene with [`RenderSettings`] (checked by
+//!   [`RenderSettings::validate`], failing with a [`SettingsError`]) into a
+//!   [`RenderOutput`]: the film and its [`RenderStats`].
+//! - [`DirectIntegrator::li`] is the radiance along one ray, for callers that drive
+//!   their own loop ([`camera_ray`] makes the camera ray with its differentials).
+//! - [`SamplePattern`] and [`sampling`]: the sample patterns and per-pixel streams;
+//!   [`Aov`]: buffers other than radiance.
 
 mod aov;
 mod direct;
@@ -25,3 +37,7 @@ pub use render::{
 };
 pub use sampling::SamplePattern;
 pub use scene::{Scene, SceneBuilder, SceneError, Surface, SurfaceKind};
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

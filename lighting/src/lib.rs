@@ -7,6 +7,20 @@
 //! - Lights follow the course's model: a point light, or each sample on an area
 //!   light, adds `color · (kd · n·l + ks · lobe)` with **no distance falloff**. An area
 //!   light is a one-sided parallelogram that emits from its front side only.
+//! - An environment's rotation about +y is in **radians** ([`EnvironmentLight::new`]).
+//!
+//! # Entry points
+//! - [`PhongMaterial::new`] (or [`PhongMaterial::mirror`]); per shading point,
+//!   [`PhongMaterial::reflectances`] gives `(kd, ks)` from the textures, then
+//!   [`PhongMaterial::reflect`] the reflection of one light and
+//!   [`PhongMaterial::brdf_cos`] the energy-normalised BRDF for the environment.
+//! - [`PointLight`], [`AreaLight::new`] (sampled with [`AreaLight::sample_point`]),
+//!   both wrapped in [`Light`].
+//! - [`EnvironmentLight::new`], with [`EnvironmentLight::radiance`],
+//!   [`EnvironmentLight::sample`] (an [`EnvironmentSample`]) and
+//!   [`EnvironmentLight::pdf`].
+//! - [`distribution`]: the piecewise-constant 1D and 2D densities behind the
+//!   environment's importance sampling.
 
 mod area_light;
 pub mod distribution;
@@ -25,3 +39,7 @@ pub enum Light {
     Point(PointLight),
     Area(AreaLight),
 }
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

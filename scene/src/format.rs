@@ -1,5 +1,5 @@
 //! The TOML scene file, as read: one struct per table, unknown keys refused.
-//! Defaults here are the documented defaults of the format (README, "Scene format").
+//! Defaults here are the documented defaults of the format (`docs/scene-format.md`).
 
 use crate::values::*;
 use serde::de::{self, Deserializer, Visitor};

@@ -4,13 +4,21 @@
 //!
 //! # Conventions
 //! - The file's units and frame are the renderer's: right-handed, y up, linear RGB.
-//! - Angles in the file are in **degrees** (the camera's `fov`).
+//! - Angles in the file are in **degrees** (the camera's `fov`, an environment's
+//!   `rotation`, a mesh's `rotate`).
 //! - Every error is one [`SceneError`] that names the file, the 1-based line and
 //!   column, and the dotted path of the field (`sphere[2].radius`); array indices
 //!   count from 0, in file order. Unknown keys, non-finite numbers and out-of-range
 //!   values are all errors, never silently accepted.
 //!
-//! The format is documented key by key in the repository README ("Scene format").
+//! The format is documented key by key in the repository's `docs/scene-format.md`.
+//!
+//! # Entry points
+//! - [`load`] reads a scene file and the assets it names; [`parse`] and [`parse_in`]
+//!   read scene text. Each gives a [`SceneDescription`] (the scene, its render
+//!   settings and its material names) or a [`SceneError`].
+//! - [`parse_resolution_parts`] and [`MAX_RESOLUTION`]: the resolution check the
+//!   command line shares with the file format.
 
 mod build;
 mod error;
@@ -59,3 +67,7 @@ pub fn parse_in(source: &str, file: &str, base_dir: &Path) -> Result<SceneDescri
     build::build(scene_file, base_dir)
         .map_err(|p| error::invalid(file, source, Some(p.span), Some(p.field), &p.message))
 }
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -1,6 +1,11 @@
 //! End-to-end tests of Glint over the shipped scenes (`scenes/`); the tests live
 //! in `tests/` and the benchmarks in `benches/`. This library locates the shipped
 //! files and makes meshes for benchmarks.
+//!
+//! # Entry points
+//! - [`scenes_dir`], [`scene_path`] and [`shipped_scenes`]: where the shipped scene
+//!   files are, and their names.
+//! - [`displaced_grid`]: a generated mesh of any size, for the BVH benchmark.
 
 use std::path::PathBuf;
 
@@ -49,3 +54,7 @@ pub fn displaced_grid(triangles: usize) -> glint_geometry::TriangleMesh {
     let indices = glint_geometry::TriangleMesh::grid_indices(n, n);
     glint_geometry::TriangleMesh::new(positions, indices, vec![], vec![]).expect("a valid grid")
 }
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

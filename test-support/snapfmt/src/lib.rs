@@ -1,6 +1,9 @@
 //! Formatting for snapshot tests: floats rounded to five significant digits, so
 //! that snapshots stay identical across machines, compilers and instruction sets
 //! while still locking every stage's numbers tightly.
+//!
+//! # Entry points
+//! [`sig5`] for one `f32`; [`vec3`] and [`vec2`] for glam vectors.
 
 use glam::{Vec2, Vec3};
 
@@ -26,6 +29,10 @@ pub fn vec3(v: Vec3) -> String {
 pub fn vec2(v: Vec2) -> String {
     format!("({}, {})", sig5(v.x), sig5(v.y))
 }
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
 
 #[cfg(test)]
 mod tests {

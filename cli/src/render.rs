@@ -1,0 +1,198 @@
+//! `glint render`: a scene file to an image.
+
+use crate::{named, progress_bar, Failure};
+use clap::Args;
+use glam::UVec2;
+use glint_camera::ImageFormat;
+use glint_integrator::{Aov, RenderSettings, SamplePattern};
+use glint_scene::SceneDescription;
+use glint_texture::TextureFilter;
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+pub(crate) struct RenderArgs {
+    /// The scene file (TOML; every key is described in docs/scene-format.md)
+    scene: PathBuf,
+
+    /// Output image; the extension picks the format: .png (8-bit sRGB),
+    /// .exr or .pfm (linear 32-bit float). Default: SCENE-NAME.png in the
+    /// current directory. Written atomically: a failed run leaves any existing file untouched.
+    #[arg(short, long, value_name = "OUT")]
+    output: Option<PathBuf>,
+
+    /// Camera samples per pixel (overrides render.spp)
+    #[arg(long, value_name = "N")]
+    spp: Option<u32>,
+
+    /// Samples per area light per camera sample (overrides render.light_samples)
+    #[arg(long, value_name = "N")]
+    light_samples: Option<u32>,
+
+    /// Pixel sample pattern (overrides render.pixel_sampler): grid (the course's
+    /// uniform grid; needs a square spp), random (independent uniform points),
+    /// stratified (jittered grid; Latin hypercube when spp is not a square)
+    #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
+    sampler: Option<SamplePattern>,
+
+    /// Light sample pattern (overrides render.light_sampler); the same patterns,
+    /// grid needing a square count
+    #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
+    light_sampler: Option<SamplePattern>,
+
+    /// Worker threads [default: one per core]; the image is identical for any count
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+
+    /// Most mirror reflections followed per camera ray (overrides render.max_depth)
+    #[arg(long, value_name = "N")]
+    max_depth: Option<u32>,
+
+    /// Environment directions sampled per shading point (overrides
+    /// render.environment_samples; 0: the environment lights nothing)
+    #[arg(long, value_name = "N")]
+    environment_samples: Option<u32>,
+
+    /// Seed of every random stream (overrides render.seed)
+    #[arg(long, value_name = "N")]
+    seed: Option<u64>,
+
+    /// Film size in pixels, e.g. 640x480 (overrides render.resolution)
+    #[arg(long, value_name = "WxH", value_parser = parse_resolution)]
+    resolution: Option<UVec2>,
+
+    /// Filter for every image texture (overrides each texture's `filter`):
+    /// nearest or bilinear (full resolution), trilinear (the two MIP levels around
+    /// the footprint), ewa (elliptically weighted average, anisotropic)
+    #[arg(long, value_name = "FILTER", value_parser = named(&TextureFilter::NAMES, TextureFilter::from_name))]
+    texture_filter: Option<TextureFilter>,
+
+    /// Write this buffer instead of the shaded image: uv (surface coordinates),
+    /// mip-level (the level the diffuse texture is read at), normal, depth
+    /// (distance from the camera), albedo (filtered diffuse color),
+    /// reflection-depth (mirror reflections taken). Raw values in .exr/.pfm, false
+    /// color in .png (normals as 0.5·n + 0.5, uv as its fractional part, depth as
+    /// gray from near to far, MIP level and reflection depth as a blue-green-red ramp)
+    #[arg(long, value_name = "BUFFER", value_parser = named(&Aov::NAMES, Aov::from_name))]
+    aov: Option<Aov>,
+}
+
+fn parse_resolution(text: &str) -> Result<UVec2, String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, e.g. 640x480, got \"{text}\""))?;
+    let side = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("expected WIDTHxHEIGHT with whole numbers, got \"{text}\""))
+    };
+    glint_scene::parse_resolution_parts(side(w)?, side(h)?)
+}
+
+pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
+    let start = std::time::Instant::now();
+    let output = output_path(args)?;
+    let SceneDescription {
+        mut scene,
+        mut settings,
+        ..
+    } = glint_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
+    apply_overrides(args, &mut settings);
+    if let Some(filter) = args.texture_filter {
+        scene.override_texture_filter(filter);
+    }
+    if let Some(resolution) = args.resolution {
+        scene.camera = scene
+            .camera
+            .with_resolution(resolution)
+            .map_err(|e| Failure::Input(format!("--resolution: {e}")))?;
+    }
+    settings
+        .validate()
+        .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
+
+    let progress = progress_bar();
+    let on_tile = |done: usize, total: usize| {
+        if let Some(bar) = &progress {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        }
+    };
+    let rendered = glint_integrator::render(&scene, &settings, &on_tile)
+        .map_err(|e| Failure::Other(e.to_string()))?;
+    if let Some(bar) = progress {
+        bar.finish_and_clear();
+    }
+    let film = match settings.aov {
+        Some(aov) if ImageFormat::from_path(&output).ok() == Some(ImageFormat::Png) => {
+            aov.false_color(&rendered.film)
+        }
+        _ => rendered.film,
+    };
+    film.save(&output)
+        .map_err(|e| Failure::Other(e.to_string()))?;
+
+    let stats = rendered.stats;
+    let resolution = film.resolution();
+    let environment_samples = match scene.environment {
+        Some(_) => format!(", {} environment samples", settings.environment_samples),
+        None => String::new(),
+    };
+    println!(
+        "wrote {}: {}x{}, {} spp, {} light samples{environment_samples}, {:.2} s wall ({:.2} s rendering), {} rays ({:.2} M rays/s)",
+        output.display(),
+        resolution.x,
+        resolution.y,
+        settings.spp,
+        settings.light_samples,
+        start.elapsed().as_secs_f64(),
+        stats.elapsed.as_secs_f64(),
+        stats.rays(),
+        stats.rays_per_second() / 1e6,
+    );
+    Ok(())
+}
+
+/// The output path: `-o`, or SCENE-NAME.png in the current directory; its
+/// extension must name a format, and its directory must be writable.
+fn output_path(args: &RenderArgs) -> Result<PathBuf, Failure> {
+    let path = match &args.output {
+        Some(p) => p.clone(),
+        None => {
+            let stem = args.scene.file_stem().unwrap_or("render".as_ref());
+            Path::new(stem).with_extension("png")
+        }
+    };
+    ImageFormat::from_path(&path).map_err(|e| Failure::Input(e.to_string()))?;
+    crate::output::check_writable(&path)?;
+    Ok(path)
+}
+
+fn apply_overrides(args: &RenderArgs, settings: &mut RenderSettings) {
+    if let Some(spp) = args.spp {
+        settings.spp = spp;
+    }
+    if let Some(n) = args.light_samples {
+        settings.light_samples = n;
+    }
+    if let Some(p) = args.sampler {
+        settings.pixel_pattern = p;
+    }
+    if let Some(p) = args.light_sampler {
+        settings.light_pattern = p;
+    }
+    if let Some(seed) = args.seed {
+        settings.seed = seed;
+    }
+    if let Some(depth) = args.max_depth {
+        settings.max_depth = depth;
+    }
+    if let Some(n) = args.environment_samples {
+        settings.environment_samples = n;
+    }
+    if args.threads.is_some() {
+        settings.threads = args.threads;
+    }
+    if args.aov.is_some() {
+        settings.aov = args.aov;
+    }
+}

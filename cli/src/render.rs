@@ -30,7 +30,9 @@ pub(crate) struct RenderArgs {
 
     /// Pixel sample pattern (overrides render.pixel_sampler): grid (the course's
     /// uniform grid; needs a square spp), random (independent uniform points),
-    /// stratified (jittered grid; Latin hypercube when spp is not a square)
+    /// stratified (jittered grid; Latin hypercube when spp is not a square),
+    /// sobol (Owen-scrambled Sobol points, one sequence per pixel; best at powers
+    /// of two)
     #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
     sampler: Option<SamplePattern>,
 
@@ -51,6 +53,11 @@ pub(crate) struct RenderArgs {
     /// render.environment_samples; 0: the environment lights nothing)
     #[arg(long, value_name = "N")]
     environment_samples: Option<u32>,
+
+    /// Environment sample pattern (overrides render.environment_sampler); the same
+    /// patterns, grid needing a square count
+    #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
+    environment_sampler: Option<SamplePattern>,
 
     /// Seed of every random stream (overrides render.seed)
     #[arg(long, value_name = "N")]
@@ -188,6 +195,9 @@ fn apply_overrides(args: &RenderArgs, settings: &mut RenderSettings) {
     }
     if let Some(n) = args.environment_samples {
         settings.environment_samples = n;
+    }
+    if let Some(p) = args.environment_sampler {
+        settings.environment_pattern = p;
     }
     if args.threads.is_some() {
         settings.threads = args.threads;

@@ -85,6 +85,54 @@ fn one_and_two_threads_write_identical_files() {
     assert_eq!(a, b);
 }
 
+#[test]
+fn sobol_samplers_render_the_same_file_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = scene("environment");
+    let run = |out: &str, threads: &str, pattern: &str| {
+        let args = [
+            "render",
+            env.as_str(),
+            "-o",
+            out,
+            "--threads",
+            threads,
+            "--sampler",
+            pattern,
+            "--light-sampler",
+            pattern,
+            "--environment-sampler",
+            pattern,
+            "--environment-samples",
+            "4",
+        ];
+        let o = glint(&[&args[..], &SMALL[..]].concat(), dir.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(dir.path().join(out)).unwrap()
+    };
+    let one = run("sobol1.pfm", "1", "sobol");
+    assert_eq!(one, run("sobol2.pfm", "2", "sobol"));
+    assert_ne!(one, run("stratified.pfm", "2", "stratified"));
+    // The environment's grid needs a square count, as the others do.
+    let args = [
+        "render",
+        env.as_str(),
+        "--environment-sampler",
+        "grid",
+        "--environment-samples",
+        "8",
+    ];
+    assert_input_error(
+        &glint(&args, dir.path()),
+        "render settings: environment samples is 8, but the grid pattern needs a perfect square",
+    );
+    let args = ["render", env.as_str(), "--environment-sampler", "halton"];
+    assert_input_error(
+        &glint(&args, dir.path()),
+        "invalid value 'halton' for '--environment-sampler <PATTERN>'",
+    );
+}
+
 fn assert_input_error(o: &Output, expected: &str) {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(o));
     let err = stderr(o);
@@ -191,6 +239,8 @@ fn help_documents_every_flag() {
         "--light-samples",
         "--sampler",
         "--light-sampler",
+        "--environment-samples",
+        "--environment-sampler",
         "--threads",
         "--seed",
         "--resolution",

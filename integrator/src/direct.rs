@@ -1,4 +1,4 @@
-use crate::sampling::SamplePattern;
+use crate::sampling::{DimensionPair, PixelSample, SamplePattern};
 use crate::{Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::{reflect_differential, spawn_ray, spawn_ray_to, Hit, Ray, RayDifferential};
@@ -21,12 +21,16 @@ pub struct DirectIntegrator {
     pub light_samples: u32,
     pub light_pattern: SamplePattern,
     pub environment_samples: u32,
+    pub environment_pattern: SamplePattern,
     pub max_depth: u32,
 }
 
-/// Reusable per-thread state: the random stream of the current camera sample,
+/// Reusable per-thread state: the current camera sample and its random stream,
 /// buffers for sample positions, and ray counters.
 pub struct SampleContext {
+    /// The camera sample being traced; names its points of the Sobol sequences.
+    pub sample: PixelSample,
+    /// Its PCG stream (for the patterns other than Sobol).
     pub rng: Pcg32,
     pub light_points: Vec<Vec2>,
     pub environment_points: Vec<Vec2>,
@@ -37,18 +41,32 @@ pub struct SampleContext {
 impl SampleContext {
     pub fn new(light_samples: u32, environment_samples: u32) -> Self {
         Self {
-            rng: crate::sampling::pixel_rng(0, 0, 0),
+            sample: PixelSample::default(),
+            rng: PixelSample::default().rng(),
             light_points: vec![Vec2::ZERO; light_samples as usize],
             environment_points: vec![Vec2::ZERO; environment_samples as usize],
             shadow_rays: 0,
             reflection_rays: 0,
         }
     }
+
+    /// Starts camera sample `sample` of pixel `pixel` (index `y · width + x`):
+    /// sets [`Self::sample`] and its stream [`Self::rng`].
+    pub fn begin_sample(&mut self, seed: u64, pixel: u64, sample: u64) {
+        self.sample = PixelSample {
+            seed,
+            pixel,
+            sample,
+        };
+        self.rng = self.sample.rng();
+    }
 }
 
 impl DirectIntegrator {
     /// Radiance arriving along `ray` (a camera ray, or a reflection ray `depth`
     /// reflections deep), whose footprint is given by the ray differentials `diff`.
+    /// Light and environment samples come from the camera sample `ctx` was
+    /// started on ([`SampleContext::begin_sample`]).
     pub fn li(
         &self,
         scene: &Scene,
@@ -73,7 +91,8 @@ impl DirectIntegrator {
         let r = material.reflectivity;
         let local = if material.has_local_shading() {
             let tc = texture_footprint(material, &hit, diff);
-            self.shade(scene, material, &hit, ray, &tc, ctx)
+            let point = ShadingPoint::new(&hit, material, ray, &tc);
+            self.shade(scene, &point, depth, ctx)
         } else {
             Vec3::ZERO
         };
@@ -89,55 +108,48 @@ impl DirectIntegrator {
         (1.0 - r) * local + r * mirror
     }
 
+    /// The local shading of `point`, `depth` reflections deep: ambient, the
+    /// lights and the environment.
     fn shade(
         &self,
         scene: &Scene,
-        material: &PhongMaterial,
-        hit: &Hit,
-        ray: &Ray,
-        tc: &TexCoord,
+        point: &ShadingPoint,
+        depth: u32,
         ctx: &mut SampleContext,
     ) -> Vec3 {
-        let (kd, ks) = material.reflectances(tc);
-        let n = hit.facing_normal(ray.direction);
-        let ng = if hit.geometric_normal.dot(n) < 0.0 {
-            -hit.geometric_normal
-        } else {
-            hit.geometric_normal
-        };
-        let point = ShadingPoint {
-            hit,
-            material,
-            kd,
-            ks,
-            n,
-            ng,
-            v: -ray.direction.normalize(),
-        };
-        let mut radiance = scene.ambient * kd;
-        for light in &scene.lights {
+        let mut radiance = scene.ambient * point.kd;
+        for (index, light) in scene.lights.iter().enumerate() {
             radiance += match light {
                 Light::Point(p) => p.color * point.unoccluded_reflection(scene, p.position, ctx),
-                Light::Area(area) => self.area_light(scene, &point, area, ctx),
+                Light::Area(area) => {
+                    let pair = DimensionPair::Light {
+                        light: index as u32,
+                        depth,
+                    };
+                    self.area_light(scene, point, area, pair, ctx)
+                }
             };
         }
         if self.environment_samples > 0 {
-            radiance += self.environment_light(scene, &point, ctx);
+            radiance += self.environment_light(scene, point, depth, ctx);
         }
         radiance
     }
 
-    /// The average over the light's samples of the Phong reflection of each
-    /// visible sample, times the light's color.
+    /// The average over the light's samples (the dimension pair `pair` of the
+    /// Sobol pattern) of the Phong reflection of each visible sample, times the
+    /// light's color.
     fn area_light(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         light: &AreaLight,
+        pair: DimensionPair,
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let mut samples = std::mem::take(&mut ctx.light_points);
-        self.light_pattern.fill(&mut ctx.rng, &mut samples);
+        let sobol = ctx.sample.sobol_points(pair, self.light_samples);
+        self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
         let mut sum = Vec3::ZERO;
         for &u in &samples {
             let position = light.sample_point(u);
@@ -150,18 +162,26 @@ impl DirectIntegrator {
     }
 
     /// Monte Carlo estimate of `∫ L_env(ω)·V(ω)·f(ω)·cos θ dω` with directions
-    /// importance-sampled from the environment (stratified over [0, 1)²).
+    /// importance-sampled from the environment (the points of
+    /// `environment_pattern` over [0, 1)² mapped to directions), for a shading
+    /// point `depth` reflections deep.
     fn environment_light(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
+        depth: u32,
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let Some(env) = &scene.environment else {
             return Vec3::ZERO;
         };
         let mut samples = std::mem::take(&mut ctx.environment_points);
-        SamplePattern::Stratified.fill(&mut ctx.rng, &mut samples);
+        let sobol = ctx.sample.sobol_points(
+            DimensionPair::Environment { depth },
+            self.environment_samples,
+        );
+        self.environment_pattern
+            .fill(&mut ctx.rng, sobol, &mut samples);
         let mut sum = Vec3::ZERO;
         for &u in &samples {
             let s = env.sample(point.n, u);
@@ -221,7 +241,27 @@ struct ShadingPoint<'a> {
     v: Vec3,
 }
 
-impl ShadingPoint<'_> {
+impl<'a> ShadingPoint<'a> {
+    /// The point `hit` of `material`, seen along `ray`, with its texture lookup `tc`.
+    fn new(hit: &'a Hit, material: &'a PhongMaterial, ray: &Ray, tc: &TexCoord) -> Self {
+        let (kd, ks) = material.reflectances(tc);
+        let n = hit.facing_normal(ray.direction);
+        let ng = if hit.geometric_normal.dot(n) < 0.0 {
+            -hit.geometric_normal
+        } else {
+            hit.geometric_normal
+        };
+        Self {
+            hit,
+            material,
+            kd,
+            ks,
+            n,
+            ng,
+            v: -ray.direction.normalize(),
+        }
+    }
+
     /// Whether light from direction `l` can reach the surface at all: it must be
     /// above the *geometric* surface. With interpolated shading normals a light can
     /// be above the shading normal's horizon but below the triangle's; its shadow

@@ -5,8 +5,10 @@
 //! # Conventions
 //! - Radiance is **linear** RGB `f32`; the film is written by the camera crate.
 //! - Determinism: every random number a pixel uses comes from a generator seeded by
-//!   `(seed, pixel index, sample index)` ([`sampling::pixel_rng`]), never from a shared
-//!   generator, so the image is bit-identical for any thread count or tile order.
+//!   `(seed, pixel index, sample index)` ([`sampling::pixel_rng`]), or from a Sobol
+//!   sequence seeded by `(seed, pixel index, dimension pair)`
+//!   ([`sampling::SobolSequence`]), never from a shared generator, so the image is
+//!   bit-identical for any thread count or tile order.
 //! - Work is split into tiles of [`TILE_SIZE`] full rows, rendered in parallel with
 //!   rayon straight into the film; scratch buffers are allocated once per tile,
 //!   never per ray.
@@ -20,7 +22,8 @@
 //!   [`RenderOutput`]: the film and its [`RenderStats`].
 //! - [`DirectIntegrator::li`] is the radiance along one ray, for callers that drive
 //!   their own loop ([`camera_ray`] makes the camera ray with its differentials).
-//! - [`SamplePattern`] and [`sampling`]: the sample patterns and per-pixel streams;
+//! - [`SamplePattern`] and [`sampling`]: the sample patterns (grid, random,
+//!   stratified, Owen-scrambled Sobol) and per-pixel streams;
 //!   [`Aov`]: buffers other than radiance.
 
 mod aov;

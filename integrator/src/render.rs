@@ -1,5 +1,5 @@
 use crate::direct::SampleContext;
-use crate::sampling::{pixel_rng, SamplePattern, PIXEL_STREAM};
+use crate::sampling::{pixel_rng, SamplePattern, SobolPoints, PIXEL_STREAM};
 use crate::{Aov, DirectIntegrator, Scene};
 use glam::{Vec2, Vec3};
 use glint_camera::{Camera, Film};
@@ -42,6 +42,9 @@ pub struct RenderSettings {
     /// Environment directions sampled per shading point to light surfaces
     /// (0: the environment is only seen, directly and in mirrors).
     pub environment_samples: u32,
+    /// Where in [0, 1)² the environment samples fall before they are mapped to
+    /// directions.
+    pub environment_pattern: SamplePattern,
 }
 
 impl Default for RenderSettings {
@@ -56,6 +59,7 @@ impl Default for RenderSettings {
             aov: None,
             max_depth: 4,
             environment_samples: 16,
+            environment_pattern: SamplePattern::Stratified,
         }
     }
 }
@@ -99,7 +103,8 @@ pub enum SettingsError {
 }
 
 impl RenderSettings {
-    /// Checks that the counts are positive and fit their patterns.
+    /// Checks that the counts are positive (the environment's may be 0) and fit
+    /// their patterns.
     pub fn validate(&self) -> Result<(), SettingsError> {
         for (what, count, pattern) in [
             (SampleCount::PerPixel, self.spp, self.pixel_pattern),
@@ -119,11 +124,12 @@ impl RenderSettings {
                 return Err(SettingsError::GridNotSquare { what, count });
             }
         }
-        if self.environment_samples > MAX_SAMPLES {
-            return Err(SettingsError::TooMany {
-                what: SampleCount::PerEnvironment,
-                count: self.environment_samples,
-            });
+        let (what, count) = (SampleCount::PerEnvironment, self.environment_samples);
+        if count > MAX_SAMPLES {
+            return Err(SettingsError::TooMany { what, count });
+        }
+        if count > 0 && !self.environment_pattern.supports(count) {
+            return Err(SettingsError::GridNotSquare { what, count });
         }
         if self.max_depth > MAX_DEPTH {
             return Err(SettingsError::Depth(self.max_depth));
@@ -194,6 +200,7 @@ fn render_on_current_pool(
         light_samples: settings.light_samples,
         light_pattern: settings.light_pattern,
         environment_samples: settings.environment_samples,
+        environment_pattern: settings.environment_pattern,
         max_depth: settings.max_depth,
     };
     let mut film = Film::new(resolution);
@@ -239,10 +246,13 @@ fn render_rows(
         let (x, y) = (offset as u32 % width, first_row + offset as u32 / width);
         let pixel = y as u64 * width as u64 + x as u64;
         let mut rng = pixel_rng(settings.seed, pixel, PIXEL_STREAM);
-        settings.pixel_pattern.fill(&mut rng, &mut pixel_samples);
+        let sobol = SobolPoints::pixel_positions(settings.seed, pixel);
+        settings
+            .pixel_pattern
+            .fill(&mut rng, sobol, &mut pixel_samples);
         let mut sum = Vec3::ZERO;
         for (sample, jitter) in pixel_samples.iter().enumerate() {
-            ctx.rng = pixel_rng(settings.seed, pixel, sample as u64);
+            ctx.begin_sample(settings.seed, pixel, sample as u64);
             let raster = Vec2::new(x as f32, y as f32) + *jitter;
             let (ray, diff) = camera_ray(&scene.camera, raster, footprint_scale);
             sum += match settings.aov {

@@ -218,6 +218,80 @@ fn output_is_bit_identical_for_any_thread_count() {
 }
 
 #[test]
+fn sobol_renders_are_bit_identical_for_any_thread_count() {
+    // Sobol alone and mixed with the PCG patterns, at counts that are not powers
+    // of two (so camera samples share blocks of the light sequences).
+    let scene = box_with_area_light(UVec2::new(40, 23));
+    let settings = |threads, pixel_pattern, light_pattern| RenderSettings {
+        spp: 3,
+        pixel_pattern,
+        light_samples: 5,
+        light_pattern,
+        seed: 42,
+        threads: Some(threads),
+        ..RenderSettings::default()
+    };
+    let bits = |f: &glint_camera::Film| -> Vec<u32> {
+        f.pixels()
+            .iter()
+            .flat_map(|p| p.to_array())
+            .map(f32::to_bits)
+            .collect()
+    };
+    let mut images = Vec::new();
+    for (pixel, light) in [
+        (SamplePattern::Sobol, SamplePattern::Sobol),
+        (SamplePattern::Sobol, SamplePattern::Random),
+        (SamplePattern::Stratified, SamplePattern::Sobol),
+    ] {
+        let one = render(&scene, &settings(1, pixel, light), &|_, _| {}).unwrap();
+        let four = render(&scene, &settings(4, pixel, light), &|_, _| {}).unwrap();
+        assert_eq!(bits(&one.film), bits(&four.film), "{pixel:?}/{light:?}");
+        assert_eq!(one.stats.shadow_rays, four.stats.shadow_rays);
+        images.push(bits(&one.film));
+    }
+    assert_ne!(images[0], images[1]);
+    assert_ne!(images[0], images[2]);
+    let other_seed = RenderSettings {
+        seed: 7,
+        ..settings(2, SamplePattern::Sobol, SamplePattern::Sobol)
+    };
+    assert_ne!(
+        images[0],
+        bits(&render(&scene, &other_seed, &|_, _| {}).unwrap().film)
+    );
+}
+
+#[test]
+fn sobol_light_samples_have_less_error_than_random_ones() {
+    // Soft shadows and the area light's falloff, against 1024 stratified light
+    // samples at the pixel centres: with 16 samples per pixel, Sobol's error is
+    // well below random's (the same number of shadow rays).
+    let scene = box_with_area_light(UVec2::new(32, 24));
+    let settings = |light_samples, light_pattern| RenderSettings {
+        light_samples,
+        light_pattern,
+        ..one_sample_at_pixel_centres()
+    };
+    let film = |s: &RenderSettings| render(&scene, s, &|_, _| {}).unwrap().film;
+    let reference = film(&settings(1024, SamplePattern::Stratified));
+    let mse = |pattern| {
+        let f = film(&settings(16, pattern));
+        f.pixels()
+            .iter()
+            .zip(reference.pixels())
+            .map(|(a, b)| (*a - *b).length_squared() as f64)
+            .sum::<f64>()
+            / f.pixels().len() as f64
+    };
+    let (sobol, random) = (mse(SamplePattern::Sobol), mse(SamplePattern::Random));
+    assert!(
+        sobol < 0.5 * random,
+        "MSE sobol {sobol:.3e}, random {random:.3e}"
+    );
+}
+
+#[test]
 fn soft_shadow_fraction_matches_the_sample_average() {
     // A point under the light's centre with half the light hidden: with a 2x2 grid
     // of light samples exactly 2 of 4 samples are visible.
@@ -297,7 +371,19 @@ fn invalid_settings_are_refused() {
             light_samples: glint_integrator::MAX_SAMPLES + 1,
             ..Default::default()
         },
+        RenderSettings {
+            environment_samples: 8,
+            environment_pattern: SamplePattern::Grid,
+            ..Default::default()
+        },
     ] {
         assert!(render(&scene, &bad, &|_, _| {}).is_err(), "{bad:?}");
     }
+    // Without environment samples the environment's pattern places nothing.
+    let none = RenderSettings {
+        environment_samples: 0,
+        environment_pattern: SamplePattern::Grid,
+        ..Default::default()
+    };
+    assert!(render(&scene, &none, &|_, _| {}).is_ok());
 }

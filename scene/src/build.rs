@@ -4,7 +4,7 @@
 use crate::error::Problem;
 use crate::format::*;
 use crate::obj::load_obj;
-use crate::values::{Count, Pattern};
+use crate::values::Pattern;
 use glam::Vec3;
 use glam::{Affine3A, EulerRot, Quat};
 use glint_camera::{Camera, CameraError};
@@ -276,16 +276,17 @@ fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> {
         aov: None,
         max_depth: *render.max_depth.get_ref(),
         environment_samples: *render.environment_samples.get_ref(),
+        environment_pattern: render.environment_sampler.get_ref().0,
     };
     settings.validate().map_err(|e| {
         // Point at the count if the file set it, else at its sampler.
-        let at = |count: &Spanned<Count>, sampler: &Spanned<Pattern>| {
+        fn at<T>(count: &Spanned<T>, sampler: &Spanned<Pattern>) -> std::ops::Range<usize> {
             if count.span().is_empty() {
                 sampler.span()
             } else {
                 count.span()
             }
-        };
+        }
         let (field, span) = match &e {
             SettingsError::Zero { what }
             | SettingsError::TooMany { what, .. }
@@ -297,7 +298,7 @@ fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> {
                 ),
                 SampleCount::PerEnvironment => (
                     "render.environment_samples",
-                    render.environment_samples.span(),
+                    at(&render.environment_samples, &render.environment_sampler),
                 ),
             },
             SettingsError::Depth(_) => ("render.max_depth", render.max_depth.span()),

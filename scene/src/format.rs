@@ -75,6 +75,7 @@ pub struct RenderTable {
     pub seed: u64,
     pub max_depth: Spanned<u32>,
     pub environment_samples: Spanned<u32>,
+    pub environment_sampler: Spanned<Pattern>,
 }
 
 /// The environment: exactly one of `color`, `cube_map`, `latlong`.
@@ -112,6 +113,7 @@ impl Default for RenderTable {
             seed: settings.seed,
             max_depth: Spanned::new(0..0, settings.max_depth),
             environment_samples: Spanned::new(0..0, settings.environment_samples),
+            environment_sampler: Spanned::new(0..0, Pattern(settings.environment_pattern)),
         }
     }
 }

@@ -198,7 +198,7 @@ fn named<'de, D: Deserializer<'de>, T>(
     })
 }
 
-/// A sample pattern name: `"grid"`, `"random"` or `"stratified"`.
+/// A sample pattern name: `"grid"`, `"random"`, `"stratified"` or `"sobol"`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pattern(pub SamplePattern);
 

@@ -40,7 +40,9 @@ fn each_kind_of_bad_input_has_its_own_message() {
         ("grid with non-square spp", format!("{CAMERA}[render]\nspp = 8\npixel_sampler = \"grid\"\n")),
         ("grid light sampler, default count ok, set count not square", format!("{CAMERA}[render]\nlight_samples = 2\nlight_sampler = \"grid\"\n")),
         ("spp above the limit", format!("{CAMERA}[render]\nspp = 4000000000\n")),
-        ("unknown sampler", format!("{CAMERA}[render]\npixel_sampler = \"sobol\"\n")),
+        ("unknown sampler", format!("{CAMERA}[render]\npixel_sampler = \"halton\"\n")),
+        ("grid environment sampler, set count not square", format!("{CAMERA}[render]\nenvironment_samples = 8\nenvironment_sampler = \"grid\"\n")),
+        ("unknown environment sampler", format!("{CAMERA}[render]\nenvironment_sampler = \"sobel\"\n")),
         ("NaN", format!("ambient = [0, nan, 0]\n{CAMERA}")),
         ("infinity", format!("{CAMERA}{MATERIAL}[[sphere]]\ncenter = [0, 0, -inf]\nradius = 1\nmaterial = \"m\"\n")),
         ("string for a number", format!("{CAMERA}{MATERIAL}[[sphere]]\ncenter = [0, 0, 0]\nradius = \"big\"\nmaterial = \"m\"\n")),
@@ -112,9 +114,39 @@ fn a_minimal_scene_gets_the_documented_defaults() {
     assert_eq!(d.settings.spp, 16);
     assert_eq!(d.settings.light_samples, 16);
     assert_eq!(d.settings.seed, 0);
+    for pattern in [
+        d.settings.pixel_pattern,
+        d.settings.light_pattern,
+        d.settings.environment_pattern,
+    ] {
+        assert_eq!(pattern, glint_integrator::SamplePattern::Stratified);
+    }
+    assert_eq!(d.settings.environment_samples, 16);
     assert_eq!(d.scene.camera.resolution(), glam::UVec2::new(512, 512));
     assert_eq!(d.scene.ambient, glam::Vec3::ZERO);
     assert!(d.scene.lights.is_empty() && d.scene.shapes.is_empty());
+}
+
+#[test]
+fn every_sampler_key_takes_every_pattern_name() {
+    use glint_integrator::SamplePattern;
+    for name in SamplePattern::NAMES {
+        let d = parse(
+            &format!(
+                "{CAMERA}[render]\nspp = 4\npixel_sampler = \"{name}\"\nlight_samples = 9\nlight_sampler = \"{name}\"\nenvironment_samples = 25\nenvironment_sampler = \"{name}\"\n"
+            ),
+            "ok.toml",
+        )
+        .unwrap();
+        let pattern = SamplePattern::from_name(name);
+        assert_eq!(Some(d.settings.pixel_pattern), pattern);
+        assert_eq!(Some(d.settings.light_pattern), pattern);
+        assert_eq!(Some(d.settings.environment_pattern), pattern);
+    }
+    // The environment's grid needs a square count only when it samples at all.
+    let none =
+        format!("{CAMERA}[render]\nenvironment_samples = 0\nenvironment_sampler = \"grid\"\n");
+    assert!(parse(&none, "ok.toml").is_ok());
 }
 
 #[test]

@@ -33,6 +33,16 @@ impl TextureFilter {
         }
     }
 
+    /// The name [`TextureFilter::from_name`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Nearest => "nearest",
+            Self::Bilinear => "bilinear",
+            Self::Trilinear => "trilinear",
+            Self::Ewa => "ewa",
+        }
+    }
+
     /// Whether this filter reads the MIP-map pyramid (and so needs a footprint).
     pub fn uses_pyramid(self) -> bool {
         matches!(self, Self::Trilinear | Self::Ewa)
@@ -149,6 +159,17 @@ fn footprint_width(dst0: Vec2, dst1: Vec2) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn filter_names_round_trip() {
+        for name in TextureFilter::NAMES {
+            assert_eq!(
+                TextureFilter::from_name(name).map(TextureFilter::name),
+                Some(name)
+            );
+        }
+        assert_eq!(TextureFilter::from_name("box"), None);
+    }
 
     fn checker_image() -> Arc<TextureImage> {
         TextureImage::new(Image::from_fn(64, 64, |x, y| {

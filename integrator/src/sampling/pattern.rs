@@ -1,12 +1,7 @@
-//! Sample patterns over the unit square and the per-pixel random number streams.
-//!
-//! Patterns (pbrt-v4 chapter 8 has the background):
-//! - `grid`: the course's uniform grid, `√N × √N` cell centres; N must be a square.
-//! - `random`: N independent uniform points.
-//! - `stratified`: one jittered point per cell of a `√N × √N` grid when N is a
-//!   square; otherwise a Latin hypercube (N-rooks): one point in each of N columns
-//!   and each of N rows, rows shuffled — still stratified in each axis, for any N.
+//! The sample patterns: where N points fall in [0, 1)².
 
+use super::sobol::SobolPoints;
+use super::streams::uniform;
 use glam::Vec2;
 use rand_core::RngCore;
 use rand_pcg::Pcg32;
@@ -14,14 +9,22 @@ use rand_pcg::Pcg32;
 /// How N points are placed in [0, 1)².
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SamplePattern {
+    /// The course's uniform grid, `√N × √N` cell centres; N must be a square.
     Grid,
+    /// N independent uniform points.
     Random,
+    /// One jittered point per cell of a `√N × √N` grid when N is a square;
+    /// otherwise a Latin hypercube (N-rooks).
     #[default]
     Stratified,
+    /// Consecutive points of an Owen-scrambled Sobol sequence, one sequence per
+    /// pixel and [`DimensionPair`](super::DimensionPair); any N, best at powers of
+    /// two.
+    Sobol,
 }
 
 impl SamplePattern {
-    pub const NAMES: [&'static str; 3] = ["grid", "random", "stratified"];
+    pub const NAMES: [&'static str; 4] = ["grid", "random", "stratified", "sobol"];
 
     /// Parses the names used in scene files and on the command line.
     pub fn from_name(name: &str) -> Option<Self> {
@@ -29,6 +32,7 @@ impl SamplePattern {
             "grid" => Some(Self::Grid),
             "random" => Some(Self::Random),
             "stratified" => Some(Self::Stratified),
+            "sobol" => Some(Self::Sobol),
             _ => None,
         }
     }
@@ -38,6 +42,7 @@ impl SamplePattern {
             Self::Grid => "grid",
             Self::Random => "random",
             Self::Stratified => "stratified",
+            Self::Sobol => "sobol",
         }
     }
 
@@ -46,12 +51,15 @@ impl SamplePattern {
         n > 0 && (self != Self::Grid || exact_sqrt(n).is_some())
     }
 
-    /// Fills `out` with `out.len()` points of this pattern.
+    /// Fills `out` with `out.len()` points of this pattern. Grid places them
+    /// without random numbers; random and stratified draw from `rng`; Sobol takes
+    /// the points `sobol` names and leaves `rng` untouched.
     ///
     /// # Panics
     /// If the pattern does not [support](Self::supports) `out.len()` points (a grid
     /// of a non-square count); [`crate::RenderSettings::validate`] rules this out.
-    pub fn fill(self, rng: &mut Pcg32, out: &mut [Vec2]) {
+    #[inline]
+    pub fn fill(self, rng: &mut Pcg32, sobol: SobolPoints, out: &mut [Vec2]) {
         let n = out.len() as u32;
         match (self, exact_sqrt(n)) {
             (Self::Grid, Some(k)) => fill_grid(k, out, |_| Vec2::splat(0.5)),
@@ -59,6 +67,7 @@ impl SamplePattern {
             (Self::Random, _) => out.iter_mut().for_each(|p| *p = uniform2(rng)),
             (Self::Stratified, Some(k)) => fill_grid(k, out, |_| uniform2(rng)),
             (Self::Stratified, None) => fill_latin_hypercube(rng, out),
+            (Self::Sobol, _) => sobol.fill(out),
         }
     }
 }
@@ -96,44 +105,21 @@ fn fill_latin_hypercube(rng: &mut Pcg32, out: &mut [Vec2]) {
 /// The largest f32 below 1.
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// A uniform f32 in [0, 1) from the top 24 bits of one 32-bit draw.
-#[inline]
-pub fn uniform(rng: &mut Pcg32) -> f32 {
-    (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
-}
-
 #[inline]
 fn uniform2(rng: &mut Pcg32) -> Vec2 {
     let x = uniform(rng);
     Vec2::new(x, uniform(rng))
 }
 
-/// SplitMix64's finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix.
-#[inline]
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-/// The sample index that names a pixel's own stream (its pixel-sample pattern),
-/// distinct from the streams of its individual samples `0..spp`.
-pub const PIXEL_STREAM: u64 = u64::MAX;
-
-/// The generator for `(seed, pixel, sample)`: independent of every other triple
-/// and of the order in which pixels are rendered.
-pub fn pixel_rng(seed: u64, pixel: u64, sample: u64) -> Pcg32 {
-    let state = mix64(mix64(mix64(seed) ^ pixel) ^ sample);
-    Pcg32::new(state, 0x0a02_bdbf_7bb3_c0a7)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::{pixel_rng, PixelSample};
 
     fn points(pattern: SamplePattern, n: usize, seed: u64) -> Vec<Vec2> {
         let mut out = vec![Vec2::ZERO; n];
-        pattern.fill(&mut pixel_rng(seed, 7, 0), &mut out);
+        let sobol = SobolPoints::pixel_positions(seed, 7);
+        pattern.fill(&mut pixel_rng(seed, 7, 0), sobol, &mut out);
         out
     }
 
@@ -194,10 +180,31 @@ mod tests {
     }
 
     #[test]
-    fn uniform_has_the_right_mean() {
-        let mut rng = pixel_rng(0, 0, 0);
-        let n = 100_000;
-        let mean: f64 = (0..n).map(|_| uniform(&mut rng) as f64).sum::<f64>() / n as f64;
-        assert!((mean - 0.5).abs() < 0.005, "mean {mean}");
+    fn sobol_takes_the_named_points_and_leaves_the_stream_alone() {
+        let id = PixelSample {
+            seed: 5,
+            pixel: 11,
+            sample: 3,
+        };
+        let pair = crate::sampling::DimensionPair::Light { light: 2, depth: 1 };
+        let mut rng = id.rng();
+        let mut out = vec![Vec2::ZERO; 6];
+        SamplePattern::Sobol.fill(&mut rng, id.sobol_points(pair, 6), &mut out);
+        assert_eq!(
+            rng.next_u32(),
+            id.rng().next_u32(),
+            "sobol drew from the rng"
+        );
+        let sequence = crate::sampling::SobolSequence::new(5, 11, pair);
+        let expected: Vec<Vec2> = (18..24).map(|i| sequence.point(i)).collect();
+        assert_eq!(out, expected);
+        assert!(SamplePattern::Sobol.supports(7));
+        assert!(!SamplePattern::Sobol.supports(0));
+        for name in SamplePattern::NAMES {
+            assert_eq!(
+                SamplePattern::from_name(name).map(SamplePattern::name),
+                Some(name)
+            );
+        }
     }
 }

@@ -1,0 +1,257 @@
+//! Owen-scrambled Sobol points, one independent 2D sequence per pixel and
+//! dimension pair ("padding", Burley 2020 §4; pbrt-v4 §8.7).
+//!
+//! Every [`DimensionPair`] of every pixel gets its own 32-bit seed, a hash of the
+//! render seed, the pixel index and the pair. The points are Sobol dimensions 0
+//! and 1 of [`sobol_burley::sample`] with that seed, which both Owen-scrambles the
+//! two dimensions and shuffles the index: each pair's sequence is a (0, 2)-sequence
+//! in base 2, and sequences of different seeds are statistically independent.
+//!
+//! `sobol_burley`'s sequences have 2^16 points. Point `i` of a longer sequence is
+//! point `i mod 2^16` of a fresh sequence whose seed is re-hashed with `i / 2^16`:
+//! each block of 2^16 points is a (0, 16, 2)-net of its own, independent of the
+//! other blocks (so the first `N` points stay stratified only for `N ≤ 2^16`).
+//!
+//! # Evaluation
+//! `sobol_burley::sample` hashes its seed three times and walks the index's bits
+//! for every coordinate. A fill hashes once per block instead ([`Scrambles`]) and
+//! looks the unscrambled points up in tables of the two dimensions' generator
+//! matrices, one per byte of the (shuffled) index ([`GENERATOR_TABLES`]), built
+//! at compile time from Joe and Kuo's direction numbers; the scrambles are
+//! `sobol_burley::parts`'s own, with the constants of `sobol_burley::sample`
+//! (version 0.5). The points are bit for bit those of
+//! `sobol_burley::sample(index, 0 or 1, seed)`, which the tests check for every
+//! index of several sequences; a point costs about a quarter of the two calls.
+
+use super::streams::mix64;
+use glam::Vec2;
+use sobol_burley::parts::{hash, owen_scramble_rev, u32_to_f32_norm};
+
+/// Which 2D sample dimensions of a pixel a set of points is for; each has its own
+/// Sobol sequence, so that no two of them correlate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DimensionPair {
+    /// The position in the pixel: camera sample `s` is point `s`.
+    Pixel,
+    /// Points on the light at index `light` of [`crate::Scene::lights`], for
+    /// shading points `depth` mirror reflections deep (0: the camera ray's hit).
+    /// Camera sample `s` with `m` light samples takes points `s·m` to `s·m + m − 1`.
+    Light { light: u32, depth: u32 },
+    /// Environment directions for shading points `depth` mirror reflections deep;
+    /// camera sample `s` with `m` environment samples takes points `s·m` to
+    /// `s·m + m − 1`.
+    Environment { depth: u32 },
+}
+
+impl DimensionPair {
+    /// A distinct 64-bit number per pair: the kind in bits 0–1, the depth in bits
+    /// 2–31 (a render follows at most 64 reflections), the light in bits 32–63.
+    #[inline]
+    fn id(self) -> u64 {
+        let depth = |d: u32| {
+            debug_assert!(d < 1 << 30, "reflection depth {d} out of range");
+            ((d & 0x3fff_ffff) as u64) << 2
+        };
+        match self {
+            Self::Pixel => 0,
+            Self::Light { light, depth: d } => 1 | depth(d) | (light as u64) << 32,
+            Self::Environment { depth: d } => 2 | depth(d),
+        }
+    }
+}
+
+/// Sets the Sobol keys apart from the PCG stream states (also hashes of the seed
+/// and the pixel).
+const SOBOL_SALT: u64 = 0x5b0b_01ee_d5ea_2b1c;
+
+/// The points per `sobol_burley` sequence.
+const BLOCK_BITS: u32 = 16;
+
+/// One pixel's Owen-scrambled Sobol sequence for one [`DimensionPair`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SobolSequence {
+    /// The 64-bit hash of (render seed, pixel, pair); blocks of 2^16 points after
+    /// the first re-hash it.
+    key: u64,
+    /// The scrambles of the first 2^16 points.
+    first_block: Scrambles,
+}
+
+impl SobolSequence {
+    pub fn new(seed: u64, pixel: u64, pair: DimensionPair) -> Self {
+        let key = mix64(mix64(mix64(seed ^ SOBOL_SALT) ^ pixel) ^ pair.id());
+        Self {
+            key,
+            first_block: Scrambles::new(fold(key)),
+        }
+    }
+
+    /// The `sobol_burley` seed of the block of 2^16 points that holds point `index`.
+    #[inline]
+    pub fn block_seed(self, index: u64) -> u32 {
+        match index >> BLOCK_BITS {
+            0 => fold(self.key),
+            block => fold(mix64(self.key ^ block)),
+        }
+    }
+
+    #[inline]
+    fn scrambles(self, index: u64) -> Scrambles {
+        match index >> BLOCK_BITS {
+            0 => self.first_block,
+            _ => Scrambles::new(self.block_seed(index)),
+        }
+    }
+
+    /// Point `index` of the sequence, in [0, 1)²: Sobol dimensions 0 and 1 of
+    /// `sobol_burley::sample(index mod 2^16, dimension, self.block_seed(index))`.
+    #[inline]
+    pub fn point(self, index: u64) -> Vec2 {
+        self.scrambles(index).point(index as u32 & BLOCK_MASK)
+    }
+
+    /// Points `first..first + out.len()`.
+    #[inline]
+    pub fn fill(self, first: u64, out: &mut [Vec2]) {
+        let mut scrambles = self.scrambles(first);
+        for (p, index) in out.iter_mut().zip(first..) {
+            let i = index as u32 & BLOCK_MASK;
+            if i == 0 && index != first {
+                scrambles = self.scrambles(index);
+            }
+            *p = scrambles.point(i);
+        }
+    }
+}
+
+const BLOCK_MASK: u32 = (1 << BLOCK_BITS) - 1;
+
+/// The hashed seeds `sobol_burley::sample` derives from its `seed` (version
+/// 0.5): one shuffles the index, one Owen-scrambles each of dimensions 0 and 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Scrambles {
+    index: u32,
+    x: u32,
+    y: u32,
+}
+
+impl Scrambles {
+    #[inline]
+    fn new(seed: u32) -> Self {
+        // As in `sobol_burley::sample`: the constants are the crate's own, for
+        // dimension set 0, dimensions 0 and 1.
+        let dimension_seed = seed.wrapping_mul(0x9c8f_2d3b);
+        Self {
+            index: hash(seed ^ 0x79c6_8e4a),
+            x: hash(dimension_seed ^ 0x912f_69ba),
+            y: hash(dimension_seed ^ 0x174f_18ab),
+        }
+    }
+
+    /// Point `i < 2^16`: the index shuffled (an Owen scramble of its reversed
+    /// bits), the Sobol point of the shuffled index, each coordinate Owen-scrambled.
+    #[inline]
+    fn point(self, i: u32) -> Vec2 {
+        let shuffled = owen_scramble_rev(i.reverse_bits(), self.index);
+        // The shuffled index's bits 0–7 and 8–15, still reversed.
+        let (low, high) = ((shuffled >> 24) as usize, (shuffled >> 16 & 0xff) as usize);
+        let [x, y] = GENERATOR_TABLES.map(|t| t[0][low] ^ t[1][high]);
+        let unit =
+            |v: u32, scramble: u32| u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits());
+        Vec2::new(unit(x, self.x), unit(y, self.y))
+    }
+}
+
+/// The unscrambled Sobol points of dimensions 0 and 1 by bytes of the index, bits
+/// reversed: `GENERATOR_TABLES[d][k][b]` is the XOR of the direction numbers
+/// `v_{8k+j}` of dimension `d` for the bits `j` set in `b` read from the top
+/// (bit 7 of `b` is index bit `8k`), as `sobol_burley::parts::sobol_rev` gives it.
+/// Point `i` of dimension `d` is then `t[0][low byte] ^ t[1][high byte]` (a Sobol
+/// point is linear in its index's bits over GF(2)).
+static GENERATOR_TABLES: [[[u32; 256]; 2]; 2] = generator_tables();
+
+/// Joe and Kuo's direction numbers `v_1 … v_16` of dimensions 0 and 1 as 32-bit
+/// fractions: dimension 0 is van der Corput's (`v_j = 2^-j`); dimension 1 has
+/// `s = 1`, `a = 0`, `m_1 = 1`, so `v_1 = 1/2` and `v_j = v_{j−1} ⊕ v_{j−1}/2`.
+const fn direction_numbers() -> [[u32; 16]; 2] {
+    let mut v = [[0u32; 16]; 2];
+    v[1][0] = 1 << 31;
+    let mut j = 0;
+    while j < 16 {
+        v[0][j] = 1 << (31 - j);
+        if j > 0 {
+            v[1][j] = v[1][j - 1] ^ (v[1][j - 1] >> 1);
+        }
+        j += 1;
+    }
+    v
+}
+
+const fn generator_tables() -> [[[u32; 256]; 2]; 2] {
+    let v = direction_numbers();
+    let mut t = [[[0u32; 256]; 2]; 2];
+    let mut d = 0;
+    while d < 2 {
+        let mut k = 0;
+        while k < 2 {
+            let mut b = 0;
+            while b < 256 {
+                let mut j = 0;
+                while j < 8 {
+                    if (b >> (7 - j)) & 1 == 1 {
+                        t[d][k][b] ^= v[d][8 * k + j].reverse_bits();
+                    }
+                    j += 1;
+                }
+                b += 1;
+            }
+            k += 1;
+        }
+        d += 1;
+    }
+    t
+}
+
+/// Consecutive points of one pixel's sequence for one pair, named but not yet
+/// hashed: [`crate::SamplePattern::fill`] makes the [`SobolSequence`] only for the
+/// Sobol pattern, so the other patterns pay nothing for it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SobolPoints {
+    /// The render's seed.
+    pub seed: u64,
+    /// The pixel's index, `y · width + x`.
+    pub pixel: u64,
+    pub pair: DimensionPair,
+    /// The index of the first point.
+    pub first: u64,
+}
+
+impl SobolPoints {
+    /// The positions in the pixel, points `0..spp` of the [`DimensionPair::Pixel`]
+    /// sequence.
+    pub fn pixel_positions(seed: u64, pixel: u64) -> Self {
+        Self {
+            seed,
+            pixel,
+            pair: DimensionPair::Pixel,
+            first: 0,
+        }
+    }
+
+    /// The sequence these points come from.
+    pub fn sequence(self) -> SobolSequence {
+        SobolSequence::new(self.seed, self.pixel, self.pair)
+    }
+
+    /// Points `first..first + out.len()` of the sequence.
+    #[inline]
+    pub fn fill(self, out: &mut [Vec2]) {
+        self.sequence().fill(self.first, out);
+    }
+}
+
+/// 64 bits to 32, both halves mixed in.
+#[inline]
+fn fold(h: u64) -> u32 {
+    (h ^ (h >> 32)) as u32
+}

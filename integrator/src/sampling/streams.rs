@@ -1,0 +1,78 @@
+//! The per-pixel random streams: every number a pixel uses is a function of
+//! `(seed, pixel index, sample index)`, never of a shared generator.
+
+use super::sobol::{DimensionPair, SobolPoints};
+use rand_core::RngCore;
+use rand_pcg::Pcg32;
+
+/// SplitMix64's finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix.
+#[inline]
+pub(crate) fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// The sample index that names a pixel's own stream (its pixel-sample pattern),
+/// distinct from the streams of its individual samples `0..spp`.
+pub const PIXEL_STREAM: u64 = u64::MAX;
+
+/// The generator for `(seed, pixel, sample)`: independent of every other triple
+/// and of the order in which pixels are rendered.
+pub fn pixel_rng(seed: u64, pixel: u64, sample: u64) -> Pcg32 {
+    let state = mix64(mix64(mix64(seed) ^ pixel) ^ sample);
+    Pcg32::new(state, 0x0a02_bdbf_7bb3_c0a7)
+}
+
+/// A uniform f32 in [0, 1) from the top 24 bits of one 32-bit draw.
+#[inline]
+pub fn uniform(rng: &mut Pcg32) -> f32 {
+    (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
+/// One camera sample of one pixel: it names the sample's PCG stream
+/// ([`pixel_rng`]) and the points it takes of each of the pixel's Sobol sequences.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PixelSample {
+    /// The render's seed.
+    pub seed: u64,
+    /// The pixel's index, `y · width + x`.
+    pub pixel: u64,
+    /// The camera sample, `0..spp`.
+    pub sample: u64,
+}
+
+impl PixelSample {
+    /// The sample's own PCG stream, which the light and environment patterns other
+    /// than Sobol draw from.
+    pub fn rng(self) -> Pcg32 {
+        pixel_rng(self.seed, self.pixel, self.sample)
+    }
+
+    /// The `per_sample` points of `pair` that this camera sample uses: points
+    /// `sample · per_sample` to `sample · per_sample + per_sample − 1` of the
+    /// pixel's sequence for `pair`, so that the samples of all of a pixel's camera
+    /// samples together are the first `spp · per_sample` points of one sequence.
+    #[inline]
+    pub fn sobol_points(self, pair: DimensionPair, per_sample: u32) -> SobolPoints {
+        SobolPoints {
+            seed: self.seed,
+            pixel: self.pixel,
+            pair,
+            first: self.sample * per_sample as u64,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_has_the_right_mean() {
+        let mut rng = pixel_rng(0, 0, 0);
+        let n = 100_000;
+        let mean: f64 = (0..n).map(|_| uniform(&mut rng) as f64).sum::<f64>() / n as f64;
+        assert!((mean - 0.5).abs() < 0.005, "mean {mean}");
+    }
+}

@@ -1,5 +1,10 @@
 //! The film: a grid of linear RGB radiance values and the writers that turn it
 //! into PNG (8-bit sRGB), OpenEXR (32-bit float, linear) or PFM (32-bit float, linear).
+//! Reading images back ([`Film::load`]) is in the `read` submodule.
+
+mod read;
+
+pub use read::{srgb_to_linear, MAX_LOAD_SIDE};
 
 use glam::{UVec2, Vec3};
 use std::io::{BufWriter, Seek, Write};
@@ -32,11 +37,17 @@ impl ImageFormat {
     }
 }
 
-/// Why a film could not be written.
+/// Why a film could not be written ([`Film::save`]) or read ([`Film::load`]).
 #[derive(Debug, thiserror::Error)]
 pub enum FilmError {
     #[error("{}: unknown output format; expected a .png, .exr or .pfm extension", .0.display())]
     UnknownFormat(PathBuf),
+    /// [`Film::load`] was given an extension it does not read.
+    #[error("{}: unknown image format; expected a .png, .jpg, .jpeg, .exr or .pfm extension", .0.display())]
+    UnknownInputFormat(PathBuf),
+    /// [`Film::load`] could not open, decode or accept the file.
+    #[error("{}: cannot read the image: {message}", path.display())]
+    Read { path: PathBuf, message: String },
     #[error("{}: {source}", path.display())]
     Io {
         path: PathBuf,

@@ -10,6 +10,8 @@
 //!   to the right and y downwards; pixel `(i, j)` has its centre at `(i + 0.5, j + 0.5)`.
 //! - [`Film`] stores **linear** RGB radiance as `f32`. Only the PNG writer applies
 //!   the sRGB transfer curve (and clamps); OpenEXR and PFM keep linear floats.
+//!   Reading undoes the same: PNG and JPEG are decoded from sRGB, float formats
+//!   are read as they are.
 //!
 //! This crate does not depend on the geometry stage: a camera ray is a plain
 //! [`CameraRay`] (origin and unit direction) that later stages wrap in their own type.
@@ -21,13 +23,16 @@
 //! - [`Film::new`], [`Film::set_pixel`] or [`Film::pixels_mut`] to fill it, and
 //!   [`Film::save`], whose format ([`ImageFormat`]) follows the file extension;
 //!   [`linear_to_srgb8`] is the PNG writer's transfer curve.
+//! - [`Film::load`] reads a PNG, JPEG, OpenEXR or PFM file back into a film (8-bit
+//!   and 16-bit integers decoded from sRGB with [`srgb_to_linear`], floats kept as
+//!   stored, NaN and negative values included), refusing sides over [`MAX_LOAD_SIDE`].
 //! - Errors: [`CameraError`] and [`FilmError`].
 
 mod camera;
 mod film;
 
 pub use camera::{Camera, CameraError, CameraRay, CameraRayDifferential};
-pub use film::{linear_to_srgb8, Film, FilmError, ImageFormat};
+pub use film::{linear_to_srgb8, srgb_to_linear, Film, FilmError, ImageFormat, MAX_LOAD_SIDE};
 
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]

@@ -8,9 +8,11 @@
 //!
 //! # Entry points
 //! The command line is the clap parser [`Cli`]; each subcommand has a file of its
-//! own: `render` ([`render::RenderArgs`], [`render::render`]). [`main`] maps every
+//! own: `render` ([`render::RenderArgs`], [`render::render`]), `diff`
+//! ([`diff::DiffArgs`], [`diff::diff`]). [`main`] maps every
 //! failure to its exit status; [`output`] checks output paths before any work.
 
+mod diff;
 mod output;
 mod render;
 
@@ -37,6 +39,8 @@ struct Cli {
 enum Command {
     /// Render a scene file to an image
     Render(render::RenderArgs),
+    /// Compare two images (metrics, heat map); exit status 1 beyond a tolerance
+    Diff(diff::DiffArgs),
 }
 
 /// A failure and the exit status it maps to.
@@ -62,6 +66,7 @@ fn main() -> ExitCode {
     };
     let result = std::panic::catch_unwind(|| match &cli.command {
         Command::Render(args) => render::render(args),
+        Command::Diff(args) => diff::diff(args),
     })
     .unwrap_or(Err(Failure::Panicked));
     match result {

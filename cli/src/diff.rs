@@ -1,0 +1,330 @@
+//! `glint diff`: two images compared by the metrics of glint-metrics, printed as
+//! a table, with an optional heat map and an exit status that gates a script.
+
+use crate::output::check_writable;
+use crate::Failure;
+use clap::{Args, ValueEnum};
+use glint_camera::Film;
+use glint_metrics::{
+    compare_with_flip_map, flip, heatmap, non_finite_count, rel_mse_map, save_heatmap, Comparison,
+    ErrorMap, ImageView, Region,
+};
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+#[command(
+    after_help = "Compares TEST with REFERENCE (PNG, JPEG, EXR or PFM; the same size): \
+                  per-channel means, RMSE, relative MSE, mean FLIP and the largest \
+                  difference, printed as a table, then whether the difference is within \
+                  the tolerance. Metrics are computed on linear RGB (PNG and JPEG decoded \
+                  from sRGB); docs/comparing-images.md defines them.\n\n\
+                  Exit status: 0 within the tolerance, 1 beyond it (or for a failure such \
+                  as a failed write), 2 for bad input (unreadable or invalid files, \
+                  different sizes, a bad region, tolerance or heat map path)."
+)]
+pub(crate) struct DiffArgs {
+    /// The image to judge (.png, .jpg, .exr or .pfm)
+    test: PathBuf,
+
+    /// The reference it is judged against: relative MSE divides by it and FLIP
+    /// judges the test against it (same size as TEST)
+    reference: PathBuf,
+
+    /// The metric --tolerance applies to: relmse (relative MSE), rmse, flip
+    /// (mean FLIP), max (the largest difference of one channel)
+    #[arg(long, value_name = "METRIC", value_enum, default_value_t = Metric::Relmse)]
+    metric: Metric,
+
+    /// The largest value of --metric that passes; above it the exit status is 1.
+    /// The default, 0, fails on any difference
+    #[arg(long, value_name = "T", default_value_t = 0.0, value_parser = parse_tolerance)]
+    tolerance: f64,
+
+    /// Measure only this rectangle of pixels: columns x0 to x1 and rows y0 to y1
+    /// (from the top), x1 and y1 excluded, e.g. 0,0,64,32 [default: the whole image]
+    #[arg(long, value_name = "x0,y0,x1,y1", value_parser = Region::parse)]
+    region: Option<Region>,
+
+    /// Write a heat map of the per-pixel error to this PNG file (the whole image,
+    /// magma colors from black for no error to light yellow); written atomically
+    #[arg(long, value_name = "FILE.png")]
+    heatmap: Option<PathBuf>,
+
+    /// The error the heat map shows: flip (per-pixel FLIP, 0 to 1) or relmse
+    /// (per-pixel relative squared error)
+    #[arg(long, value_name = "METRIC", value_enum, default_value_t = HeatmapMetric::Flip)]
+    heatmap_metric: HeatmapMetric,
+
+    /// The error drawn as the top color of the heat map [default: 1 for flip; for
+    /// relmse the 99th percentile of the region's per-pixel values]
+    #[arg(long, value_name = "S", value_parser = parse_scale)]
+    heatmap_scale: Option<f32>,
+}
+
+/// The metric the tolerance applies to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Metric {
+    Relmse,
+    Rmse,
+    Flip,
+    Max,
+}
+
+impl Metric {
+    fn label(self) -> &'static str {
+        match self {
+            Metric::Relmse => "relMSE",
+            Metric::Rmse => "RMSE",
+            Metric::Flip => "mean FLIP",
+            Metric::Max => "max difference",
+        }
+    }
+
+    fn value(self, c: &Comparison) -> f64 {
+        match self {
+            Metric::Relmse => c.rel_mse,
+            Metric::Rmse => c.rmse,
+            Metric::Flip => c.flip,
+            Metric::Max => c.max_difference.value as f64,
+        }
+    }
+}
+
+/// The per-pixel error a heat map shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum HeatmapMetric {
+    Flip,
+    Relmse,
+}
+
+fn parse_tolerance(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(t) if t.is_finite() && t >= 0.0 => Ok(t),
+        _ => Err("expected a number, 0 or more".into()),
+    }
+}
+
+fn parse_scale(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(s) if s.is_finite() && s > 0.0 => Ok(s),
+        _ => Err("expected a number greater than 0".into()),
+    }
+}
+
+pub(crate) fn diff(args: &DiffArgs) -> Result<(), Failure> {
+    if let Some(path) = &args.heatmap {
+        check_heatmap_path(path, args)?;
+    }
+    let test = Film::load(&args.test).map_err(|e| Failure::Input(e.to_string()))?;
+    let reference = Film::load(&args.reference).map_err(|e| Failure::Input(e.to_string()))?;
+    let (size, reference_size) = (test.resolution(), reference.resolution());
+    if size != reference_size {
+        return Err(Failure::Input(format!(
+            "{}: the image is {}x{}, but {} is {}x{}; glint diff compares images of the same size",
+            args.reference.display(),
+            reference_size.x,
+            reference_size.y,
+            args.test.display(),
+            size.x,
+            size.y
+        )));
+    }
+    let region = args.region.unwrap_or(Region::full(size.x, size.y));
+    region
+        .check(size.x, size.y)
+        .map_err(|e| Failure::Input(format!("{}: --region: {e}", args.test.display())))?;
+
+    let (t, r) = (ImageView::from(&test), ImageView::from(&reference));
+    let flip_map = flip(t, r);
+    let c = compare_with_flip_map(t, r, region, &flip_map);
+
+    let mut table = Table::default();
+    table.row("A (test)", [args.test.display().to_string()]);
+    table.row("B (reference)", [args.reference.display().to_string()]);
+    table.row("size", [format!("{}x{}", size.x, size.y)]);
+    let region_text = if region == Region::full(size.x, size.y) {
+        format!("whole image ({} pixels)", region.pixel_count())
+    } else {
+        format!("{region} ({} pixels)", region.pixel_count())
+    };
+    table.row("region", [region_text]);
+    table.row("", ["A".to_string(), "B".to_string()]);
+    for (i, name) in ["mean R", "mean G", "mean B"].into_iter().enumerate() {
+        table.row(
+            name,
+            [number(c.means_test[i]), number(c.means_reference[i])],
+        );
+    }
+    table.row(
+        "non-finite",
+        [non_finite_count(t, region), non_finite_count(r, region)].map(|n| n.to_string()),
+    );
+    table.row("RMSE", [number(c.rmse)]);
+    table.row("relMSE", [number(c.rel_mse)]);
+    table.row("mean FLIP", [number(c.flip)]);
+    let m = c.max_difference;
+    let max_text = if m.value == 0.0 {
+        "0 (identical)".to_string()
+    } else {
+        let channel = |film: &Film| film.pixel(m.x, m.y)[m.channel] as f64;
+        format!(
+            "{} at pixel ({}, {}), channel {} (A {}, B {})",
+            number(m.value as f64),
+            m.x,
+            m.y,
+            m.channel_name(),
+            number(channel(&test)),
+            number(channel(&reference))
+        )
+    };
+    table.row("max difference", [max_text]);
+    print!("{}", table.render());
+
+    if let Some(path) = &args.heatmap {
+        let (map, name) = match args.heatmap_metric {
+            HeatmapMetric::Flip => (flip_map, "FLIP"),
+            HeatmapMetric::Relmse => (rel_mse_map(t, r), "relMSE per pixel"),
+        };
+        let scale = args
+            .heatmap_scale
+            .unwrap_or_else(|| match args.heatmap_metric {
+                HeatmapMetric::Flip => 1.0,
+                HeatmapMetric::Relmse => percentile_99(&map, region),
+            });
+        save_heatmap(path, size.x, size.y, &heatmap(&map, scale)).map_err(Failure::Other)?;
+        let mut line = Table::default();
+        line.row(
+            "heat map",
+            [format!(
+                "{} ({name}, scale {})",
+                path.display(),
+                number(scale as f64)
+            )],
+        );
+        print!("{}", line.render());
+    }
+
+    let value = args.metric.value(&c);
+    let label = args.metric.label();
+    if value <= args.tolerance {
+        println!("within tolerance: {label} {value} <= {}", args.tolerance);
+        Ok(())
+    } else {
+        // NaN (a NaN or infinity in one image only) is never within tolerance.
+        let verdict = format!("{label} {value} > tolerance {}", args.tolerance);
+        println!("beyond tolerance: {verdict}");
+        Err(Failure::Other(format!(
+            "{}: differs from {}: {verdict}",
+            args.test.display(),
+            args.reference.display()
+        )))
+    }
+}
+
+/// The heat map path, before any work: a .png name, in a writable directory,
+/// and not one of the images being compared.
+fn check_heatmap_path(path: &Path, args: &DiffArgs) -> Result<(), Failure> {
+    let is_png = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png {
+        return Err(Failure::Input(format!(
+            "{}: a heat map is written as PNG; expected a .png extension",
+            path.display()
+        )));
+    }
+    check_writable(path)?;
+    if let Ok(target) = path.canonicalize() {
+        for input in [&args.test, &args.reference] {
+            if input.canonicalize().is_ok_and(|i| i == target) {
+                return Err(Failure::Input(format!(
+                    "{}: is one of the images being compared; choose another heat map file",
+                    path.display()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The 99th percentile of the finite values of `map` in `region`, or 1 if it is
+/// not positive (no error at all): a scale that fireflies do not flatten.
+fn percentile_99(map: &ErrorMap, region: Region) -> f32 {
+    let mut values: Vec<f32> = (region.y0..region.y1)
+        .flat_map(|y| {
+            let start = y as usize * map.width as usize;
+            map.values[start + region.x0 as usize..start + region.x1 as usize]
+                .iter()
+                .copied()
+        })
+        .filter(|v| v.is_finite())
+        .collect();
+    values.sort_by(f32::total_cmp);
+    values
+        .get(values.len().saturating_sub(1) * 99 / 100)
+        .copied()
+        .filter(|v| *v > 0.0)
+        .unwrap_or(1.0)
+}
+
+/// A number for the table: about six significant digits, plain between 1e-4 and
+/// 1e6, scientific outside; NaN and infinities by name.
+fn number(v: f64) -> String {
+    if v.is_nan() {
+        return "NaN".into();
+    }
+    if v.is_infinite() {
+        return if v > 0.0 { "inf" } else { "-inf" }.into();
+    }
+    if v == 0.0 {
+        return "0".into();
+    }
+    let magnitude = v.abs();
+    if !(1e-4..1e6).contains(&magnitude) {
+        return format!("{v:.5e}");
+    }
+    let decimals = (5 - magnitude.log10().floor() as i32).max(0) as usize;
+    let text = format!("{v:.decimals$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
+}
+
+/// Rows of a label and one or two values, aligned in columns.
+#[derive(Default)]
+struct Table {
+    rows: Vec<(String, Vec<String>)>,
+}
+
+impl Table {
+    fn row<const N: usize>(&mut self, label: &str, values: [String; N]) {
+        self.rows.push((label.to_string(), values.to_vec()));
+    }
+
+    fn render(&self) -> String {
+        const LABEL_WIDTH: usize = 16;
+        // The first column is as wide as its widest entry among two-value rows.
+        let first = self
+            .rows
+            .iter()
+            .filter(|(_, v)| v.len() > 1)
+            .map(|(_, v)| v[0].chars().count())
+            .max()
+            .unwrap_or(0);
+        let mut out = String::new();
+        for (label, values) in &self.rows {
+            let mut line = format!("{label:<LABEL_WIDTH$}");
+            match values.as_slice() {
+                [a, b] => line += &format!("{a:<first$}  {b}"),
+                [a] => line += a,
+                _ => {}
+            }
+            out += line.trim_end();
+            out.push('\n');
+        }
+        out
+    }
+}

@@ -1,0 +1,94 @@
+//! Heat maps: an [`ErrorMap`] colored with the magma color map, and writing one
+//! as a PNG.
+
+use crate::ErrorMap;
+use std::io::Write;
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// The 256 colors of the magma color map (black through purple and orange to
+/// light yellow), as FLIP's tools use it.
+pub fn magma() -> &'static [[u8; 3]; 256] {
+    static LUT: OnceLock<[[u8; 3]; 256]> = OnceLock::new();
+    LUT.get_or_init(|| {
+        let bytes = nv_flip::magma_lut().to_vec();
+        std::array::from_fn(|i| [bytes[3 * i], bytes[3 * i + 1], bytes[3 * i + 2]])
+    })
+}
+
+/// Colors each value of `map` with the magma color map: `value / scale`,
+/// clamped to [0, 1], picks entry `round(255 · t)`, so 0 is black and `scale` or
+/// more is light yellow. NaN is drawn as the top of the scale (it is an error
+/// worth seeing). Use `scale = 1` for FLIP, whose values lie in [0, 1]. Rows
+/// from the top, as in the map.
+///
+/// # Panics
+/// If `scale` is not positive and finite.
+pub fn heatmap(map: &ErrorMap, scale: f32) -> Vec<[u8; 3]> {
+    assert!(
+        scale.is_finite() && scale > 0.0,
+        "a heat map needs a positive, finite scale, got {scale}"
+    );
+    let lut = magma();
+    map.values
+        .iter()
+        .map(|&v| {
+            let t = if v.is_nan() {
+                1.0
+            } else {
+                (v / scale).clamp(0.0, 1.0)
+            };
+            lut[(t * 255.0).round() as usize]
+        })
+        .collect()
+}
+
+/// Writes `rgb` (`width × height` colors, rows from the top) as an 8-bit RGB PNG
+/// at `path`. The image goes to a temporary file beside `path` that is renamed
+/// over it once complete, so a failed write never leaves a partial file and
+/// never destroys what was at `path`; a replaced file keeps its permissions.
+/// Errors name the file.
+///
+/// # Panics
+/// If `rgb` does not hold `width × height` colors.
+pub fn save_heatmap(path: &Path, width: u32, height: u32, rgb: &[[u8; 3]]) -> Result<(), String> {
+    assert_eq!(
+        rgb.len() as u64,
+        width as u64 * height as u64,
+        "a {width}x{height} heat map needs {} colors",
+        width as u64 * height as u64
+    );
+    let fail =
+        |e: &dyn std::fmt::Display| format!("{}: cannot write the heat map: {e}", path.display());
+    let bytes: Vec<u8> = rgb.iter().flatten().copied().collect();
+    let image = image::RgbImage::from_raw(width, height, bytes).expect("length checked above");
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".glint-").suffix(".partial");
+    // Temporary files are owner-only; the heat map should get the permissions of
+    // any new file (umask), or those of the file it replaces.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder.tempfile_in(dir).map_err(|e| fail(&e))?;
+    if let Ok(existing) = std::fs::metadata(path) {
+        tmp.as_file()
+            .set_permissions(existing.permissions())
+            .map_err(|e| fail(&e))?;
+    }
+    {
+        let mut out = std::io::BufWriter::new(tmp.as_file_mut());
+        image
+            .write_to(&mut out, image::ImageFormat::Png)
+            .map_err(|e| fail(&e))?;
+        out.flush().map_err(|e| fail(&e))?;
+    }
+    tmp.as_file().sync_all().map_err(|e| fail(&e))?;
+    tmp.persist(path).map_err(|e| fail(&e.error))?;
+    Ok(())
+}

@@ -7,7 +7,7 @@ mod read;
 pub use read::{srgb_to_linear, MAX_LOAD_SIDE};
 
 use glam::{UVec2, Vec3};
-use std::io::{BufWriter, Seek, Write};
+use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
 /// The on-disk formats a [`Film`] can be written in, chosen by file extension.
@@ -122,33 +122,19 @@ impl Film {
             path: path.to_path_buf(),
             source,
         };
-        let dir = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-        let mut builder = tempfile::Builder::new();
-        builder.prefix(".glint-").suffix(".partial");
-        // Temporary files are owner-only by default; the image should get the
-        // permissions of the file it replaces, or those of any new file (umask).
-        #[cfg(unix)]
-        {
-            use std::os::unix::fs::PermissionsExt;
-            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        // The encoder's own error is kept aside: the atomic writer speaks io::Error.
+        let mut encode_error = None;
+        let written = crate::write_atomically(path, |out| {
+            self.encode(format, out, path).map_err(|e| {
+                encode_error = Some(e);
+                std::io::Error::other("encoding failed")
+            })
+        });
+        match (written, encode_error) {
+            (_, Some(e)) => Err(e),
+            (Err(e), None) => Err(io_err(e)),
+            (Ok(()), None) => Ok(()),
         }
-        let mut tmp = builder.tempfile_in(dir).map_err(io_err)?;
-        if let Ok(existing) = std::fs::metadata(path) {
-            tmp.as_file()
-                .set_permissions(existing.permissions())
-                .map_err(io_err)?;
-        }
-        {
-            let mut out = BufWriter::new(tmp.as_file_mut());
-            self.encode(format, &mut out, path)?;
-            out.flush().map_err(io_err)?;
-        }
-        tmp.as_file().sync_all().map_err(io_err)?;
-        tmp.persist(path).map_err(|e| io_err(e.error))?;
-        Ok(())
     }
 
     fn encode<W: Write + Seek>(

@@ -28,9 +28,11 @@
 //!   stored, NaN and negative values included), refusing sides over [`MAX_LOAD_SIDE`].
 //! - Errors: [`CameraError`] and [`FilmError`].
 
+mod atomic_file;
 mod camera;
 mod film;
 
+pub use atomic_file::write_atomically;
 pub use camera::{Camera, CameraError, CameraRay, CameraRayDifferential};
 pub use film::{linear_to_srgb8, srgb_to_linear, Film, FilmError, ImageFormat, MAX_LOAD_SIDE};
 

@@ -2,7 +2,6 @@
 //! as a PNG.
 
 use crate::ErrorMap;
-use std::io::Write;
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -62,33 +61,10 @@ pub fn save_heatmap(path: &Path, width: u32, height: u32, rgb: &[[u8; 3]]) -> Re
         |e: &dyn std::fmt::Display| format!("{}: cannot write the heat map: {e}", path.display());
     let bytes: Vec<u8> = rgb.iter().flatten().copied().collect();
     let image = image::RgbImage::from_raw(width, height, bytes).expect("length checked above");
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".glint-").suffix(".partial");
-    // Temporary files are owner-only; the heat map should get the permissions of
-    // any new file (umask), or those of the file it replaces.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut tmp = builder.tempfile_in(dir).map_err(|e| fail(&e))?;
-    if let Ok(existing) = std::fs::metadata(path) {
-        tmp.as_file()
-            .set_permissions(existing.permissions())
-            .map_err(|e| fail(&e))?;
-    }
-    {
-        let mut out = std::io::BufWriter::new(tmp.as_file_mut());
+    glint_camera::write_atomically(path, |out| {
         image
-            .write_to(&mut out, image::ImageFormat::Png)
-            .map_err(|e| fail(&e))?;
-        out.flush().map_err(|e| fail(&e))?;
-    }
-    tmp.as_file().sync_all().map_err(|e| fail(&e))?;
-    tmp.persist(path).map_err(|e| fail(&e.error))?;
-    Ok(())
+            .write_to(out, image::ImageFormat::Png)
+            .map_err(std::io::Error::other)
+    })
+    .map_err(|e| fail(&e))
 }

@@ -60,8 +60,14 @@ fn means_mse_rmse_and_rel_mse_match_hand_computed_values() {
 fn relative_mse_divides_by_the_reference_not_the_test() {
     let (a, b) = ([Vec3::splat(2.0); 2], [Vec3::splat(1.0); 2]);
     let region = Region::full(2, 1);
-    assert!(close(rel_mse(view(&a), view(&b), region), 1.0 / (1.01 * 1.01)));
-    assert!(close(rel_mse(view(&b), view(&a), region), 1.0 / (2.01 * 2.01)));
+    assert!(close(
+        rel_mse(view(&a), view(&b), region),
+        1.0 / (1.01 * 1.01)
+    ));
+    assert!(close(
+        rel_mse(view(&b), view(&a), region),
+        1.0 / (2.01 * 2.01)
+    ));
     // MSE and RMSE are symmetric.
     assert_eq!(
         mse(view(&a), view(&b), region),

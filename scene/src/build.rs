@@ -29,12 +29,20 @@ pub struct SceneDescription {
     pub settings: RenderSettings,
     /// `material_names[i]` is the file's name for `scene.materials[i]`.
     pub material_names: Vec<String>,
+    /// Every file the scene read besides itself (images, environment maps, OBJ
+    /// and MTL files), each once, in the order first read.
+    pub assets: Vec<PathBuf>,
+    /// The file's `[regions]`: names and `[x0, y0, x1, y1]` pixel rectangles of
+    /// the render resolution, sorted by name.
+    pub regions: Vec<(String, [u32; 4])>,
 }
 
 pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription, Problem> {
     let settings = settings(&file.render)?;
     let camera = camera(&file.camera, file.render.resolution.0)?;
-    let textures = textures(&file.textures, base_dir)?;
+    let regions = regions(&file)?;
+    let mut assets = Vec::new();
+    let textures = textures(&file.textures, base_dir, &mut assets)?;
     let mut builder = SceneBuilder::new();
     let mut extra_material_names = Vec::new();
     let mut material_ids = BTreeMap::new();
@@ -141,6 +149,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
             .transpose()?;
         let obj = load_obj(&base_dir.join(m.file.get_ref()), material.is_none())
             .map_err(|e| Problem::new(m.file.span(), format!("{field}.file"), e))?;
+        assets.extend(obj.files.iter().cloned());
         let triangle_materials: Vec<u32> = match material {
             Some(id) => vec![id; obj.indices.len()],
             None => {
@@ -215,7 +224,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
     }
     builder.ambient(file.ambient.0);
     if let Some(env) = &file.environment {
-        builder.environment(environment(env, base_dir)?);
+        builder.environment(environment(env, base_dir, &mut assets)?);
     }
     let scene = builder
         .build(camera)
@@ -226,11 +235,37 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         .cloned()
         .chain(extra_material_names)
         .collect();
+    let mut seen = std::collections::HashSet::new();
+    assets.retain(|p| seen.insert(p.clone()));
     Ok(SceneDescription {
         scene,
         settings,
         material_names,
+        assets,
+        regions,
     })
+}
+
+/// The `[regions]` table: each a non-empty rectangle inside the render resolution.
+fn regions(file: &SceneFile) -> Result<Vec<(String, [u32; 4])>, Problem> {
+    let size = file.render.resolution.0;
+    file.regions
+        .iter()
+        .map(|(name, spanned)| {
+            let [x0, y0, x1, y1] = *spanned.get_ref();
+            if x0 >= x1 || y0 >= y1 || x1 > size.x || y1 > size.y {
+                return Err(Problem::new(
+                    spanned.span(),
+                    format!("regions.{name}"),
+                    format!(
+                        "expected [x0, y0, x1, y1] with x0 < x1 <= {} and y0 < y1 <= {} (pixels of the {}x{} render, x1 and y1 excluded), got [{x0}, {y0}, {x1}, {y1}]",
+                        size.x, size.y, size.x, size.y
+                    ),
+                ));
+            }
+            Ok((name.clone(), [x0, y0, x1, y1]))
+        })
+        .collect()
 }
 
 fn no_area(field: &str, edge1: &Spanned<crate::values::Point>) -> Problem {
@@ -336,6 +371,7 @@ fn camera(c: &CameraTable, resolution: glam::UVec2) -> Result<Camera, Problem> {
 fn textures<'a>(
     tables: &'a BTreeMap<String, TextureTable>,
     base_dir: &Path,
+    assets: &mut Vec<PathBuf>,
 ) -> Result<BTreeMap<&'a str, Texture>, Problem> {
     let mut images: HashMap<PathBuf, Arc<TextureImage>> = HashMap::new();
     let mut textures = BTreeMap::new();
@@ -382,6 +418,7 @@ fn textures<'a>(
                             )
                         })?;
                         let image = TextureImage::new(loaded);
+                        assets.push(path.clone());
                         images.insert(path, image.clone());
                         image
                     }
@@ -458,6 +495,7 @@ fn material(
 fn environment(
     spanned: &Spanned<EnvironmentTable>,
     base_dir: &Path,
+    assets: &mut Vec<PathBuf>,
 ) -> Result<EnvironmentLight, Problem> {
     let e = spanned.get_ref();
     let sources = [e.color.is_some(), e.cube_map.is_some(), e.latlong.is_some()];
@@ -468,9 +506,12 @@ fn environment(
             "expected exactly one of `color`, `cube_map` or `latlong`",
         ));
     }
-    let load = |file: &Spanned<String>, path: &str, field: &str| {
-        load_image(&base_dir.join(path))
-            .map_err(|err| Problem::new(file.span(), field, err.to_string()))
+    let mut load = |file: &Spanned<String>, path: &str, field: &str| {
+        let path = base_dir.join(path);
+        let image =
+            load_image(&path).map_err(|err| Problem::new(file.span(), field, err.to_string()))?;
+        assets.push(path);
+        Ok(image)
     };
     let map = if let Some(c) = e.color {
         Environment::Constant(c.0)

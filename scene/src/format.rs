@@ -36,6 +36,10 @@ pub struct SceneFile {
     pub point_light: Vec<PointLightTable>,
     #[serde(default)]
     pub area_light: Vec<AreaLightTable>,
+    /// Named rectangles of the image, `[x0, y0, x1, y1]` in pixels of the render
+    /// resolution (x1, y1 excluded), for `glint bench --region NAME`.
+    #[serde(default)]
+    pub regions: BTreeMap<String, Spanned<[u32; 4]>>,
 }
 
 fn black() -> Color {

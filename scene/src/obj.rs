@@ -22,6 +22,8 @@ pub struct ObjMesh {
     /// Per triangle: an index into `materials`, or `None`.
     pub triangle_materials: Vec<Option<u32>>,
     pub materials: Vec<(String, PhongMaterial)>,
+    /// Every file read: the OBJ, the MTL files it names, the images they map.
+    pub files: Vec<PathBuf>,
 }
 
 /// Reads `path`: polygons are triangulated (as fans), vertices de-duplicated per
@@ -58,6 +60,10 @@ pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
         indices: Vec::new(),
         triangle_materials: Vec::new(),
         materials: phong,
+        files: std::iter::once(path.to_owned())
+            .chain(material_libraries(path))
+            .chain(images.into_keys())
+            .collect(),
     };
     // Normals and uvs are kept only if every vertex of every object has them (an
     // OBJ may give them to some faces only); otherwise normals are generated.
@@ -113,6 +119,20 @@ pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
         return Err(format!("{}: the OBJ file has no faces", path.display()));
     }
     Ok(mesh)
+}
+
+/// The MTL files an OBJ names (`mtllib` lines, relative to the OBJ) that exist.
+fn material_libraries(path: &Path) -> Vec<PathBuf> {
+    let base = path.parent().unwrap_or(Path::new(""));
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Vec::new();
+    };
+    text.lines()
+        .filter_map(|l| l.trim_start().strip_prefix("mtllib"))
+        .flat_map(|names| names.split_whitespace())
+        .map(|name| base.join(name))
+        .filter(|p| p.is_file())
+        .collect()
 }
 
 fn mtl_to_phong(

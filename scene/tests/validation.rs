@@ -72,6 +72,9 @@ fn each_kind_of_bad_input_has_its_own_message() {
         ("mesh with zero scale", format!("{CAMERA}[[mesh]]\nfile = \"x.obj\"\nscale = [1, 0, 1]\n")),
         ("mesh with an unknown material", format!("{CAMERA}{MATERIAL}[[mesh]]\nfile = \"x.obj\"\nmaterial = \"mm\"\n")),
         ("zero tile size", format!("{CAMERA}{MATERIAL}[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\ntile_size = 0\nmaterial = \"m\"\n")),
+        ("empty region", format!("{CAMERA}[render]\nresolution = [64, 32]\n[regions]\nfloor = [10, 20, 10, 30]\n")),
+        ("region past the image", format!("{CAMERA}[render]\nresolution = [64, 32]\n[regions]\nfloor = [0, 0, 64, 33]\n")),
+        ("negative region corner", format!("{CAMERA}[regions]\nfloor = [-1, 0, 4, 4]\n")),
     ];
     let mut report = String::new();
     for (name, body) in &cases {
@@ -119,7 +122,7 @@ fn a_minimal_scene_gets_the_documented_defaults() {
         d.settings.light_pattern,
         d.settings.environment_pattern,
     ] {
-        assert_eq!(pattern, glint_integrator::SamplePattern::Stratified);
+        assert_eq!(pattern, glint_integrator::SamplePattern::Sobol);
     }
     assert_eq!(d.settings.environment_samples, 16);
     assert_eq!(d.scene.camera.resolution(), glam::UVec2::new(512, 512));
@@ -193,6 +196,26 @@ fn image_paths_are_relative_to_the_scene_file_and_loaded_once() {
     );
     assert_eq!(m.uv_transform.scale, glam::Vec2::new(2.0, 3.0));
     assert_eq!(m.uv_transform.offset, glam::Vec2::new(0.5, 0.0));
+    // The file read, listed once, for callers that fingerprint a scene's inputs.
+    assert_eq!(d.assets.len(), 1, "{:?}", d.assets);
+    assert!(d.assets[0].ends_with("tex/orange.png"), "{:?}", d.assets);
+}
+
+#[test]
+fn regions_are_read_in_pixels_and_sorted_by_name() {
+    let d = parse(
+        &format!("{CAMERA}[render]\nresolution = [64, 32]\n[regions]\nshadow = [8, 16, 40, 32]\nall = [0, 0, 64, 32]\n"),
+        "r.toml",
+    )
+    .unwrap();
+    assert_eq!(
+        d.regions,
+        [
+            ("all".to_owned(), [0, 0, 64, 32]),
+            ("shadow".to_owned(), [8, 16, 40, 32])
+        ]
+    );
+    assert!(parse(CAMERA, "r.toml").unwrap().regions.is_empty());
 }
 
 #[test]
@@ -228,6 +251,12 @@ fn meshes_load_with_their_materials_and_bad_files_get_located_errors() {
         names.iter().any(|n| n == "(default mesh material)"),
         "{names:?}"
     );
+    let files: Vec<String> = d
+        .assets
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(files, ["tri.obj", "tri.mtl"], "the OBJ and its MTL");
     let per_triangle = &d.scene.mesh_materials[0];
     let shiny = &d.scene.materials[per_triangle[0] as usize];
     assert_eq!(shiny.shininess, 50.0);

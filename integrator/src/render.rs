@@ -51,15 +51,15 @@ impl Default for RenderSettings {
     fn default() -> Self {
         Self {
             spp: 16,
-            pixel_pattern: SamplePattern::Stratified,
+            pixel_pattern: SamplePattern::Sobol,
             light_samples: 16,
-            light_pattern: SamplePattern::Stratified,
+            light_pattern: SamplePattern::Sobol,
             seed: 0,
             threads: None,
             aov: None,
             max_depth: 4,
             environment_samples: 16,
-            environment_pattern: SamplePattern::Stratified,
+            environment_pattern: SamplePattern::Sobol,
         }
     }
 }

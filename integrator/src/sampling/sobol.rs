@@ -41,6 +41,13 @@ pub enum DimensionPair {
     /// camera sample `s` with `m` environment samples takes points `s·m` to
     /// `s·m + m − 1`.
     Environment { depth: u32 },
+    /// Sobol dimensions `2k` and `2k + 1` (`k` up to [`MAX_JOINT`]) of the
+    /// pixel's own sequence, whose dimensions 0 and 1 place the camera samples:
+    /// camera sample `s` takes point `s`. The integrator gives dimensions 2 and 3
+    /// to the first area light (or the environment) at the camera ray's hit when
+    /// it takes one sample per camera sample, so that the pixel position and the
+    /// light sample are stratified together in 4D, not only each on its own.
+    Joint { k: u32 },
 }
 
 impl DimensionPair {
@@ -56,9 +63,27 @@ impl DimensionPair {
             Self::Pixel => 0,
             Self::Light { light, depth: d } => 1 | depth(d) | (light as u64) << 32,
             Self::Environment { depth: d } => 2 | depth(d),
+            // The pixel's own sequence (other dimensions of it).
+            Self::Joint { .. } => Self::Pixel.id(),
+        }
+    }
+
+    /// Which Sobol dimensions the pair reads: `2k` and `2k + 1`.
+    #[inline]
+    fn dimension_pair(self) -> u32 {
+        match self {
+            Self::Joint { k } => {
+                debug_assert!((1..=MAX_JOINT).contains(&k), "joint pair {k}");
+                k.min(MAX_JOINT)
+            }
+            _ => 0,
         }
     }
 }
+
+/// The most joint pairs beyond the pixel's: Sobol dimensions 2 and 3 (the 2D
+/// projection of dimensions 4 and 5 is a (3, 2)-net at 256 points, too weak).
+pub const MAX_JOINT: u32 = 1;
 
 /// Sets the Sobol keys apart from the PCG stream states (also hashes of the seed
 /// and the pixel).
@@ -73,6 +98,8 @@ pub struct SobolSequence {
     /// The 64-bit hash of (render seed, pixel, pair); blocks of 2^16 points after
     /// the first re-hash it.
     key: u64,
+    /// Which two Sobol dimensions: `2·dimensions` and `2·dimensions + 1`.
+    dimensions: u32,
     /// The scrambles of the first 2^16 points.
     first_block: Scrambles,
 }
@@ -80,9 +107,11 @@ pub struct SobolSequence {
 impl SobolSequence {
     pub fn new(seed: u64, pixel: u64, pair: DimensionPair) -> Self {
         let key = mix64(mix64(mix64(seed ^ SOBOL_SALT) ^ pixel) ^ pair.id());
+        let dimensions = pair.dimension_pair();
         Self {
             key,
-            first_block: Scrambles::new(fold(key)),
+            dimensions,
+            first_block: Scrambles::new(fold(key), dimensions),
         }
     }
 
@@ -99,11 +128,12 @@ impl SobolSequence {
     fn scrambles(self, index: u64) -> Scrambles {
         match index >> BLOCK_BITS {
             0 => self.first_block,
-            _ => Scrambles::new(self.block_seed(index)),
+            _ => Scrambles::new(self.block_seed(index), self.dimensions),
         }
     }
 
-    /// Point `index` of the sequence, in [0, 1)²: Sobol dimensions 0 and 1 of
+    /// Point `index` of the sequence, in [0, 1)²: Sobol dimensions `2k` and
+    /// `2k + 1` (0 and 1 but for [`DimensionPair::Joint`]) of
     /// `sobol_burley::sample(index mod 2^16, dimension, self.block_seed(index))`.
     #[inline]
     pub fn point(self, index: u64) -> Vec2 {
@@ -127,24 +157,32 @@ impl SobolSequence {
 const BLOCK_MASK: u32 = (1 << BLOCK_BITS) - 1;
 
 /// The hashed seeds `sobol_burley::sample` derives from its `seed` (version
-/// 0.5): one shuffles the index, one Owen-scrambles each of dimensions 0 and 1.
+/// 0.5): one shuffles the index, one Owen-scrambles each of the two dimensions;
+/// and which two dimensions they are.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Scrambles {
     index: u32,
     x: u32,
     y: u32,
+    dimensions: u32,
 }
+
+/// `sobol_burley::sample`'s per-dimension constants, by dimension mod 4.
+const DIMENSION_CONSTANTS: [u32; 4] = [0x912f_69ba, 0x174f_18ab, 0x691e_72ca, 0xb40c_c1b8];
 
 impl Scrambles {
     #[inline]
-    fn new(seed: u32) -> Self {
-        // As in `sobol_burley::sample`: the constants are the crate's own, for
-        // dimension set 0, dimensions 0 and 1.
+    fn new(seed: u32, dimensions: u32) -> Self {
+        // As in `sobol_burley::sample`: the dimension's scramble seed is the
+        // seed's product, its dimension set (dimension / 4) and a constant.
         let dimension_seed = seed.wrapping_mul(0x9c8f_2d3b);
+        let scramble =
+            |d: u32| hash(dimension_seed ^ (d >> 2) ^ DIMENSION_CONSTANTS[d as usize & 3]);
         Self {
             index: hash(seed ^ 0x79c6_8e4a),
-            x: hash(dimension_seed ^ 0x912f_69ba),
-            y: hash(dimension_seed ^ 0x174f_18ab),
+            x: scramble(2 * dimensions),
+            y: scramble(2 * dimensions + 1),
+            dimensions,
         }
     }
 
@@ -155,7 +193,11 @@ impl Scrambles {
         let shuffled = owen_scramble_rev(i.reverse_bits(), self.index);
         // The shuffled index's bits 0–7 and 8–15, still reversed.
         let (low, high) = ((shuffled >> 24) as usize, (shuffled >> 16 & 0xff) as usize);
-        let [x, y] = GENERATOR_TABLES.map(|t| t[0][low] ^ t[1][high]);
+        let tables = match self.dimensions {
+            0 => &GENERATOR_TABLES,
+            k => &JOINT_TABLES[k as usize - 1],
+        };
+        let [x, y] = tables.map(|t| t[0][low] ^ t[1][high]);
         let unit =
             |v: u32, scramble: u32| u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits());
         Vec2::new(unit(x, self.x), unit(y, self.y))
@@ -169,6 +211,28 @@ impl Scrambles {
 /// Point `i` of dimension `d` is then `t[0][low byte] ^ t[1][high byte]` (a Sobol
 /// point is linear in its index's bits over GF(2)).
 static GENERATOR_TABLES: [[[u32; 256]; 2]; 2] = generator_tables();
+
+/// The same tables for Sobol dimensions 2 to 5 (the joint pairs), made once from
+/// `sobol_burley::parts::sobol_rev`: a point is linear in its index's bits, so a
+/// byte's entry is the point of that byte alone.
+static JOINT_TABLES: std::sync::LazyLock<[[[[u32; 256]; 2]; 2]; MAX_JOINT as usize]> =
+    std::sync::LazyLock::new(|| {
+        let mut tables = [[[[0u32; 256]; 2]; 2]; MAX_JOINT as usize];
+        for (k, pair) in tables.iter_mut().enumerate() {
+            for (d, dimension) in pair.iter_mut().enumerate() {
+                let sobol_dimension = 2 * (k as u32 + 1) + d as u32;
+                for (byte, table) in dimension.iter_mut().enumerate() {
+                    for (b, entry) in table.iter_mut().enumerate() {
+                        // The reversed index holds index byte `byte` in its bits
+                        // 24 − 8·byte upwards.
+                        let index_rev = (b as u32) << (24 - 8 * byte);
+                        *entry = sobol_burley::parts::sobol_rev(index_rev, sobol_dimension);
+                    }
+                }
+            }
+        }
+        tables
+    });
 
 /// Joe and Kuo's direction numbers `v_1 … v_16` of dimensions 0 and 1 as 32-bit
 /// fractions: dimension 0 is van der Corput's (`v_j = 2^-j`); dimension 1 has

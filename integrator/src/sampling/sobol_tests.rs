@@ -429,3 +429,114 @@ fn different_pairs_and_pixels_are_uncorrelated() {
     // The check can fail: a sequence against itself.
     assert!(correlation(&x, &x) > 0.99);
 }
+
+#[test]
+fn a_joint_pair_is_sobol_burley_dimensions_2_and_3_of_the_pixel_sequence() {
+    for (seed, pixel) in [(0, 0), (3, 99), (u64::MAX, 1 << 40)] {
+        let joint = SobolSequence::new(seed, pixel, DimensionPair::Joint { k: 1 });
+        let own = SobolSequence::new(seed, pixel, DimensionPair::Pixel);
+        let first = (0..1 << 16).map(|i| (0, i));
+        let later = (0..4096).map(|i| (1, i));
+        for (block, i) in first.chain(later) {
+            let index = block << 16 | i as u64;
+            // The pixel's own seed: the same Sobol point, two more dimensions.
+            let seed = own.block_seed(index);
+            assert_eq!(joint.block_seed(index), seed);
+            let expected = Vec2::new(
+                sobol_burley::sample(i, 2, seed),
+                sobol_burley::sample(i, 3, seed),
+            );
+            assert_eq!(joint.point(index), expected, "index {index}");
+        }
+    }
+}
+
+/// The `2^m` points of four dimensions, whether every elementary interval of
+/// volume `2^(t−m)` (all shapes `2^-a₀ × … × 2^-a₃`, `Σa = m − t`) holds exactly
+/// `2^t` of them: a (t, m, 4)-net.
+fn is_4d_net(points: &[[f32; 4]], t: u32) -> bool {
+    let m = points.len().trailing_zeros();
+    let k = m - t;
+    let mut shapes = Vec::new();
+    for a0 in 0..=k {
+        for a1 in 0..=k - a0 {
+            for a2 in 0..=k - a0 - a1 {
+                shapes.push([a0, a1, a2, k - a0 - a1 - a2]);
+            }
+        }
+    }
+    shapes.iter().all(|a| {
+        let mut count = vec![0u32; 1 << k];
+        for p in points {
+            let mut cell = 0usize;
+            for d in 0..4 {
+                cell = (cell << a[d]) | (p[d] * (1u32 << a[d]) as f32) as usize;
+            }
+            count[cell] += 1;
+        }
+        count.iter().all(|&c| c == 1 << t)
+    })
+}
+
+#[test]
+fn the_pixel_position_and_the_joint_light_sample_are_stratified_together() {
+    // Sobol dimensions 0–3 (Joe and Kuo) form a (t, m, 4)-net with t ≤ 3 for the
+    // first 2^m points, m ≤ 10 (measured: t = 2, 2, 3, 2 for m = 4, 6, 8, 10);
+    // scrambling keeps it. A light sample from an independent sequence, paired
+    // with the pixel position at random, does not: with 256 points, some 4D
+    // interval of volume 1/32 (2^(t−m), t = 3) misses its 8 points.
+    for (seed, pixel) in [(0, 0), (42, 7), (9, 123_456)] {
+        let own = SobolSequence::new(seed, pixel, DimensionPair::Pixel);
+        let joint = SobolSequence::new(seed, pixel, DimensionPair::Joint { k: 1 });
+        let padded = SobolSequence::new(seed, pixel, DimensionPair::Light { light: 0, depth: 0 });
+        let points = |other: SobolSequence, n: u64| -> Vec<[f32; 4]> {
+            (0..n)
+                .map(|i| {
+                    let (p, q) = (own.point(i), other.point(i));
+                    [p.x, p.y, q.x, q.y]
+                })
+                .collect()
+        };
+        for m in [4, 6, 8, 10] {
+            assert!(
+                is_4d_net(&points(joint, 1 << m), 3),
+                "seed {seed}, 2^{m} points"
+            );
+        }
+        assert!(!is_4d_net(&points(padded, 256), 3), "seed {seed}: padded");
+    }
+}
+
+#[test]
+fn a_4d_discontinuity_converges_faster_with_the_joint_pair() {
+    // f = 1 when x + u > 1: a soft-shadow-like edge across the pixel position x
+    // and the light sample u, its integral ½. Joint: RMS error at 1024 points
+    // well below the padded pair's, and a steeper slope (the padded pair's
+    // interaction term converges at the Monte Carlo rate, slope −½). Measured
+    // over 64 scrambles: slopes −0.86 and −0.46, errors 0.0020 and 0.0093.
+    let rms = |pair: DimensionPair| -> Vec<(usize, f64)> {
+        (4..=10)
+            .map(|k| {
+                let n = 1u64 << k;
+                let mse = (0..64u64)
+                    .map(|r| {
+                        let own = SobolSequence::new(r, 5, DimensionPair::Pixel);
+                        let other = SobolSequence::new(r, 5, pair);
+                        let hits = (0..n)
+                            .filter(|&i| own.point(i).x + other.point(i).x > 1.0)
+                            .count();
+                        (hits as f64 / n as f64 - 0.5).powi(2)
+                    })
+                    .sum::<f64>()
+                    / 64.0;
+                (n as usize, mse.sqrt())
+            })
+            .collect()
+    };
+    let joint = rms(DimensionPair::Joint { k: 1 });
+    let padded = rms(DimensionPair::Light { light: 0, depth: 0 });
+    let (sj, sp) = (log_log_slope(&joint), log_log_slope(&padded));
+    assert!(sj < -0.8, "joint slope {sj}");
+    assert!((sp + 0.5).abs() < 0.15, "padded slope {sp}");
+    assert!(joint[6].1 < 0.25 * padded[6].1, "{joint:?} vs {padded:?}");
+}

@@ -9,9 +9,11 @@
 //! # Entry points
 //! The command line is the clap parser [`Cli`]; each subcommand has a file of its
 //! own: `render` ([`render::RenderArgs`], [`render::render`]), `diff`
-//! ([`diff::DiffArgs`], [`diff::diff`]). [`main`] maps every
+//! ([`diff::DiffArgs`], [`diff::diff`]), `bench` ([`bench::BenchArgs`],
+//! [`bench::bench`]). [`main`] maps every
 //! failure to its exit status; [`output`] checks output paths before any work.
 
+mod bench;
 mod diff;
 mod output;
 mod render;
@@ -41,6 +43,9 @@ enum Command {
     Render(render::RenderArgs),
     /// Compare two images (metrics, heat map); exit status 1 beyond a tolerance
     Diff(diff::DiffArgs),
+    /// Run time against error: sample patterns and filters over a ladder of
+    /// budgets, measured against a reference (table, CSV, JSON, plot, heat maps)
+    Bench(bench::BenchArgs),
 }
 
 /// A failure and the exit status it maps to.
@@ -67,6 +72,7 @@ fn main() -> ExitCode {
     let result = std::panic::catch_unwind(|| match &cli.command {
         Command::Render(args) => render::render(args),
         Command::Diff(args) => diff::diff(args),
+        Command::Bench(args) => bench::bench(args),
     })
     .unwrap_or(Err(Failure::Panicked));
     match result {

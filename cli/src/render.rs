@@ -83,7 +83,7 @@ pub(crate) struct RenderArgs {
     aov: Option<Aov>,
 }
 
-fn parse_resolution(text: &str) -> Result<UVec2, String> {
+pub(crate) fn parse_resolution(text: &str) -> Result<UVec2, String> {
     let (w, h) = text
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WIDTHxHEIGHT, e.g. 640x480, got \"{text}\""))?;

@@ -1,0 +1,307 @@
+//! `glint bench`: run time against error (the work is glint-bench's; this file
+//! turns flags into its configuration and its progress into a bar).
+
+use crate::{named, Failure};
+use clap::Args;
+use glam::UVec2;
+use glint_bench::budget::{parse_counts, parse_durations, sample_ladder, Ladder};
+use glint_bench::strategy::{combine, parse_samplers, parse_texture_filters};
+use glint_bench::{BenchConfig, BenchError, Progress, ReferenceChoice, RegionChoice};
+use glint_metrics::Region;
+use glint_texture::TextureFilter;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+pub(crate) struct BenchArgs {
+    /// The scene file (TOML; every key is described in docs/scene-format.md)
+    scene: PathBuf,
+
+    /// Directory for the results (results.csv, results.json, relmse-vs-time.png
+    /// and .svg, heat maps) and the cached reference; created if missing
+    /// [default: SCENE-NAME-bench]
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
+
+    /// Sampler strategies to compare, comma-separated: a pattern (grid, random,
+    /// stratified, sobol) for every sample, or PIXEL/LIGHT, or
+    /// PIXEL/LIGHT/ENVIRONMENT
+    #[arg(
+        long,
+        value_name = "LIST",
+        default_value = "random,stratified,sobol,grid"
+    )]
+    samplers: String,
+
+    /// Texture filters to compare (each with every sampler), comma-separated:
+    /// nearest, bilinear, trilinear, ewa [default: each texture's own]
+    #[arg(long, value_name = "LIST")]
+    texture_filters: Option<String>,
+
+    /// Camera samples per pixel at each step of the ladder, comma-separated
+    #[arg(long, value_name = "LIST", default_value = "1,4,16,64,256")]
+    spp: String,
+
+    /// Samples per area light per camera sample: one value for every step, or
+    /// one per step
+    #[arg(long, value_name = "LIST", default_value = "1")]
+    light_samples: String,
+
+    /// Environment directions per shading point: one value, or one per step
+    /// [default: 1, or 0 when the scene's environment lights nothing]
+    #[arg(long, value_name = "LIST")]
+    environment_samples: Option<String>,
+
+    /// Time budgets instead of sample counts, e.g. 0.1s,0.3s,1s,3s: each strategy
+    /// renders with the spp that takes about that long here
+    #[arg(long, value_name = "LIST", conflicts_with = "spp")]
+    time: Option<String>,
+
+    /// Runs per budget; times are their median (images are identical: renders are
+    /// deterministic)
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    repeat: u32,
+
+    /// Measure errors over part of the image: x0,y0,x1,y1 in pixels (x1, y1
+    /// excluded), or the name of a region in the scene's [regions] table
+    #[arg(long, value_name = "REGION")]
+    region: Option<String>,
+
+    /// Reference image (EXR, PFM or PNG) of the bench's resolution, e.g. from
+    /// another renderer, instead of rendering one
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["reference_spp", "reference_texture_filter"])]
+    reference: Option<PathBuf>,
+
+    /// Samples per pixel of the rendered reference [default: enough for its noise
+    /// to be 10x below the smallest error measured]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=1_048_576))]
+    reference_spp: Option<u32>,
+
+    /// Texture filter of the reference [default: bilinear when --texture-filters
+    /// is given (full resolution, supersampled), else each texture's own]
+    #[arg(long, value_name = "FILTER", value_parser = named(&TextureFilter::NAMES, TextureFilter::from_name))]
+    reference_texture_filter: Option<TextureFilter>,
+
+    /// Where the rendered reference samples each pixel: over its area (the
+    /// pixel's box filter), or at its centre only, its samples then going to the
+    /// lights and the environment; `centre` measures light sampling alone, for
+    /// strategies that also sample pixel centres (--samplers grid/PATTERN --spp 1
+    /// --light-samples LIST)
+    #[arg(long, value_name = "WHERE", value_enum, default_value_t = ReferencePixel::Area, conflicts_with = "reference")]
+    reference_pixel: ReferencePixel,
+
+    /// The ladder step (1 = the first) whose error heat maps are drawn
+    /// [default: the last]
+    #[arg(long, value_name = "STEP", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    heatmap_step: Option<u32>,
+
+    /// Film size in pixels, e.g. 256x256 (overrides render.resolution)
+    #[arg(long, value_name = "WxH", value_parser = crate::render::parse_resolution)]
+    resolution: Option<UVec2>,
+
+    /// Seed of every random stream (overrides render.seed)
+    #[arg(long, value_name = "N")]
+    seed: Option<u64>,
+
+    /// Worker threads [default: one per core]
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+
+    /// Most mirror reflections followed per camera ray (overrides render.max_depth)
+    #[arg(long, value_name = "N")]
+    max_depth: Option<u32>,
+}
+
+/// Where the rendered reference samples each pixel.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum ReferencePixel {
+    /// Over the pixel's area, as the renders do
+    Area,
+    /// At the pixel's centre only
+    Centre,
+}
+
+pub(crate) fn bench(args: &BenchArgs) -> Result<(), Failure> {
+    let config = config(args)?;
+    check_output_dir(&config.output_dir)?;
+    let bar = progress_bar();
+    let on_progress = |p: Progress| {
+        let Some(bar) = &bar else { return };
+        match p {
+            Progress::Render {
+                number,
+                planned,
+                what,
+            } => {
+                bar.set_message(format!("render {number}/{planned}: {what}"));
+                bar.set_position(0);
+            }
+            Progress::Tiles { done, total } => {
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+            }
+            Progress::Step(what) => bar.set_message(what.to_owned()),
+        }
+    };
+    let result = glint_bench::run(&config, &on_progress);
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let bench = result.map_err(|e| match e {
+        BenchError::Input(m) => Failure::Input(m),
+        BenchError::Other(m) => Failure::Other(m),
+    })?;
+    std::fs::create_dir_all(&config.output_dir)
+        .map_err(|e| Failure::Other(format!("{}: {e}", config.output_dir.display())))?;
+    let written = bench.write(&config.output_dir).map_err(Failure::Other)?;
+    print!("{}", bench.report.table());
+    println!(
+        "wrote {} files to {}",
+        written.len(),
+        config.output_dir.display()
+    );
+    Ok(())
+}
+
+/// The output directory, before any work: an existing directory we may write
+/// in, or one we may create (its parent exists and is writable). It is created
+/// only when there is something to put in it.
+fn check_output_dir(dir: &Path) -> Result<(), Failure> {
+    if dir.exists() {
+        if !dir.is_dir() {
+            return Err(Failure::Input(format!(
+                "{}: is a file, expected a directory for the results",
+                dir.display()
+            )));
+        }
+        return crate::output::check_writable(&dir.join("results.json"));
+    }
+    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
+    crate::output::check_writable(&parent.unwrap_or(Path::new(".")).join("results.json"))
+        .map_err(|_| {
+            Failure::Input(format!(
+                "{}: cannot create the results directory here (its parent is missing or not writable)",
+                dir.display()
+            ))
+        })
+}
+
+fn config(args: &BenchArgs) -> Result<BenchConfig, Failure> {
+    let input = Failure::Input;
+    let samplers = parse_samplers(&args.samplers).map_err(|e| input(format!("--samplers: {e}")))?;
+    let filters = match &args.texture_filters {
+        Some(list) => {
+            parse_texture_filters(list).map_err(|e| input(format!("--texture-filters: {e}")))?
+        }
+        None => Vec::new(),
+    };
+    let light = parse_counts("--light-samples", &args.light_samples).map_err(input)?;
+    let environment = match &args.environment_samples {
+        Some(list) => parse_environment_counts(list)?,
+        None => vec![default_environment_samples(&args.scene)],
+    };
+    let ladder = match &args.time {
+        Some(list) => {
+            let budgets = parse_durations(list).map_err(input)?;
+            let single = |flag: &str, values: &[u32]| match values {
+                [one] => Ok(*one),
+                _ => Err(Failure::Input(format!(
+                    "{flag}: with --time give one value, got {}",
+                    values.len()
+                ))),
+            };
+            Ladder::Time {
+                budgets,
+                light_samples: single("--light-samples", &light)?,
+                environment_samples: single("--environment-samples", &environment)?,
+            }
+        }
+        None => {
+            let spp = parse_counts("--spp", &args.spp).map_err(input)?;
+            Ladder::Samples(sample_ladder(&spp, &light, &environment).map_err(input)?)
+        }
+    };
+    let region = match &args.region {
+        None => RegionChoice::Whole,
+        Some(text) if text.contains(',') => {
+            RegionChoice::Pixels(Region::parse(text).map_err(|e| input(format!("--region: {e}")))?)
+        }
+        Some(name) => RegionChoice::Named(name.clone()),
+    };
+    let reference = match &args.reference {
+        Some(path) => ReferenceChoice::File(path.clone()),
+        None => ReferenceChoice::Render {
+            pixel_centre: args.reference_pixel == ReferencePixel::Centre,
+            spp: args.reference_spp,
+            texture_filter: args
+                .reference_texture_filter
+                .or((!filters.is_empty()).then_some(TextureFilter::Bilinear)),
+        },
+    };
+    Ok(BenchConfig {
+        scene: args.scene.clone(),
+        strategies: combine(&samplers, &filters),
+        ladder,
+        repeat: args.repeat as usize,
+        region,
+        reference,
+        heatmap_step: args.heatmap_step.map(|s| s as usize - 1),
+        resolution: args.resolution,
+        seed: args.seed,
+        threads: args.threads,
+        max_depth: args.max_depth,
+        output_dir: args.output.clone().unwrap_or_else(|| {
+            PathBuf::from(format!("{}-bench", glint_bench::scene_name(&args.scene)))
+        }),
+        version: version(),
+    })
+}
+
+/// Environment sample counts: like the other lists, but 0 is allowed.
+fn parse_environment_counts(list: &str) -> Result<Vec<u32>, Failure> {
+    list.split(',')
+        .map(|item| {
+            item.trim().parse::<u32>().map_err(|_| {
+                Failure::Input(format!(
+                    "--environment-samples: expected whole numbers separated by commas, got \"{}\"",
+                    item.trim()
+                ))
+            })
+        })
+        .collect()
+}
+
+/// One environment direction per shading point, or none when the scene's own
+/// settings sample none (its environment is then only seen, not a light). An
+/// unreadable scene gets 1 here; loading it reports the real error.
+fn default_environment_samples(scene: &Path) -> u32 {
+    glint_scene::load(scene).map_or(1, |d| u32::from(d.settings.environment_samples > 0))
+}
+
+/// This build's identity for the reference cache: the package version and a
+/// hash of the running executable, so that a rebuilt Glint renders anew.
+fn version() -> String {
+    let exe = std::env::current_exe()
+        .ok()
+        .and_then(|p| std::fs::read(p).ok())
+        .map_or_else(
+            || "unknown".into(),
+            |b| blake3::hash(&b).to_hex()[..16].to_owned(),
+        );
+    format!("{} {exe}", env!("CARGO_PKG_VERSION"))
+}
+
+/// A bar over the current render's tiles with the render's name, on stderr,
+/// only when stderr is a terminal.
+fn progress_bar() -> Option<ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg}")
+            .expect("valid template"),
+    );
+    Some(bar)
+}

@@ -35,7 +35,9 @@ pub(crate) struct BenchArgs {
     samplers: String,
 
     /// Texture filters to compare (each with every sampler), comma-separated:
-    /// nearest, bilinear, trilinear, ewa [default: each texture's own]
+    /// nearest, bilinear, trilinear, ewa, or analytic (checker images evaluated as
+    /// the procedural checkerboard, box-filtered exactly; other images ewa)
+    /// [default: each texture's own]
     #[arg(long, value_name = "LIST")]
     texture_filters: Option<String>,
 

@@ -66,6 +66,35 @@ impl Scene {
             }
         }
     }
+
+    /// Evaluates every image rasterised from a checkerboard (a `checker_image`
+    /// texture) as the procedural checkerboard, box-filtered exactly over the
+    /// footprint ([`glint_texture::Checkerboard`]'s analytic filter), and filters
+    /// the other images with `others`. Only repeating images of an even number of
+    /// checks are replaced: only they repeat exactly as the pattern does outside
+    /// the uv square.
+    pub fn use_analytic_checkerboards(&mut self, others: TextureFilter) {
+        for material in &mut self.materials {
+            let textures = std::iter::once(&mut material.diffuse).chain(material.specular.as_mut());
+            for texture in textures {
+                let Texture::Image(image) = texture else {
+                    continue;
+                };
+                match image.image.pattern() {
+                    Some(pattern)
+                        if image.wrap == glint_texture::WrapMode::Repeat
+                            && pattern.checks % 2 == 0 =>
+                    {
+                        *texture = Texture::Checkerboard(glint_texture::Checkerboard {
+                            analytic: true,
+                            ..pattern.clone()
+                        });
+                    }
+                    _ => image.filter = others,
+                }
+            }
+        }
+    }
 }
 
 /// Why a scene could not be assembled.
@@ -176,5 +205,63 @@ impl SceneBuilder {
             environment: self.environment,
             mesh_materials: self.mesh_materials,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glint_texture::{Checkerboard, ImageTexture, TextureImage, WrapMode};
+
+    fn image_texture(image: std::sync::Arc<TextureImage>, wrap: WrapMode) -> Texture {
+        Texture::Image(ImageTexture::new(image, wrap, TextureFilter::Trilinear))
+    }
+
+    #[test]
+    fn checker_images_become_analytic_checkerboards_and_photos_take_the_filter() {
+        let even = Checkerboard::new(Vec3::ONE, Vec3::ZERO, 8);
+        let odd = Checkerboard::new(Vec3::ONE, Vec3::ZERO, 3);
+        let photo = TextureImage::new(odd.to_image(4));
+        let mut builder = SceneBuilder::new();
+        let textures = [
+            image_texture(
+                TextureImage::from_checkerboard(even.clone(), 4),
+                WrapMode::Repeat,
+            ),
+            image_texture(
+                TextureImage::from_checkerboard(even.clone(), 4),
+                WrapMode::Clamp,
+            ),
+            image_texture(TextureImage::from_checkerboard(odd, 4), WrapMode::Repeat),
+            image_texture(photo, WrapMode::Repeat),
+        ];
+        for t in &textures {
+            builder.material(PhongMaterial {
+                diffuse: t.clone(),
+                ..PhongMaterial::new(Vec3::ONE, 1.0)
+            });
+        }
+        let camera =
+            Camera::new(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0, glam::UVec2::ONE).unwrap();
+        let mut scene = builder.build(camera).unwrap();
+        scene.use_analytic_checkerboards(TextureFilter::Ewa);
+        let kinds: Vec<String> = scene
+            .materials
+            .iter()
+            .map(|m| match &m.diffuse {
+                Texture::Checkerboard(c) => format!("analytic {} checks: {}", c.checks, c.analytic),
+                Texture::Image(i) => format!("image {:?}", i.filter),
+                Texture::Constant(_) => "constant".into(),
+            })
+            .collect();
+        assert_eq!(
+            kinds,
+            [
+                "analytic 8 checks: true",
+                "image Ewa",
+                "image Ewa",
+                "image Ewa"
+            ]
+        );
     }
 }

@@ -400,7 +400,7 @@ fn textures<'a>(
                     ));
                 }
                 let checker = Checkerboard::new(c.colors[0].0, c.colors[1].0, checks);
-                let image = TextureImage::new(checker.to_image(per_check));
+                let image = TextureImage::from_checkerboard(checker, per_check);
                 Texture::Image(ImageTexture::new(image, c.wrap.0, c.filter.0))
             }
             TextureTable::Image(i) => {

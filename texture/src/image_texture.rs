@@ -1,4 +1,4 @@
-use crate::{Image, MipMap, TexCoord, WrapMode};
+use crate::{Checkerboard, Image, MipMap, TexCoord, WrapMode};
 use glam::{Vec2, Vec3};
 use std::sync::{Arc, OnceLock};
 
@@ -55,6 +55,8 @@ impl TextureFilter {
 pub struct TextureImage {
     image: Image,
     pyramid: OnceLock<MipMap>,
+    /// The procedural pattern the image was rasterised from, if any.
+    pattern: Option<Checkerboard>,
 }
 
 impl TextureImage {
@@ -62,11 +64,28 @@ impl TextureImage {
         Arc::new(Self {
             image,
             pyramid: OnceLock::new(),
+            pattern: None,
+        })
+    }
+
+    /// The checkerboard rasterised at `pixels_per_check` texels per check (the
+    /// course's checker image), remembering the pattern: a caller comparing
+    /// filters can evaluate it analytically instead.
+    pub fn from_checkerboard(checkerboard: Checkerboard, pixels_per_check: u32) -> Arc<Self> {
+        Arc::new(Self {
+            image: checkerboard.to_image(pixels_per_check),
+            pyramid: OnceLock::new(),
+            pattern: Some(checkerboard),
         })
     }
 
     pub fn image(&self) -> &Image {
         &self.image
+    }
+
+    /// The checkerboard this image was made from ([`TextureImage::from_checkerboard`]).
+    pub fn pattern(&self) -> Option<&Checkerboard> {
+        self.pattern.as_ref()
     }
 
     /// The pyramid, built now if no lookup has needed it yet.

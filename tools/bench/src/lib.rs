@@ -34,7 +34,7 @@ pub use budget::{Ladder, SampleBudget};
 pub use machine::Machine;
 pub use reference::Reference;
 pub use report::Report;
-pub use strategy::Strategy;
+pub use strategy::{Strategy, TextureChoice};
 
 use glam::{UVec2, Vec3};
 use glint_integrator::{RenderOutput, RenderSettings, SamplePattern, Scene};
@@ -169,24 +169,15 @@ impl Setup<'_> {
         Ok(d)
     }
 
-    /// The scene and settings of one strategy at one budget.
-    fn prepare(
-        &self,
-        strategy: &Strategy,
-        budget: SampleBudget,
-    ) -> Result<(Scene, RenderSettings), BenchError> {
+    /// The scene and settings of one strategy (its own copy of the scene, so
+    /// that one-off work such as MIP pyramids is paid by each strategy).
+    fn prepare(&self, strategy: &Strategy) -> Result<(Scene, RenderSettings), BenchError> {
         let SceneDescription {
             mut scene,
             mut settings,
             ..
         } = self.load()?;
         strategy.apply(&mut scene, &mut settings);
-        settings.spp = budget.spp;
-        settings.light_samples = budget.light_samples;
-        settings.environment_samples = budget.environment_samples;
-        settings
-            .validate()
-            .map_err(|e| BenchError::Input(format!("{}: {e}", strategy.name())))?;
         Ok((scene, settings))
     }
 
@@ -194,7 +185,6 @@ impl Setup<'_> {
         &self,
         scene: &Scene,
         settings: &RenderSettings,
-        _number: usize,
         progress: &(dyn Fn(Progress) + Sync),
     ) -> Result<RenderOutput, BenchError> {
         let on_tile = |done: usize, total: usize| progress(Progress::Tiles { done, total });
@@ -584,9 +574,9 @@ fn rendered_reference(
         while sums.rounds < wanted {
             settings.seed = reference::round_seed(d.settings.seed, sums.rounds);
             let what = format!("reference round {} ({} spp)", sums.rounds + 1, round_spp);
-            let number = counter.next(&what, progress);
+            counter.next(&what, progress);
             let start = Instant::now();
-            let output = setup.render(&scene, &settings, number, progress)?;
+            let output = setup.render(&scene, &settings, progress)?;
             rendered += start.elapsed();
             sums.add(output.film.pixels());
         }

@@ -11,8 +11,45 @@ pub struct Strategy {
     pub pixel: SamplePattern,
     pub light: SamplePattern,
     pub environment: SamplePattern,
-    /// Overrides the filter of every image texture (`None`: each texture's own).
-    pub texture_filter: Option<TextureFilter>,
+    /// Overrides the filtering of every image texture (`None`: each texture's own).
+    pub texture_filter: Option<TextureChoice>,
+}
+
+/// How a strategy filters image textures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TextureChoice {
+    /// Every image with this filter.
+    Filter(TextureFilter),
+    /// Images rasterised from a checkerboard (`checker_image`) as the procedural
+    /// checkerboard, box-filtered exactly over the footprint; other images with
+    /// EWA.
+    AnalyticCheckerboards,
+}
+
+impl TextureChoice {
+    /// The names `--texture-filters` takes.
+    pub const NAMES: [&'static str; 5] = ["nearest", "bilinear", "trilinear", "ewa", "analytic"];
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "analytic" => Some(Self::AnalyticCheckerboards),
+            other => TextureFilter::from_name(other).map(Self::Filter),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Filter(f) => f.name(),
+            Self::AnalyticCheckerboards => "analytic",
+        }
+    }
+
+    fn apply(self, scene: &mut Scene) {
+        match self {
+            Self::Filter(f) => scene.override_texture_filter(f),
+            Self::AnalyticCheckerboards => scene.use_analytic_checkerboards(TextureFilter::Ewa),
+        }
+    }
 }
 
 impl Strategy {
@@ -56,8 +93,8 @@ impl Strategy {
         settings.pixel_pattern = self.pixel;
         settings.light_pattern = self.light;
         settings.environment_pattern = self.environment;
-        if let Some(filter) = self.texture_filter {
-            scene.override_texture_filter(filter);
+        if let Some(choice) = self.texture_filter {
+            choice.apply(scene);
         }
     }
 
@@ -115,14 +152,14 @@ pub fn parse_samplers(list: &str) -> Result<Vec<Strategy>, String> {
     Ok(strategies)
 }
 
-/// Parses a list of texture filters (`nearest,bilinear,trilinear,ewa`).
-pub fn parse_texture_filters(list: &str) -> Result<Vec<TextureFilter>, String> {
+/// Parses a list of texture filters (`nearest,bilinear,trilinear,ewa,analytic`).
+pub fn parse_texture_filters(list: &str) -> Result<Vec<TextureChoice>, String> {
     let mut filters = Vec::new();
     for name in list.split(',').map(str::trim) {
-        let filter = TextureFilter::from_name(name).ok_or_else(|| {
+        let filter = TextureChoice::from_name(name).ok_or_else(|| {
             format!(
                 "unknown texture filter \"{name}\", expected one of {}",
-                TextureFilter::NAMES.join(", ")
+                TextureChoice::NAMES.join(", ")
             )
         })?;
         if filters.contains(&filter) {
@@ -135,7 +172,7 @@ pub fn parse_texture_filters(list: &str) -> Result<Vec<TextureFilter>, String> {
 
 /// Every sampler strategy with every texture filter (or with none, keeping each
 /// texture's own, when `filters` is empty).
-pub fn combine(samplers: &[Strategy], filters: &[TextureFilter]) -> Vec<Strategy> {
+pub fn combine(samplers: &[Strategy], filters: &[TextureChoice]) -> Vec<Strategy> {
     if filters.is_empty() {
         return samplers.to_vec();
     }
@@ -162,8 +199,22 @@ mod tests {
             names,
             ["sobol", "stratified/random", "grid/grid/random", "random"]
         );
-        let with_filter = combine(&s[..1], &[TextureFilter::Ewa]);
+        let with_filter = combine(
+            &s[..1],
+            &[
+                TextureChoice::Filter(TextureFilter::Ewa),
+                TextureChoice::AnalyticCheckerboards,
+            ],
+        );
         assert_eq!(with_filter[0].name(), "sobol+ewa");
+        assert_eq!(with_filter[1].name(), "sobol+analytic");
+        assert_eq!(
+            parse_texture_filters("trilinear, analytic").unwrap(),
+            [
+                TextureChoice::Filter(TextureFilter::Trilinear),
+                TextureChoice::AnalyticCheckerboards
+            ]
+        );
         assert_eq!(s[1].file_stem(), "stratified-random");
     }
 

@@ -75,7 +75,26 @@ fn config(scene: PathBuf, out: &Path) -> BenchConfig {
 fn a_bench_measures_fits_writes_and_caches_its_reference() {
     let dir = tempfile::tempdir().unwrap();
     let config = config(scene_in(dir.path()), dir.path());
-    let bench = run(&config, &|_| {}).unwrap();
+    let renders = std::sync::Mutex::new(Vec::new());
+    let record = |p: glint_bench::Progress| {
+        if let glint_bench::Progress::Render { what, .. } = p {
+            renders.lock().unwrap().push(what.to_owned());
+        }
+    };
+    let bench = run(&config, &record).unwrap();
+    // Strategies take turns, budget by budget and run by run.
+    let renders = renders.into_inner().unwrap();
+    assert_eq!(
+        renders[..4],
+        [
+            "random at 1 spp × 1 light samples (run 1 of 2)",
+            "sobol at 1 spp × 1 light samples (run 1 of 2)",
+            "random at 1 spp × 1 light samples (run 2 of 2)",
+            "sobol at 1 spp × 1 light samples (run 2 of 2)",
+        ]
+    );
+    assert!(renders[4].starts_with("random at 4 spp"), "{renders:?}");
+    assert!(renders.iter().any(|r| r.starts_with("reference round 1")));
     let r = &bench.report;
     assert_eq!(r.rows.len(), 6);
     assert!(r

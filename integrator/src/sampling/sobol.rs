@@ -197,7 +197,11 @@ impl Scrambles {
             0 => &GENERATOR_TABLES,
             k => &JOINT_TABLES[k as usize - 1],
         };
-        let [x, y] = tables.map(|t| t[0][low] ^ t[1][high]);
+        // By reference: `map` on the arrays themselves would copy 4 KB a point.
+        let (x, y) = (
+            tables[0][0][low] ^ tables[0][1][high],
+            tables[1][0][low] ^ tables[1][1][high],
+        );
         let unit =
             |v: u32, scramble: u32| u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits());
         Vec2::new(unit(x, self.x), unit(y, self.y))

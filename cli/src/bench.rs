@@ -51,7 +51,7 @@ pub(crate) struct BenchArgs {
     light_samples: String,
 
     /// Environment directions per shading point: one value, or one per step
-    /// [default: 1, or 0 when the scene's environment lights nothing]
+    /// [default: 1, or 0 when the scene has no environment or it lights nothing]
     #[arg(long, value_name = "LIST")]
     environment_samples: Option<String>,
 
@@ -66,11 +66,11 @@ pub(crate) struct BenchArgs {
     repeat: u32,
 
     /// Measure errors over part of the image: x0,y0,x1,y1 in pixels (x1, y1
-    /// excluded), or the name of a region in the scene's [regions] table
+    /// excluded), or the name of a region in the scene's `[regions]` table
     #[arg(long, value_name = "REGION")]
     region: Option<String>,
 
-    /// Reference image (EXR, PFM or PNG) of the bench's resolution, e.g. from
+    /// Reference image (EXR, PFM, PNG or JPEG) of the bench's resolution, e.g. from
     /// another renderer, instead of rendering one
     #[arg(long, value_name = "FILE", conflicts_with_all = ["reference_spp", "reference_texture_filter"])]
     reference: Option<PathBuf>,
@@ -274,11 +274,14 @@ fn parse_environment_counts(list: &str) -> Result<Vec<u32>, Failure> {
         .collect()
 }
 
-/// One environment direction per shading point, or none when the scene's own
-/// settings sample none (its environment is then only seen, not a light). An
-/// unreadable scene gets 1 here; loading it reports the real error.
+/// One environment direction per shading point, or none when the scene has no
+/// environment or its own settings sample none (its environment is then only
+/// seen, not a light). An unreadable scene gets 0 here; loading it reports the
+/// real error.
 fn default_environment_samples(scene: &Path) -> u32 {
-    glint_scene::load(scene).map_or(1, |d| u32::from(d.settings.environment_samples > 0))
+    glint_scene::load(scene).map_or(0, |d| {
+        u32::from(d.scene.environment.is_some() && d.settings.environment_samples > 0)
+    })
 }
 
 /// This build's identity for the reference cache: the package version and a

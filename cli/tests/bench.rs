@@ -127,6 +127,8 @@ fn bad_input_gives_one_line_and_exit_2_before_any_work() {
         "perfect squares",
     );
     assert_input_error(&bench(&["--spp", "4,1"]), "grow");
+    // A count past the limit at a later step is refused before the first render.
+    assert_input_error(&bench(&["--spp", "1,2000000"]), "more than the limit");
     assert_input_error(&bench(&["--spp", "1,x"]), "--spp");
     assert_input_error(&bench(&["--region", "nowhere"]), "\"nowhere\"");
     assert_input_error(&bench(&["--region", "0,0,9,9"]), "--region");
@@ -163,6 +165,7 @@ fn help_documents_every_flag() {
         "--reference",
         "--reference-spp",
         "--reference-texture-filter",
+        "--reference-pixel",
         "--heatmap-step",
         "--resolution",
         "--seed",

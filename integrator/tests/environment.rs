@@ -158,11 +158,16 @@ fn gradient_maps() -> (Environment, Environment) {
     )
 }
 
+/// pbrt-v4's relative MSE (`imgtool diff --metric MRSE`), as `glint diff` computes
+/// it: the mean over pixels and channels of `(a − b)²/(b + 0.01)²`.
 fn relative_mse(a: &glint_camera::Film, b: &glint_camera::Film) -> f32 {
     a.pixels()
         .iter()
         .zip(b.pixels())
-        .map(|(a, b)| ((*a - *b) * (*a - *b) / (*b * *b + Vec3::splat(0.01))).element_sum() / 3.0)
+        .map(|(a, b)| {
+            let d = *b + Vec3::splat(0.01);
+            ((*a - *b) * (*a - *b) / (d * d)).element_sum() / 3.0
+        })
         .sum::<f32>()
         / a.pixels().len() as f32
 }

@@ -1,6 +1,6 @@
 //! Loads a scene file with the scene stage alone and prints what it describes:
-//! the camera, render settings, materials, shapes and lights — or the one-line
-//! error a bad file gets.
+//! the camera, render settings, named regions, materials, shapes and lights — or
+//! the one-line error a bad file gets.
 //!
 //! `cargo run -p glint-scene --example inspect -- scenes/cornell-set1.toml`
 
@@ -34,14 +34,28 @@ fn main() -> std::process::ExitCode {
         c.resolution().x,
         c.resolution().y
     );
+    // Environment samples only matter when there is an environment, as in the
+    // summary line of `glint render`.
+    let environment = match s.environment {
+        Some(_) => format!(
+            ", {} environment samples ({})",
+            r.environment_samples,
+            r.environment_pattern.name()
+        ),
+        None => String::new(),
+    };
     println!(
-        "render   {} spp ({}), {} light samples ({}), seed {}",
+        "render   {} spp ({}), {} light samples ({}){environment}, max depth {}, seed {}",
         r.spp,
         r.pixel_pattern.name(),
         r.light_samples,
         r.light_pattern.name(),
+        r.max_depth,
         r.seed
     );
+    for (name, [x0, y0, x1, y1]) in &d.regions {
+        println!("region   \"{name}\": x {x0}..{x1}, y {y0}..{y1} (x1, y1 excluded)");
+    }
     println!("ambient  {}", s.ambient);
     for (i, m) in s.materials.iter().enumerate() {
         println!(

@@ -13,7 +13,7 @@
 //!   `1 / (relMSE · seconds)`.
 //! - "Samples" are light-sample paths per pixel, `spp · light_samples`: the
 //!   x-axis of the fitted slopes.
-//! - The reference is rendered (and cached) unless given; see [`reference`].
+//! - The reference is rendered (and cached) unless given; see [`reference`](mod@reference).
 //!
 //! # Entry points
 //! [`run`] does a bench described by a [`BenchConfig`] and returns a [`Bench`]:
@@ -206,7 +206,7 @@ pub fn run(
         .unwrap_or_else(|| default_resolution(scene_resolution));
     let setup = Setup { config, resolution };
     let region = resolve_region(&config.region, &first, scene_resolution, resolution)?;
-    check_budgets(config)?;
+    check_budgets(config, &first.settings)?;
     check_pixel_centre(config)?;
     if config.strategies.is_empty() {
         return Err(BenchError::Input("no strategy to measure".into()));
@@ -378,10 +378,10 @@ fn resolve_region(
     Ok(region)
 }
 
-/// Every budget must suit every strategy (the grid pattern needs squares), and
-/// the environment must be sampled at every step or at none (else the steps
-/// would compute different images).
-fn check_budgets(config: &BenchConfig) -> Result<(), BenchError> {
+/// Every budget must suit every strategy (the grid pattern needs squares, counts
+/// have limits), checked before any render; and the environment must be sampled
+/// at every step or at none (else the steps would compute different images).
+fn check_budgets(config: &BenchConfig, scene_settings: &RenderSettings) -> Result<(), BenchError> {
     let budgets: Vec<SampleBudget> = match &config.ladder {
         Ladder::Samples(b) => b.clone(),
         Ladder::Time {
@@ -414,6 +414,20 @@ fn check_budgets(config: &BenchConfig) -> Result<(), BenchError> {
                     b.environment_samples
                 )));
             }
+            let settings = RenderSettings {
+                spp: b.spp,
+                light_samples: b.light_samples,
+                environment_samples: b.environment_samples,
+                pixel_pattern: s.pixel,
+                light_pattern: s.light,
+                environment_pattern: s.environment,
+                threads: config.threads.or(scene_settings.threads),
+                max_depth: config.max_depth.unwrap_or(scene_settings.max_depth),
+                ..scene_settings.clone()
+            };
+            settings
+                .validate()
+                .map_err(|e| BenchError::Input(format!("{}: {e}", s.name())))?;
         }
     }
     Ok(())
@@ -665,8 +679,8 @@ fn rows(
         .collect()
 }
 
-/// The strategy speed-ups are measured against: `random` (all patterns random,
-/// with the same texture filter) when the bench has it, else the first.
+/// The strategy speed-ups are measured against: the first strategy whose
+/// patterns are all `random` (whatever its texture filter), else the first.
 fn baseline_name(config: &BenchConfig) -> String {
     config
         .strategies

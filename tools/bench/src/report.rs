@@ -170,7 +170,14 @@ impl Report {
             }
         }
         writeln!(out).unwrap();
-        if let Some(b) = &self.baseline {
+        let (by_error, by_efficiency) = self.rankings();
+        writeln!(out, "ranked by relMSE at the largest budget: {by_error}").unwrap();
+        writeln!(out, "ranked by efficiency there: {by_efficiency}").unwrap();
+        let one_budget = self
+            .strategies
+            .iter()
+            .all(|s| self.rows.iter().filter(|r| r.strategy == s.name).count() < 2);
+        if let (Some(b), false) = (&self.baseline, one_budget) {
             writeln!(
                 out,
                 "speed-up: render time of {} to reach its relMSE at {} samples ({}), over each strategy's",
@@ -180,7 +187,7 @@ impl Report {
             )
             .unwrap();
         }
-        for s in &self.strategies {
+        for s in self.strategies.iter().filter(|_| !one_budget) {
             let slope = |x: Option<f64>| x.map_or("—".into(), |v| format!("{v:+.2}"));
             let speedup = match s.equal_error_speedup {
                 Some(v) if s.speedup_extrapolated => format!("{v:.2}× (extrapolated)"),
@@ -243,6 +250,30 @@ impl Report {
         }
         writeln!(out, "machine: {}", self.machine.label()).unwrap();
         out
+    }
+
+    /// The strategies at their largest budget (the last row of each), best first:
+    /// by relative MSE, and by efficiency.
+    fn rankings(&self) -> (String, String) {
+        let last: Vec<&Row> = self
+            .strategies
+            .iter()
+            .filter_map(|s| self.rows.iter().rev().find(|r| r.strategy == s.name))
+            .collect();
+        let mut by_error = last.clone();
+        by_error.sort_by(|a, b| a.rel_mse.total_cmp(&b.rel_mse));
+        let mut by_efficiency = last;
+        by_efficiency.sort_by(|a, b| b.efficiency.total_cmp(&a.efficiency));
+        let list = |rows: &[&Row], value: fn(&Row) -> f64| {
+            rows.iter()
+                .map(|r| format!("{} {}", r.strategy, format_sig(value(r))))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        (
+            list(&by_error, |r| r.rel_mse),
+            list(&by_efficiency, |r| r.efficiency),
+        )
     }
 
     /// One line per row, with a header; fields needing it are quoted.

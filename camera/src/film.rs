@@ -24,11 +24,7 @@ pub enum ImageFormat {
 impl ImageFormat {
     /// The format named by `path`'s extension (case-insensitive).
     pub fn from_path(path: &Path) -> Result<Self, FilmError> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
+        match lowercase_extension(path).as_deref() {
             Some("png") => Ok(Self::Png),
             Some("exr") => Ok(Self::Exr),
             Some("pfm") => Ok(Self::Pfm),
@@ -198,6 +194,13 @@ pub fn linear_to_srgb8(linear: f32) -> u8 {
         1.055 * c.powf(1.0 / 2.4) - 0.055
     };
     (encoded * 255.0 + 0.5) as u8
+}
+
+/// `path`'s extension in lower case, which names its image format.
+fn lowercase_extension(path: &Path) -> Option<String> {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
 }
 
 #[cfg(test)]

@@ -1,21 +1,10 @@
 //! `glint bench` as a user runs it: the table, the files, the cached reference,
 //! and one error line with exit status 2 for bad input, before any work.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn glint(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("glint runs")
-}
-
-fn scene(name: &str) -> String {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../scenes/{name}.toml"));
-    p.to_str().unwrap().to_owned()
-}
+use common::{assert_input_error, glint, scene};
+use std::path::Path;
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
@@ -102,15 +91,6 @@ fn a_named_region_is_measured_and_reported() {
         text(&o.stdout)
     );
     assert!(dir.path().join("cornell-set1-bench/results.json").is_file());
-}
-
-fn assert_input_error(o: &Output, expected: &str) {
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
-    let err = text(&o.stderr);
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.starts_with("glint: error: "), "{err}");
-    assert!(err.contains(expected), "expected {expected:?} in {err}");
-    assert!(o.stdout.is_empty(), "{}", text(&o.stdout));
 }
 
 #[test]

@@ -1,24 +1,9 @@
 //! The `glint` binary as a user runs it: outputs, exit statuses, error lines.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn glint(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("glint runs")
-}
-
-fn scene(name: &str) -> String {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../scenes/{name}.toml"));
-    p.to_str().unwrap().to_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{assert_input_error, glint, scene, stderr};
+use std::path::Path;
 
 const SMALL: [&str; 6] = [
     "--resolution",
@@ -131,14 +116,6 @@ fn sobol_samplers_render_the_same_file_on_any_thread_count() {
         &glint(&args, dir.path()),
         "invalid value 'halton' for '--environment-sampler <PATTERN>'",
     );
-}
-
-fn assert_input_error(o: &Output, expected: &str) {
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(o));
-    let err = stderr(o);
-    assert_eq!(err.lines().count(), 1, "not one line: {err}");
-    assert!(err.contains(expected), "{err}");
-    assert!(!err.contains("panicked") && !err.contains("backtrace"));
 }
 
 #[test]

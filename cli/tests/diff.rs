@@ -4,23 +4,11 @@
 use glam::{UVec2, Vec3};
 use glint_camera::Film;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn glint(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("glint runs")
-}
+mod common;
 
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{assert_input_error, glint, stderr, stdout};
 
 /// A 4 × 2 film of mid grays.
 fn base() -> Film {
@@ -62,19 +50,6 @@ fn assert_exit(o: &Output, code: i32) {
         stdout(o),
         stderr(o)
     );
-}
-
-/// Exit status 2, one line on stderr containing `expected`, nothing on stdout.
-fn assert_input_error(o: &Output, expected: &str) {
-    assert_exit(o, 2);
-    let err = stderr(o);
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(
-        err.starts_with("glint: error: ") && err.contains(expected),
-        "{err}"
-    );
-    assert!(!err.contains("panicked"), "{err}");
-    assert_eq!(stdout(o), "");
 }
 
 #[test]

@@ -25,11 +25,7 @@ enum InputFormat {
 
 impl InputFormat {
     fn from_path(path: &Path) -> Result<Self, FilmError> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
+        match super::lowercase_extension(path).as_deref() {
             Some("png") => Ok(Self::Png),
             Some("jpg" | "jpeg") => Ok(Self::Jpeg),
             Some("exr") => Ok(Self::Exr),

@@ -1,0 +1,42 @@
+//! What every test of the `glint` binary needs: running it as a user does, the
+//! shipped scenes, its output as text, and the rule for bad input.
+
+#![allow(dead_code)] // each test file uses its own part of this
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs the built `glint` with `args` in `dir`.
+pub fn glint(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("glint runs")
+}
+
+/// The absolute path of a shipped scene, `scenes/NAME.toml`.
+pub fn scene(name: &str) -> String {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../scenes/{name}.toml"));
+    p.to_str().unwrap().to_owned()
+}
+
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Bad input: exit status 2, one line on stderr, `glint: error: …` containing
+/// `expected`, no panic, nothing on stdout.
+pub fn assert_input_error(o: &Output, expected: &str) {
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(o));
+    let err = stderr(o);
+    assert_eq!(err.lines().count(), 1, "not one line: {err}");
+    assert!(err.starts_with("glint: error: "), "{err}");
+    assert!(err.contains(expected), "expected {expected:?} in {err}");
+    assert!(!err.contains("panicked") && !err.contains("backtrace"));
+    assert!(o.stdout.is_empty(), "stdout: {}", stdout(o));
+}

@@ -8,11 +8,13 @@ use std::path::Path;
 
 /// Writes `path` through `write`, atomically. The new file gets the permissions
 /// of the file it replaces, or those of any new file (the umask's), not the
-/// owner-only ones of a temporary file.
-pub fn write_atomically(
+/// owner-only ones of a temporary file. `write` fails with the caller's own
+/// error type; `io_error` turns the file operations' errors into it.
+pub fn write_atomically<E>(
     path: &Path,
-    write: impl FnOnce(&mut BufWriter<&mut File>) -> std::io::Result<()>,
-) -> std::io::Result<()> {
+    io_error: impl Fn(std::io::Error) -> E,
+    write: impl FnOnce(&mut BufWriter<&mut File>) -> Result<(), E>,
+) -> Result<(), E> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -24,17 +26,19 @@ pub fn write_atomically(
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let mut tmp = builder.tempfile_in(dir)?;
+    let mut tmp = builder.tempfile_in(dir).map_err(&io_error)?;
     if let Ok(existing) = std::fs::metadata(path) {
-        tmp.as_file().set_permissions(existing.permissions())?;
+        tmp.as_file()
+            .set_permissions(existing.permissions())
+            .map_err(&io_error)?;
     }
     {
         let mut out = BufWriter::new(tmp.as_file_mut());
         write(&mut out)?;
-        out.flush()?;
+        out.flush().map_err(&io_error)?;
     }
-    tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
+    tmp.as_file().sync_all().map_err(&io_error)?;
+    tmp.persist(path).map_err(|e| io_error(e.error))?;
     Ok(())
 }
 
@@ -46,15 +50,18 @@ mod tests {
     fn a_failed_write_keeps_the_old_file_and_leaves_nothing_behind() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("out.txt");
-        write_atomically(&path, |w| w.write_all(b"first")).unwrap();
-        let failed = write_atomically(&path, |w| {
-            w.write_all(b"partial")?;
-            Err(std::io::Error::other("disk full"))
+        let io = |e: std::io::Error| e.to_string();
+        let put =
+            |bytes: &'static [u8]| write_atomically(&path, io, |w| w.write_all(bytes).map_err(io));
+        put(b"first").unwrap();
+        let failed = write_atomically(&path, io, |w| {
+            w.write_all(b"partial").map_err(io)?;
+            Err("the encoder failed".to_owned())
         });
-        assert!(failed.is_err());
+        assert_eq!(failed.unwrap_err(), "the encoder failed");
         assert_eq!(std::fs::read(&path).unwrap(), b"first");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
-        write_atomically(&path, |w| w.write_all(b"second")).unwrap();
+        put(b"second").unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"second");
     }
 }

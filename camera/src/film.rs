@@ -118,19 +118,7 @@ impl Film {
             path: path.to_path_buf(),
             source,
         };
-        // The encoder's own error is kept aside: the atomic writer speaks io::Error.
-        let mut encode_error = None;
-        let written = crate::write_atomically(path, |out| {
-            self.encode(format, out, path).map_err(|e| {
-                encode_error = Some(e);
-                std::io::Error::other("encoding failed")
-            })
-        });
-        match (written, encode_error) {
-            (_, Some(e)) => Err(e),
-            (Err(e), None) => Err(io_err(e)),
-            (Ok(()), None) => Ok(()),
-        }
+        crate::write_atomically(path, io_err, |out| self.encode(format, out, path))
     }
 
     fn encode<W: Write + Seek>(

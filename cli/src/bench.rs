@@ -1,7 +1,7 @@
 //! `glint bench`: run time against error (the work is glint-bench's; this file
 //! turns flags into its configuration and its progress into a bar).
 
-use crate::{named, Failure};
+use crate::{named, progress_bar, Failure};
 use clap::Args;
 use glam::UVec2;
 use glint_bench::budget::{parse_counts, parse_durations, sample_ladder, Ladder};
@@ -9,8 +9,6 @@ use glint_bench::strategy::{combine, parse_samplers, parse_texture_filters};
 use glint_bench::{BenchConfig, BenchError, Progress, ReferenceChoice, RegionChoice};
 use glint_metrics::Region;
 use glint_texture::TextureFilter;
-use indicatif::{ProgressBar, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -127,7 +125,8 @@ enum ReferencePixel {
 pub(crate) fn bench(args: &BenchArgs) -> Result<(), Failure> {
     let config = config(args)?;
     check_output_dir(&config.output_dir)?;
-    let bar = progress_bar();
+    // A bar over the current render's tiles, with the render's name.
+    let bar = progress_bar("{spinner} [{elapsed_precise}] {wide_bar} {msg}");
     let on_progress = |p: Progress| {
         let Some(bar) = &bar else { return };
         match p {
@@ -198,9 +197,9 @@ fn config(args: &BenchArgs) -> Result<BenchConfig, Failure> {
         }
         None => Vec::new(),
     };
-    let light = parse_counts("--light-samples", &args.light_samples).map_err(input)?;
+    let light = parse_counts("--light-samples", &args.light_samples, 1).map_err(input)?;
     let environment = match &args.environment_samples {
-        Some(list) => parse_environment_counts(list)?,
+        Some(list) => parse_counts("--environment-samples", list, 0).map_err(input)?,
         None => vec![default_environment_samples(&args.scene)],
     };
     let ladder = match &args.time {
@@ -220,7 +219,7 @@ fn config(args: &BenchArgs) -> Result<BenchConfig, Failure> {
             }
         }
         None => {
-            let spp = parse_counts("--spp", &args.spp).map_err(input)?;
+            let spp = parse_counts("--spp", &args.spp, 1).map_err(input)?;
             Ladder::Samples(sample_ladder(&spp, &light, &environment).map_err(input)?)
         }
     };
@@ -260,20 +259,6 @@ fn config(args: &BenchArgs) -> Result<BenchConfig, Failure> {
     })
 }
 
-/// Environment sample counts: like the other lists, but 0 is allowed.
-fn parse_environment_counts(list: &str) -> Result<Vec<u32>, Failure> {
-    list.split(',')
-        .map(|item| {
-            item.trim().parse::<u32>().map_err(|_| {
-                Failure::Input(format!(
-                    "--environment-samples: expected whole numbers separated by commas, got \"{}\"",
-                    item.trim()
-                ))
-            })
-        })
-        .collect()
-}
-
 /// One environment direction per shading point, or none when the scene has no
 /// environment or its own settings sample none (its environment is then only
 /// seen, not a light). An unreadable scene gets 0 here; loading it reports the
@@ -295,18 +280,4 @@ fn version() -> String {
             |b| blake3::hash(&b).to_hex()[..16].to_owned(),
         );
     format!("{} {exe}", env!("CARGO_PKG_VERSION"))
-}
-
-/// A bar over the current render's tiles with the render's name, on stderr,
-/// only when stderr is a terminal.
-fn progress_bar() -> Option<ProgressBar> {
-    if !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let bar = ProgressBar::new(0);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg}")
-            .expect("valid template"),
-    );
-    Some(bar)
 }

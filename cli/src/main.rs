@@ -113,17 +113,12 @@ pub(crate) fn named<T: Clone + Send + Sync + 'static>(
         .map(move |name: String| from_name(&name).expect("clap accepted only listed names"))
 }
 
-/// A progress bar over tiles on stderr, only when stderr is a terminal.
-pub(crate) fn progress_bar() -> Option<ProgressBar> {
+/// A progress bar drawn with `template` on stderr, only when stderr is a terminal.
+pub(crate) fn progress_bar(template: &str) -> Option<ProgressBar> {
     if !std::io::stderr().is_terminal() {
         return None;
     }
     let bar = ProgressBar::new(0);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} tiles (eta {eta})",
-        )
-        .expect("valid template"),
-    );
+    bar.set_style(ProgressStyle::with_template(template).expect("valid template"));
     Some(bar)
 }

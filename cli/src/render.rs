@@ -117,7 +117,8 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         .validate()
         .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
 
-    let progress = progress_bar();
+    let progress =
+        progress_bar("{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} tiles (eta {eta})");
     let on_tile = |done: usize, total: usize| {
         if let Some(bar) = &progress {
             bar.set_length(total as u64);

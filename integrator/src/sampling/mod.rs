@@ -81,4 +81,4 @@ mod streams;
 
 pub use pattern::SamplePattern;
 pub use sobol::{DimensionPair, SobolPoints, SobolSequence, MAX_JOINT};
-pub use streams::{pixel_rng, uniform, PixelSample, PIXEL_STREAM};
+pub use streams::{mix64, pixel_rng, uniform, PixelSample, PIXEL_STREAM};

@@ -35,15 +35,15 @@ pub enum Ladder {
     },
 }
 
-/// Parses a comma-separated list of positive whole numbers.
-pub fn parse_counts(flag: &str, list: &str) -> Result<Vec<u32>, String> {
+/// Parses a comma-separated list of whole numbers, each at least `min`.
+pub fn parse_counts(flag: &str, list: &str, min: u32) -> Result<Vec<u32>, String> {
     list.split(',')
         .map(|item| {
             let item = item.trim();
             match item.parse::<u32>() {
-                Ok(n) if n > 0 => Ok(n),
+                Ok(n) if n >= min => Ok(n),
                 _ => Err(format!(
-                    "{flag}: expected whole numbers above 0 separated by commas, got \"{item}\""
+                    "{flag}: expected whole numbers of at least {min} separated by commas, got \"{item}\""
                 )),
             }
         })
@@ -148,9 +148,14 @@ mod tests {
 
     #[test]
     fn counts_and_durations_parse_or_say_why_not() {
-        assert_eq!(parse_counts("--spp", "1, 4,16").unwrap(), [1, 4, 16]);
-        assert!(parse_counts("--spp", "1,0").unwrap_err().contains("\"0\""));
-        assert!(parse_counts("--spp", "1,x").unwrap_err().contains("--spp"));
+        assert_eq!(parse_counts("--spp", "1, 4,16", 1).unwrap(), [1, 4, 16]);
+        assert!(parse_counts("--spp", "1,0", 1)
+            .unwrap_err()
+            .contains("\"0\""));
+        assert!(parse_counts("--spp", "1,x", 1)
+            .unwrap_err()
+            .contains("--spp"));
+        assert_eq!(parse_counts("--environment-samples", "0", 0).unwrap(), [0]);
         let d = parse_durations("0.1s,300ms,2").unwrap();
         assert_eq!(d[0], Duration::from_millis(100));
         assert_eq!(d[1], Duration::from_millis(300));

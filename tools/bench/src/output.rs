@@ -8,8 +8,8 @@ use std::path::Path;
 /// Writes `bytes` to `path` atomically (temporary file, then rename), with the
 /// permissions of an ordinary new file.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    glint_camera::write_atomically(path, |out| out.write_all(bytes))
-        .map_err(|e| format!("{}: {e}", path.display()))
+    let fail = |e: std::io::Error| format!("{}: {e}", path.display());
+    glint_camera::write_atomically(path, fail, |out| out.write_all(bytes).map_err(fail))
 }
 
 #[cfg(test)]

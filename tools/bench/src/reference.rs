@@ -190,10 +190,7 @@ impl RoundSums {
 /// The seed of reference round `round`: far from the sweep's own seed, so that
 /// no round shares a random stream with a measured render.
 pub fn round_seed(seed: u64, round: u32) -> u64 {
-    let mut z = seed ^ 0x5245_4645_5245_4e43 ^ ((round as u64 + 1) << 32);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
+    glint_integrator::sampling::mix64(seed ^ 0x5245_4645_5245_4e43 ^ ((round as u64 + 1) << 32))
 }
 
 /// What the cache key hashes besides the files: the settings of one round.

@@ -61,10 +61,13 @@ pub fn save_heatmap(path: &Path, width: u32, height: u32, rgb: &[[u8; 3]]) -> Re
         |e: &dyn std::fmt::Display| format!("{}: cannot write the heat map: {e}", path.display());
     let bytes: Vec<u8> = rgb.iter().flatten().copied().collect();
     let image = image::RgbImage::from_raw(width, height, bytes).expect("length checked above");
-    glint_camera::write_atomically(path, |out| {
-        image
-            .write_to(out, image::ImageFormat::Png)
-            .map_err(std::io::Error::other)
-    })
-    .map_err(|e| fail(&e))
+    glint_camera::write_atomically(
+        path,
+        |e| fail(&e),
+        |out| {
+            image
+                .write_to(out, image::ImageFormat::Png)
+                .map_err(|e| fail(&e))
+        },
+    )
 }

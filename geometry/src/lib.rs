@@ -52,10 +52,11 @@ pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceD
 pub use hit::Hit;
 pub use offset::{offset_ray_origin, spawn_ray, spawn_ray_to, SHADOW_EPSILON};
 pub use ray::Ray;
-pub use shape_list::{ObjectRef, PrimitiveHit, ShapeList};
+pub use shape_list::{ObjectRef, Occluders, PrimitiveHit, ShapeList};
 pub use shapes::{triangle, triangle_packet};
 pub use shapes::{
-    AaBox, MeshError, Parallelogram, Plane, Shape, Sphere, TriangleMesh, TrianglePacket,
+    AaBox, MeshError, Parallelogram, ParallelogramPacket, Plane, Shape, Sphere, SpherePacket,
+    TriangleMesh, TrianglePacket,
 };
 
 #[cfg(doctest)]

@@ -1,10 +1,17 @@
 use crate::sampling::{DimensionPair, PixelSample, SamplePattern, MAX_JOINT};
 use crate::{Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
-use glint_geometry::{reflect_differential, spawn_ray, spawn_ray_to, Hit, Ray, RayDifferential};
+use glint_geometry::{
+    reflect_differential, spawn_ray, spawn_ray_to, Hit, Occluders, Ray, RayDifferential,
+};
 use glint_lighting::{AreaLight, Light, PhongMaterial};
 use glint_texture::TexCoord;
 use rand_pcg::Pcg32;
+
+/// From this many samples per area light on, each shading point first culls the
+/// shapes that cannot block its shadow rays to the light
+/// ([`glint_geometry::ShapeList::occluders_towards`]).
+const CULL_FROM_SAMPLES: u32 = 4;
 
 /// The direct-lighting integrator of the course report (section 2.5), with the
 /// environment and mirror reflections of section 2.7.
@@ -121,14 +128,18 @@ impl DirectIntegrator {
         let mut pairs = PairAllocation::new(depth);
         for (index, light) in scene.lights.iter().enumerate() {
             radiance += match light {
-                Light::Point(p) => p.color * point.unoccluded_reflection(scene, p.position, ctx),
+                Light::Point(p) => {
+                    let reflected =
+                        point.unoccluded_reflection(scene, p.position, &Occluders::ALL, ctx);
+                    p.color * reflected
+                }
                 Light::Area(area) => {
                     let own = DimensionPair::Light {
                         light: index as u32,
                         depth,
                     };
                     let pair = pairs.take(own, self.light_samples);
-                    self.area_light(scene, point, area, pair, ctx)
+                    self.area_light(scene, point, index, area, pair, ctx)
                 }
             };
         }
@@ -149,6 +160,7 @@ impl DirectIntegrator {
         &self,
         scene: &Scene,
         point: &ShadingPoint,
+        index: usize,
         light: &AreaLight,
         pair: DimensionPair,
         ctx: &mut SampleContext,
@@ -156,11 +168,22 @@ impl DirectIntegrator {
         let mut samples = std::mem::take(&mut ctx.light_points);
         let sobol = ctx.sample.sobol_points(pair, self.light_samples);
         self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+        // Culling the shapes that cannot block this point's shadow rays costs
+        // about as much as testing them once: it pays from a few samples on.
+        let occluders = if self.light_samples >= CULL_FROM_SAMPLES {
+            scene.shapes.occluders_towards(
+                point.hit.point,
+                &light.surface().corners(),
+                [point.hit.shape, scene.light_objects[index]],
+            )
+        } else {
+            Occluders::ALL
+        };
         let mut sum = Vec3::ZERO;
         for &u in &samples {
             let position = light.sample_point(u);
             if light.illuminates(position, point.hit.point) {
-                sum += point.unoccluded_reflection(scene, position, ctx);
+                sum += point.unoccluded_reflection(scene, position, &occluders, ctx);
             }
         }
         ctx.light_points = samples;
@@ -278,12 +301,13 @@ impl<'a> ShadingPoint<'a> {
 
 impl ShadingPoint<'_> {
     /// Phong reflection towards `v` of a unit light at `position`, or zero if the
-    /// light is behind the surface or a shadow ray finds it occluded. The shadow ray
-    /// is only traced when the light could contribute.
+    /// light is behind the surface or a shadow ray finds it occluded (testing only
+    /// `occluders`). The shadow ray is only traced when the light could contribute.
     fn unoccluded_reflection(
         &self,
         scene: &Scene,
         position: Vec3,
+        occluders: &Occluders,
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let Some(l) = (position - self.hit.point).try_normalize() else {
@@ -298,7 +322,7 @@ impl ShadingPoint<'_> {
         }
         let (shadow, t_max) = spawn_ray_to(self.hit, position);
         ctx.shadow_rays += 1;
-        if scene.shapes.any_hit(&shadow, t_max) {
+        if scene.shapes.any_hit_among(occluders, &shadow, t_max) {
             Vec3::ZERO
         } else {
             reflected

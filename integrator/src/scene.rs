@@ -38,6 +38,9 @@ pub struct Scene {
     pub environment: Option<EnvironmentLight>,
     /// Per mesh, the material index of each triangle.
     pub mesh_materials: Vec<Vec<u32>>,
+    /// Per light, the object of `shapes` that is its emitting surface
+    /// (`u32::MAX` for a point light).
+    pub light_objects: Vec<u32>,
 }
 
 impl Scene {
@@ -195,7 +198,14 @@ impl SceneBuilder {
             }
         }
         self.shapes.build_acceleration();
+        let mut light_objects = vec![u32::MAX; self.lights.len()];
+        for (object, surface) in self.surfaces.iter().enumerate() {
+            if let Surface::Emitter(light) = *surface {
+                light_objects[light as usize] = object as u32;
+            }
+        }
         Ok(Scene {
+            light_objects,
             camera,
             shapes: self.shapes,
             surfaces: self.surfaces,

@@ -160,10 +160,31 @@ impl PhongMaterial {
         } else if self.shininess.fract() == 0.0 && self.shininess <= 1024.0 {
             // Integral exponents (the usual case) by repeated squaring: several
             // times faster than powf, and as accurate to a few ULPs.
-            cosine.powi(self.shininess as i32)
+            powi(cosine, self.shininess as i32)
         } else {
             cosine.powf(self.shininess)
         }
+    }
+}
+
+/// `base^exponent` by binary exponentiation, inlined: the multiplications of
+/// `f32::powi` (the runtime's `__powisf2`, which the compiler calls out of line for
+/// an exponent unknown at compile time) in the same order, so the same bits.
+#[inline]
+fn powi(mut base: f32, exponent: i32) -> f32 {
+    let mut n = exponent.unsigned_abs();
+    let mut result = if n & 1 == 1 { base } else { 1.0 };
+    while n > 1 {
+        n >>= 1;
+        base *= base;
+        if n & 1 == 1 {
+            result *= base;
+        }
+    }
+    if exponent < 0 {
+        1.0 / result
+    } else {
+        result
     }
 }
 
@@ -173,6 +194,21 @@ mod tests {
     use glint_snapfmt::vec3;
     use glint_texture::Checkerboard;
     use std::fmt::Write;
+
+    #[test]
+    fn inline_powi_gives_the_bits_of_f32_powi() {
+        for exponent in (-40..=1024).chain([i32::MAX, i32::MIN + 1]) {
+            for k in 0..200 {
+                let base = k as f32 / 199.0 * 1.25;
+                let expected = std::hint::black_box(base).powi(std::hint::black_box(exponent));
+                assert_eq!(
+                    powi(base, exponent).to_bits(),
+                    expected.to_bits(),
+                    "{base}^{exponent}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn phong_values_for_fixed_geometry() {

@@ -8,7 +8,15 @@ use super::wide::{self, Link};
 use super::Bvh;
 use crate::prefetch::prefetch;
 use crate::Ray;
+use std::cell::RefCell;
 use std::ops::ControlFlow;
+
+thread_local! {
+    /// Each thread's traversal stack, reused by its queries one after another: a
+    /// fresh one per query had its 2.3 KB zeroed every time, 5% of the render time
+    /// of `bunny-cornell` (perf).
+    static STACK: RefCell<TraversalStack> = const { RefCell::new(TraversalStack::new()) };
+}
 
 impl Bvh {
     /// Closest hit: visits nodes front to back (nearest child first, by entry
@@ -84,19 +92,35 @@ impl Bvh {
         &self,
         ray: &Ray,
         t_max: f32,
-        mut visit_leaf: impl FnMut(Link, f32) -> ControlFlow<(), f32>,
+        visit_leaf: impl FnMut(Link, f32) -> ControlFlow<(), f32>,
     ) -> ControlFlow<()> {
         if ray.origin.is_nan() || ray.direction.is_nan() || self.is_empty() {
             return ControlFlow::Continue(());
         }
         let ray = PreparedRay::new(ray);
+        STACK.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut stack) => self.traverse_with(&ray, t_max, &mut stack, visit_leaf),
+            // A query made from inside another's leaf visit: a stack of its own.
+            Err(_) => self.traverse_with(&ray, t_max, &mut TraversalStack::new(), visit_leaf),
+        })
+    }
+
+    /// [`Bvh::traverse`] with `stack` (emptied first) as its traversal stack.
+    #[inline(always)]
+    fn traverse_with(
+        &self,
+        ray: &PreparedRay,
+        t_max: f32,
+        stack: &mut TraversalStack,
+        mut visit_leaf: impl FnMut(Link, f32) -> ControlFlow<(), f32>,
+    ) -> ControlFlow<()> {
+        stack.clear();
         let mut t_max = t_max;
-        let mut stack = TraversalStack::new();
         let mut next = Some(Link::ROOT);
         while let Some(link) = next {
             next = self.step(
-                &ray,
-                &mut stack,
+                ray,
+                stack,
                 link,
                 &mut t_max,
                 &mut visit_leaf,

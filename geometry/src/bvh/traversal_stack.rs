@@ -20,7 +20,7 @@ pub(super) struct TraversalStack {
 }
 
 impl TraversalStack {
-    pub(super) fn new() -> Self {
+    pub(super) const fn new() -> Self {
         Self {
             links: [Link::UNUSED; STACK_SIZE],
             enter: [0.0; STACK_SIZE],

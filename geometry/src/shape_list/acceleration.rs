@@ -2,7 +2,7 @@
 //! primitive (each analytic shape, each triangle), with the primitives stored in
 //! the BVH's leaf order and each leaf's triangles as one four-lane packet.
 
-use super::{Object, Primitive, ShapeList};
+use super::{LinearShapes, Object, Primitive, ShapeList};
 use crate::bvh::{Bounds3, Bvh, BvhStats, LEAF_WIDTH};
 use crate::triangle::WatertightRay;
 use crate::{Ray, TrianglePacket};
@@ -14,7 +14,8 @@ pub const LINEAR_LIMIT: usize = 32;
 impl ShapeList {
     /// Builds the BVH if the scene is large enough for it to pay: below
     /// 32 primitives (`LINEAR_LIMIT`) the linear loop is faster (and gives the same
-    /// answers), so none is built.
+    /// answers), so none is built, and spheres and parallelograms are laid out in
+    /// packets of four for it instead.
     pub fn build_acceleration(&mut self) {
         let primitives: usize = self
             .objects
@@ -28,11 +29,13 @@ impl ShapeList {
             self.build_bvh();
         } else {
             self.bvh = None;
+            self.linear = Some(LinearShapes::new(self));
         }
     }
 
     /// Builds the BVH over every bounded primitive (binned SAH; see [`Bvh`]).
     pub fn build_bvh(&mut self) {
+        self.linear = None;
         let mut primitives = Vec::new();
         let mut bounds = Vec::new();
         self.unbounded.clear();

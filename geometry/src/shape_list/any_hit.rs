@@ -1,7 +1,7 @@
 //! Any-hit (shadow) queries: whether anything lies on a ray before `t_max`, for
 //! one ray or a batch traced as an interleaved stream.
 
-use super::{Object, ShapeList};
+use super::{LinearShapes, Object, ShapeList};
 use crate::bvh::RayStream;
 use crate::triangle::WatertightRay;
 use crate::Ray;
@@ -25,6 +25,7 @@ impl ShapeList {
                         })
                         .is_break()
             }
+            None if self.linear.is_some() => self.linear_any_hit(ray, t_max),
             // Without meshes the objects are the shapes, in order: the course's loop.
             None if self.meshes.is_empty() => self
                 .shapes
@@ -70,6 +71,33 @@ impl ShapeList {
                 }
             }
         }
+    }
+
+    /// [`ShapeList::any_hit`] through the linear loop's packets.
+    fn linear_any_hit(&self, ray: &Ray, t_max: f32) -> bool {
+        let Some(linear) = &self.linear else {
+            return false;
+        };
+        linear
+            .spheres
+            .iter()
+            .any(|(packet, _)| packet.hit4(ray, t_max).0 != 0)
+            || linear
+                .parallelograms
+                .iter()
+                .any(|(packet, _)| packet.hit4(ray, t_max).0 != 0)
+            || self.others_hit(linear, ray, t_max)
+    }
+
+    /// Whether an object of the linear loop outside its packets lies on the ray.
+    pub(super) fn others_hit(&self, linear: &LinearShapes, ray: &Ray, t_max: f32) -> bool {
+        linear.others.iter().any(|&object| {
+            let watertight = WatertightRay::new(ray);
+            self.primitives_of(object).any(|p| {
+                self.primitive_distance(p, ray, &watertight, t_max)
+                    .is_some()
+            })
+        })
     }
 
     /// Whether an unbounded plane (which the BVH leaves out) lies on the ray in

@@ -3,12 +3,12 @@
 //! exactly equal distances go to the lowest (object, triangle), with or without
 //! the BVH.
 
-use super::{Object, Primitive, ShapeList};
+use super::{LinearShapes, Object, Primitive, ShapeList};
 use crate::bvh::RayStream;
 use crate::prefetch::prefetch;
 use crate::triangle::WatertightRay;
 use crate::{Hit, Ray};
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use std::ops::ControlFlow;
 
 /// A candidate for the closest hit: a primitive, or a position in the BVH's leaf
@@ -65,7 +65,10 @@ impl ShapeList {
                     ControlFlow::Continue(search.visit_leaf(self, first))
                 });
             }
-            None => self.all_primitives().for_each(|p| search.test(self, p)),
+            None => match &self.linear {
+                Some(linear) => search.test_linear(self, linear),
+                None => self.all_primitives().for_each(|p| search.test(self, p)),
+            },
         }
         search.finish(self)
     }
@@ -177,6 +180,37 @@ impl ClosestSearch {
             .get_or_insert_with(|| WatertightRay::new(&ray));
         if let Some(t) = list.primitive_distance(p, &self.ray, &watertight, self.limit()) {
             self.consider(list, Found::Primitive(p), t);
+        }
+    }
+
+    /// Tests every object through the linear loop's packets.
+    fn test_linear(&mut self, list: &ShapeList, linear: &LinearShapes) {
+        for (packet, objects) in &linear.spheres {
+            let (hits, t) = packet.hit4(&self.ray, self.limit);
+            self.consider_lanes(list, hits, t, objects);
+        }
+        for (packet, objects) in &linear.parallelograms {
+            let (hits, t) = packet.hit4(&self.ray, self.limit);
+            self.consider_lanes(list, hits, t, objects);
+        }
+        for &object in &linear.others {
+            for p in list.primitives_of(object) {
+                self.test(list, p);
+            }
+        }
+    }
+
+    /// Considers the hit lanes of a packet of shapes, lane k being object `objects[k]`.
+    #[inline]
+    fn consider_lanes(&mut self, list: &ShapeList, mut hits: u32, t: Vec4, objects: &[u32; 4]) {
+        while hits != 0 {
+            let lane = hits.trailing_zeros() as usize;
+            hits &= hits - 1;
+            let p = Primitive {
+                object: objects[lane],
+                triangle: 0,
+            };
+            self.consider(list, Found::Primitive(p), t[lane]);
         }
     }
 

@@ -6,16 +6,22 @@
 //! - `acceleration`: the BVH over the primitives, and its leaves' triangle packets.
 //! - `closest`: closest-hit queries (with the surface record, without, and batches).
 //! - `any_hit`: shadow queries, one ray or a batch.
+//! - `linear`: the linear loop's layout, spheres and parallelograms in packets of four.
+//! - `occluders`: shadow rays towards an area light, testing only the shapes that may block them.
 
 mod acceleration;
 mod any_hit;
 mod closest;
+mod linear;
+mod occluders;
 
 pub use closest::PrimitiveHit;
+pub use occluders::Occluders;
 
 use crate::bvh::Bvh;
 use crate::triangle::WatertightRay;
 use crate::{Ray, Shape, TriangleMesh, TrianglePacket};
+use linear::LinearShapes;
 
 /// What an object index names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,6 +85,8 @@ pub struct ShapeList {
     /// …and per leaf, the lanes holding analytic shapes, tested one by one.
     shape_lanes: Vec<u8>,
     unbounded: Vec<u32>,
+    /// The linear loop's packets, when [`ShapeList::build_acceleration`] chose it.
+    linear: Option<LinearShapes>,
 }
 
 impl PartialEq for ShapeList {
@@ -106,6 +114,7 @@ impl ShapeList {
 
     fn add(&mut self, object: Object) -> u32 {
         self.bvh = None;
+        self.linear = None;
         self.objects.push(object);
         self.objects.len() as u32 - 1
     }
@@ -146,19 +155,16 @@ impl ShapeList {
 
     /// Every primitive, object by object (the linear loop's order).
     fn all_primitives(&self) -> impl Iterator<Item = Primitive> + '_ {
-        self.objects
-            .iter()
-            .enumerate()
-            .flat_map(move |(object, kind)| {
-                let triangles = match *kind {
-                    Object::Shape(_) => 1,
-                    Object::Mesh(m) => self.meshes[m as usize].triangle_count() as u32,
-                };
-                (0..triangles).map(move |triangle| Primitive {
-                    object: object as u32,
-                    triangle,
-                })
-            })
+        (0..self.objects.len() as u32).flat_map(move |object| self.primitives_of(object))
+    }
+
+    /// The primitives of object `object`: the shape, or each triangle of the mesh.
+    fn primitives_of(&self, object: u32) -> impl Iterator<Item = Primitive> {
+        let triangles = match self.objects[object as usize] {
+            Object::Shape(_) => 1,
+            Object::Mesh(m) => self.meshes[m as usize].triangle_count() as u32,
+        };
+        (0..triangles).map(move |triangle| Primitive { object, triangle })
     }
 
     #[inline]

@@ -11,6 +11,7 @@ mod aabox;
 mod mesh;
 mod parallelogram;
 mod plane;
+mod shape_packets;
 mod sphere;
 pub mod triangle;
 pub mod triangle_packet;
@@ -19,6 +20,7 @@ pub use aabox::AaBox;
 pub use mesh::{MeshError, TriangleMesh};
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
+pub use shape_packets::{ParallelogramPacket, SpherePacket};
 pub use sphere::Sphere;
 pub use triangle_packet::TrianglePacket;
 

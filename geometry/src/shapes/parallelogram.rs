@@ -11,13 +11,13 @@ use glam::{Vec2, Vec3};
 /// A one-sided parallelogram is seen only from its front side.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Parallelogram {
-    origin: Vec3,
-    edge1: Vec3,
-    edge2: Vec3,
-    normal: Vec3,
-    two_sided: bool,
+    pub(super) origin: Vec3,
+    pub(super) edge1: Vec3,
+    pub(super) edge2: Vec3,
+    pub(super) normal: Vec3,
+    pub(super) two_sided: bool,
     /// `(e1 × e2) / |e1 × e2|²`: turns cross products into the coordinates α, β.
-    w: Vec3,
+    pub(super) w: Vec3,
 }
 
 impl Parallelogram {
@@ -64,6 +64,11 @@ impl Parallelogram {
     }
     pub fn center(&self) -> Vec3 {
         self.origin + 0.5 * (self.edge1 + self.edge2)
+    }
+    /// The four corners, in order around the parallelogram.
+    pub fn corners(&self) -> [Vec3; 4] {
+        let (o, e1, e2) = (self.origin, self.edge1, self.edge2);
+        [o, o + e1, o + e1 + e2, o + e2]
     }
     /// The point with coordinates `(α, β)` ∈ `[0, 1]²`.
     pub fn point_at(&self, ab: Vec2) -> Vec3 {

@@ -12,8 +12,8 @@ use std::f32::consts::{PI, TAU};
 /// bottom pole, 1 at the top).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
-    center: Vec3,
-    radius: f32,
+    pub(super) center: Vec3,
+    pub(super) radius: f32,
 }
 
 impl Sphere {

@@ -1,0 +1,313 @@
+//! Shadow rays towards an area light, with the shapes that cannot be in their way
+//! culled once per shading point.
+//!
+//! Every shadow ray from a point `p` to a point of a light lies in the convex hull
+//! of `p` and the light's corners: a pyramid with apex `p` over the light. A shape
+//! whose bounding sphere lies wholly outside one of the pyramid's five face planes
+//! (by more than a margin covering the rays' offset origins and rounding) cannot
+//! block any of them, so [`ShapeList::occluders_towards`] leaves it out once for all
+//! the light's samples at that point, and [`ShapeList::any_hit_among`] tests only
+//! the rest. The answers are [`ShapeList::any_hit`]'s: only shapes that cannot be hit
+//! are skipped. (In the Cornell box a floor point's 16 shadow rays to the light
+//! then test one or two spheres instead of ten shapes.)
+
+use super::ShapeList;
+use crate::Ray;
+use glam::{Vec3, Vec4};
+
+/// The shapes of a [`ShapeList`] that may block shadow rays from one point to one
+/// light: bit `4k + lane` for lane `lane` of the linear loop's packet `k` (sphere
+/// packets, then parallelogram packets). Objects outside the packets (planes,
+/// boxes, meshes), and every object of a list with a BVH, are always tested.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Occluders {
+    lanes: u64,
+}
+
+impl Occluders {
+    /// Every shape (no culling).
+    pub const ALL: Occluders = Occluders { lanes: u64::MAX };
+
+    /// How many packed shapes may block the rays (64 meaning "all").
+    pub fn count(&self) -> u32 {
+        self.lanes.count_ones()
+    }
+
+    /// The lanes kept of packet `k`.
+    #[inline]
+    fn packet(&self, k: usize) -> u32 {
+        (self.lanes.checked_shr(4 * k as u32).unwrap_or(0) & 0xf) as u32
+    }
+}
+
+/// The most packets whose lanes [`Occluders`] can name; a linear loop never has
+/// more (it holds at most 32 shapes, so at most 8 packets of each kind).
+const MAX_PACKETS: usize = 16;
+
+impl ShapeList {
+    /// The shapes that may lie on a segment from `from` to any point of the convex
+    /// polygon `corners` (an area light's corners, in order around it), short of
+    /// its ends. The objects `exclude` names are left out if flat: the surface the
+    /// segments leave (a flat shape cannot block rays leaving it) and the light's
+    /// own surface (shadow rays stop short of it). Culls only in the linear loop's
+    /// layout; otherwise [`Occluders::ALL`].
+    pub fn occluders_towards(
+        &self,
+        from: Vec3,
+        corners: &[Vec3; 4],
+        exclude: [u32; 2],
+    ) -> Occluders {
+        let Some(linear) = &self.linear else {
+            return Occluders::ALL;
+        };
+        let Some(planes) = pyramid_planes(from, corners) else {
+            return Occluders::ALL;
+        };
+        if linear.sphere_bounds.len() + linear.parallelogram_corners.len() > MAX_PACKETS {
+            return Occluders::ALL;
+        }
+        let mut lanes = 0u64;
+        let mut bit = 0;
+        for (center, radius) in &linear.sphere_bounds {
+            // A sphere is kept unless it lies wholly outside a face.
+            let mut keep = Vec4::ONE.cmpgt(Vec4::ZERO);
+            for plane in &planes {
+                keep &= plane
+                    .distance(center)
+                    .cmple(*radius + Vec4::splat(plane.margin));
+            }
+            lanes |= (keep.bitmask() as u64) << bit;
+            bit += 4;
+        }
+        for corners in &linear.parallelogram_corners {
+            // A parallelogram is kept unless its four corners lie outside one face.
+            let mut outside = Vec4::ZERO.cmpgt(Vec4::ONE);
+            for plane in &planes {
+                let margin = Vec4::splat(plane.margin);
+                let mut all = Vec4::ONE.cmpgt(Vec4::ZERO);
+                for corner in corners {
+                    all &= plane.distance(corner).cmpgt(margin);
+                }
+                outside |= all;
+            }
+            // NaN (unused) lanes are never outside: drop them by their corner.
+            let used = corners[0][0].cmpeq(corners[0][0]);
+            lanes |= ((used & !outside).bitmask() as u64) << bit;
+            bit += 4;
+        }
+        // A flat shape never blocks a ray leaving its own surface, nor one that
+        // ends (short of) on it.
+        for object in exclude {
+            if let Some(Some(flat)) = linear.flat_bits.get(object as usize) {
+                lanes &= !(1u64 << flat);
+            }
+        }
+        Occluders { lanes }
+    }
+
+    /// [`ShapeList::any_hit`] for a shadow ray from the point and towards the light
+    /// `occluders` was made for: the same answer, testing only those shapes.
+    pub fn any_hit_among(&self, occluders: &Occluders, ray: &Ray, t_max: f32) -> bool {
+        let Some(linear) = self
+            .linear
+            .as_ref()
+            .filter(|_| *occluders != Occluders::ALL)
+        else {
+            return self.any_hit(ray, t_max);
+        };
+        let spheres = linear.spheres.len();
+        linear.spheres.iter().enumerate().any(|(k, (packet, _))| {
+            let lanes = occluders.packet(k);
+            lanes != 0 && packet.hit4(ray, t_max).0 & lanes != 0
+        }) || linear
+            .parallelograms
+            .iter()
+            .enumerate()
+            .any(|(k, (packet, _))| {
+                let lanes = occluders.packet(spheres + k);
+                lanes != 0 && packet.hit4(ray, t_max).0 & lanes != 0
+            })
+            || self.others_hit(linear, ray, t_max)
+    }
+}
+
+/// A face of the pyramid: a point `x` is outside when `normal · x − offset > margin`.
+#[derive(Clone, Copy, Debug)]
+struct Face {
+    normal: Vec3,
+    offset: f32,
+    margin: f32,
+}
+
+impl Face {
+    /// `normal · x − offset` for four points given as `[x, y, z]` lanes.
+    #[inline]
+    fn distance(&self, x: &[Vec4; 3]) -> Vec4 {
+        x[0] * Vec4::splat(self.normal.x)
+            + x[1] * Vec4::splat(self.normal.y)
+            + x[2] * Vec4::splat(self.normal.z)
+            - Vec4::splat(self.offset)
+    }
+}
+
+/// The outward faces of the pyramid with apex `apex` over the convex polygon
+/// `corners`. `None` if the apex lies in the polygon's plane (no pyramid: nothing
+/// is culled).
+fn pyramid_planes(apex: Vec3, corners: &[Vec3; 4]) -> Option<[Face; 5]> {
+    let centroid = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+    // Shadow rays start up to a few hundred ULPs off `apex` and end within rounding
+    // of the polygon: a margin far above both, relative to the coordinates' size.
+    let size = corners.iter().fold(apex.abs().max_element(), |m, c| {
+        m.max(c.abs().max_element())
+    });
+    let margin = 1e-3 * (1.0 + size);
+    let outward = |normal: Vec3, on_face: Vec3| -> Option<Face> {
+        let normal = normal.try_normalize()?;
+        let inside = normal.dot(centroid - on_face);
+        // Also false for NaN: then nothing is culled.
+        let clear = inside.abs() > 1e-6 * (1.0 + size);
+        if !clear {
+            return None;
+        }
+        let normal = if inside > 0.0 { -normal } else { normal };
+        Some(Face {
+            normal,
+            offset: normal.dot(on_face),
+            margin,
+        })
+    };
+    let side = |i: usize| outward((corners[i] - apex).cross(corners[(i + 1) % 4] - apex), apex);
+    // The base: the polygon's plane, outward away from the apex.
+    let base = (corners[1] - corners[0])
+        .cross(corners[3] - corners[0])
+        .try_normalize()?;
+    let height = base.dot(apex - corners[0]);
+    let clear = height.abs() > 1e-6 * (1.0 + size);
+    if !clear {
+        return None;
+    }
+    let normal = if height > 0.0 { -base } else { base };
+    let base = Some(Face {
+        normal,
+        offset: normal.dot(corners[0]),
+        margin,
+    });
+    Some([side(0)?, side(1)?, side(2)?, side(3)?, base?])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Parallelogram, Sphere};
+
+    /// The course's Cornell box (walls one-sided, facing in), its four spheres and
+    /// its light.
+    fn cornell() -> (ShapeList, [Vec3; 4]) {
+        let mut list = ShapeList::new();
+        let wall = |o: [f32; 3], e1: [f32; 3], e2: [f32; 3], n: Vec3| {
+            Parallelogram::new(o.into(), e1.into(), e2.into(), false)
+                .unwrap()
+                .facing(n)
+        };
+        list.push(wall(
+            [-10., -10., -10.],
+            [20., 0., 0.],
+            [0., 20., 0.],
+            Vec3::Z,
+        ));
+        list.push(wall(
+            [-6., -7., -11.],
+            [0., 0., 20.],
+            [0., 20., 0.],
+            Vec3::X,
+        ));
+        list.push(wall(
+            [6., -7., -11.],
+            [0., 0., 20.],
+            [0., 20., 0.],
+            -Vec3::X,
+        ));
+        list.push(wall(
+            [-7., -6., -11.],
+            [20., 0., 0.],
+            [0., 0., 20.],
+            Vec3::Y,
+        ));
+        list.push(wall(
+            [-7., 6., -11.],
+            [20., 0., 0.],
+            [0., 0., 20.],
+            -Vec3::Y,
+        ));
+        for (c, r) in [
+            ([3., 1., -7.], 1.5),
+            ([2., -3.2, -5.], 1.0),
+            ([-4., 2., -5.], 1.8),
+            ([-2., -4.5, -8.], 2.0),
+        ] {
+            list.push(Sphere::new(c.into(), r).unwrap());
+        }
+        let light = wall([-1., 5.9, -7.], [2., 0., 0.], [0., 0., 2.], -Vec3::Y);
+        list.push(light);
+        list.build_acceleration();
+        (list, light.corners())
+    }
+
+    #[test]
+    fn a_floor_point_keeps_only_what_stands_between_it_and_the_light() {
+        let (list, light) = cornell();
+        // Far from the spheres: nothing at all (the floor is its own surface).
+        let open = list.occluders_towards(Vec3::new(4.0, -6.0, 0.0), &light, [3, 9]);
+        assert_eq!(open.count(), 0, "{open:?}");
+        // Under the small sphere at (2, −3.2, −5): that sphere alone.
+        let under = list.occluders_towards(Vec3::new(1.9, -6.0, -5.0), &light, [3, 9]);
+        assert_eq!(under, Occluders { lanes: 1 << 1 });
+    }
+
+    /// Culling never changes an answer: shadow rays from points all over the box's
+    /// walls and spheres to points of the light get the course loop's answer.
+    #[test]
+    fn culled_shadow_rays_get_the_answers_of_the_full_loop() {
+        let (list, light) = cornell();
+        let mut plain = ShapeList::new();
+        for k in 0..list.len() as u32 {
+            if let crate::ObjectRef::Shape(s) = list.object(k) {
+                plain.push(*s);
+            }
+        }
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut blocked, mut culled) = (0, 0);
+        for _ in 0..4000 {
+            let aim = Vec3::new(
+                next() * 12.0 - 6.0,
+                next() * 12.0 - 6.0,
+                next() * 20.0 - 11.0,
+            );
+            // The first surface a ray from the camera towards `aim` meets.
+            let ray = Ray::new(Vec3::new(0.0, 0.0, 10.0), aim - Vec3::new(0.0, 0.0, 10.0));
+            let Some(hit) = plain.closest_hit(&ray, f32::INFINITY) else {
+                continue;
+            };
+            let occluders = list.occluders_towards(hit.point, &light, [hit.shape, 9]);
+            culled += 64 - occluders.count().min(64);
+            for _ in 0..4 {
+                let (a, b) = (next(), next());
+                let target = light[0] + a * (light[1] - light[0]) + b * (light[3] - light[0]);
+                let (shadow, t_max) = crate::spawn_ray_to(&hit, target);
+                let expected = plain.any_hit(&shadow, t_max);
+                assert_eq!(list.any_hit_among(&occluders, &shadow, t_max), expected);
+                blocked += expected as u32;
+            }
+        }
+        assert!(
+            blocked > 500 && culled > 1000,
+            "{blocked} blocked, {culled} culled"
+        );
+    }
+}

@@ -17,6 +17,7 @@ mod bench;
 mod diff;
 mod output;
 mod render;
+mod stats;
 
 use clap::builder::TypedValueParser;
 use clap::{Parser, Subcommand};

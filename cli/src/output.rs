@@ -36,3 +36,12 @@ pub(crate) fn check_writable(path: &Path) -> Result<(), Failure> {
         })?;
     Ok(())
 }
+
+/// Writes `text` to `path` atomically.
+pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), Failure> {
+    use std::io::Write;
+    let fail = |e: std::io::Error| Failure::Other(format!("{}: {e}", path.display()));
+    glint_camera::write_atomically(path, fail, |out| {
+        out.write_all(text.as_bytes()).map_err(fail)
+    })
+}

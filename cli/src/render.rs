@@ -1,5 +1,6 @@
 //! `glint render`: a scene file to an image.
 
+use crate::stats::StatsReport;
 use crate::{named, progress_bar, Failure};
 use clap::Args;
 use glam::UVec2;
@@ -81,6 +82,18 @@ pub(crate) struct RenderArgs {
     /// gray from near to far, MIP level and reflection depth as a blue-green-red ramp)
     #[arg(long, value_name = "BUFFER", value_parser = named(&Aov::NAMES, Aov::from_name))]
     aov: Option<Aov>,
+
+    /// At the end, print what the render did: rays by kind, intersection tests by
+    /// shape, BVH nodes and leaves visited, shadow rays skipped and why, texture
+    /// lookups by filter and MIP level, NaN/Inf samples dropped, time by phase, peak
+    /// memory. The image is the same with or without it
+    #[arg(long)]
+    stats: bool,
+
+    /// Write the same statistics as JSON to FILE (atomically); implies gathering
+    /// them (the schema is in docs/command-line.md)
+    #[arg(long, value_name = "FILE")]
+    stats_json: Option<PathBuf>,
 }
 
 pub(crate) fn parse_resolution(text: &str) -> Result<UVec2, String> {
@@ -98,12 +111,17 @@ pub(crate) fn parse_resolution(text: &str) -> Result<UVec2, String> {
 pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
     let start = std::time::Instant::now();
     let output = output_path(args)?;
+    if let Some(json) = &args.stats_json {
+        crate::output::check_writable(json)?;
+    }
     let SceneDescription {
         mut scene,
         mut settings,
+        timings,
         ..
     } = glint_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
     apply_overrides(args, &mut settings);
+    settings.stats = args.stats || args.stats_json.is_some();
     if let Some(filter) = args.texture_filter {
         scene.override_texture_filter(filter);
     }
@@ -136,8 +154,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         }
         _ => rendered.film,
     };
+    let write_start = std::time::Instant::now();
     film.save(&output)
         .map_err(|e| Failure::Other(e.to_string()))?;
+    let write = write_start.elapsed();
 
     let stats = rendered.stats;
     let resolution = film.resolution();
@@ -157,6 +177,25 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         stats.rays(),
         stats.rays_per_second() / 1e6,
     );
+    let report = StatsReport {
+        stats: &stats,
+        scene: &scene,
+        load: timings,
+        write,
+    };
+    if args.stats {
+        println!("{}", report.to_text());
+    }
+    if let Some(path) = &args.stats_json {
+        let text = serde_json::to_string_pretty(&report.to_json()).expect("JSON of numbers");
+        crate::output::write_text(path, &(text + "\n"))?;
+    }
+    if stats.shading.nonfinite_samples > 0 {
+        eprintln!(
+            "glint: warning: {} camera samples were NaN or infinite and were left out of their pixels",
+            stats.shading.nonfinite_samples
+        );
+    }
     Ok(())
 }
 

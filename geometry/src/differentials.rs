@@ -5,7 +5,7 @@
 //! ∂p/∂x and ∂p/∂y; ∂(u,v)/∂x and ∂(u,v)/∂y then follow from
 //! `∂p/∂x = ∂p/∂u · ∂u/∂x + ∂p/∂v · ∂v/∂x`, solved in the least-squares sense.
 
-use crate::Hit;
+use crate::{Hit, Ray};
 use glam::{Vec2, Vec3};
 
 /// The rays one pixel step away from a main ray, in x and in y.
@@ -15,6 +15,19 @@ pub struct RayDifferential {
     pub rx_direction: Vec3,
     pub ry_origin: Vec3,
     pub ry_direction: Vec3,
+}
+
+impl RayDifferential {
+    /// No footprint: both offset rays are `ray` itself. For scenes where nothing
+    /// reads differentials, so they are never computed.
+    pub fn none(ray: &Ray) -> Self {
+        Self {
+            rx_origin: ray.origin,
+            rx_direction: ray.direction,
+            ry_origin: ray.origin,
+            ry_direction: ray.direction,
+        }
+    }
 }
 
 /// The change of surface position and uv per pixel step in x and y.

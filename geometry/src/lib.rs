@@ -40,6 +40,7 @@
 //! - [`bvh::Bvh`] on its own: a BVH over any primitives given by their bounds.
 
 pub mod bvh;
+mod counters;
 mod differentials;
 mod hit;
 mod offset;
@@ -48,6 +49,7 @@ mod ray;
 mod shape_list;
 mod shapes;
 
+pub use counters::{take_counters, CountingGuard, QueryCounters};
 pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceDifferentials};
 pub use hit::Hit;
 pub use offset::{offset_ray_origin, spawn_ray, spawn_ray_to, SHADOW_EPSILON};

@@ -1,3 +1,4 @@
+use crate::counters::{ShadingCounters, TextureCounters};
 use crate::sampling::{DimensionPair, PixelSample, SamplePattern, MAX_JOINT};
 use crate::{Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
@@ -41,8 +42,12 @@ pub struct SampleContext {
     pub rng: Pcg32,
     pub light_points: Vec<Vec2>,
     pub environment_points: Vec<Vec2>,
-    pub shadow_rays: u64,
-    pub reflection_rays: u64,
+    /// What the integrator did so far.
+    pub counters: ShadingCounters,
+    /// Texture lookups by kind and level, counted when `detailed` is set.
+    pub textures: TextureCounters,
+    /// Whether to gather [`Self::textures`] (`--stats`).
+    pub detailed: bool,
 }
 
 impl SampleContext {
@@ -52,8 +57,9 @@ impl SampleContext {
             rng: PixelSample::default().rng(),
             light_points: vec![Vec2::ZERO; light_samples as usize],
             environment_points: vec![Vec2::ZERO; environment_samples as usize],
-            shadow_rays: 0,
-            reflection_rays: 0,
+            counters: ShadingCounters::default(),
+            textures: TextureCounters::default(),
+            detailed: false,
         }
     }
 
@@ -85,6 +91,7 @@ impl DirectIntegrator {
         let Some(hit) = scene.shapes.closest_hit(ray, f32::INFINITY) else {
             return match &scene.environment {
                 Some(env) => {
+                    ctx.counters.environment_lookups += 1;
                     env.radiance(ray.direction.normalize(), diff.angular_width(ray.direction))
                 }
                 None => Vec3::ZERO,
@@ -97,7 +104,13 @@ impl DirectIntegrator {
         };
         let r = material.reflectivity;
         let local = if material.has_local_shading() {
+            if material.uses_footprint() {
+                ctx.counters.footprints += 1;
+            }
             let tc = texture_footprint(material, &hit, diff);
+            if ctx.detailed {
+                ctx.textures.record(material, &tc);
+            }
             let point = ShadingPoint::new(&hit, material, ray, &tc);
             self.shade(scene, &point, depth, ctx)
         } else {
@@ -107,7 +120,7 @@ impl DirectIntegrator {
             let surface = hit.differentials(diff);
             let (wi, reflected_diff) = reflect_differential(&hit, ray.direction, diff, &surface);
             let reflected = spawn_ray(&hit, wi);
-            ctx.reflection_rays += 1;
+            ctx.counters.reflection_rays += 1;
             material.mirror_tint * self.li(scene, &reflected, &reflected_diff, depth + 1, ctx)
         } else {
             Vec3::ZERO
@@ -180,10 +193,13 @@ impl DirectIntegrator {
             Occluders::ALL
         };
         let mut sum = Vec3::ZERO;
+        ctx.counters.light_samples += samples.len() as u64;
         for &u in &samples {
             let position = light.sample_point(u);
             if light.illuminates(position, point.hit.point) {
                 sum += point.unoccluded_reflection(scene, position, &occluders, ctx);
+            } else {
+                ctx.counters.skipped_behind_light += 1;
             }
         }
         ctx.light_points = samples;
@@ -215,15 +231,15 @@ impl DirectIntegrator {
                 continue;
             }
             if !point.above_surface(s.direction) {
+                ctx.counters.skipped_behind_surface += 1;
                 continue;
             }
-            let f = point
-                .material
-                .brdf_cos(point.kd, point.ks, point.n, s.direction, point.v);
+            let f = point.brdf_cos(s.direction, ctx);
             if f == Vec3::ZERO {
+                ctx.counters.skipped_zero_brdf += 1;
                 continue;
             }
-            ctx.shadow_rays += 1;
+            ctx.counters.environment_shadow_rays += 1;
             if !scene
                 .shapes
                 .any_hit(&spawn_ray(point.hit, s.direction), f32::INFINITY)
@@ -265,6 +281,8 @@ struct ShadingPoint<'a> {
     n: Vec3,
     ng: Vec3,
     v: Vec3,
+    /// Whether `ks` is nonzero: without it the specular lobe is never evaluated.
+    has_specular: bool,
 }
 
 impl<'a> ShadingPoint<'a> {
@@ -285,6 +303,7 @@ impl<'a> ShadingPoint<'a> {
             n,
             ng,
             v: -ray.direction.normalize(),
+            has_specular: ks != Vec3::ZERO,
         }
     }
 
@@ -296,6 +315,18 @@ impl<'a> ShadingPoint<'a> {
     #[inline]
     fn above_surface(&self, l: Vec3) -> bool {
         self.ng.dot(l) > 0.0
+    }
+
+    /// The BRDF times the cosine for light from direction `l`: the specular
+    /// lobe only where `ks` is nonzero.
+    #[inline]
+    fn brdf_cos(&self, l: Vec3, ctx: &mut SampleContext) -> Vec3 {
+        if self.has_specular {
+            ctx.counters.specular_lobes += 1;
+            self.material.brdf_cos(self.kd, self.ks, self.n, l, self.v)
+        } else {
+            self.material.brdf_cos_diffuse(self.kd, self.n, l)
+        }
     }
 }
 
@@ -314,14 +345,21 @@ impl ShadingPoint<'_> {
             return Vec3::ZERO;
         };
         if !self.above_surface(l) {
+            ctx.counters.skipped_behind_surface += 1;
             return Vec3::ZERO;
         }
-        let reflected = self.material.reflect(self.kd, self.ks, self.n, l, self.v);
+        let reflected = if self.has_specular {
+            ctx.counters.specular_lobes += 1;
+            self.material.reflect(self.kd, self.ks, self.n, l, self.v)
+        } else {
+            self.material.reflect_diffuse(self.kd, self.n, l)
+        };
         if reflected == Vec3::ZERO {
+            ctx.counters.skipped_zero_brdf += 1;
             return Vec3::ZERO;
         }
         let (shadow, t_max) = spawn_ray_to(self.hit, position);
-        ctx.shadow_rays += 1;
+        ctx.counters.light_shadow_rays += 1;
         if scene.shapes.any_hit_among(occluders, &shadow, t_max) {
             Vec3::ZERO
         } else {

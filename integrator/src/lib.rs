@@ -27,12 +27,14 @@
 //!   [`Aov`]: buffers other than radiance.
 
 mod aov;
+pub mod counters;
 mod direct;
 mod render;
 pub mod sampling;
 mod scene;
 
 pub use aov::Aov;
+pub use counters::{LookupKind, ShadingCounters, TextureCounters};
 pub use direct::{DirectIntegrator, SampleContext};
 pub use render::{
     camera_ray, render, RenderOutput, RenderSettings, RenderStats, SampleCount, SettingsError,

@@ -1,9 +1,10 @@
+use crate::counters::{ShadingCounters, TextureCounters};
 use crate::direct::SampleContext;
 use crate::sampling::{pixel_rng, SamplePattern, SobolPoints, PIXEL_STREAM};
 use crate::{Aov, DirectIntegrator, Scene};
 use glam::{Vec2, Vec3};
 use glint_camera::{Camera, Film};
-use glint_geometry::{Ray, RayDifferential};
+use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -45,6 +46,9 @@ pub struct RenderSettings {
     /// Where in [0, 1)² the environment samples fall before they are mapped to
     /// directions.
     pub environment_pattern: SamplePattern,
+    /// Gather the detailed counts of [`RenderStats`] (intersection tests, BVH
+    /// visits, texture lookups by level); the image is the same either way.
+    pub stats: bool,
 }
 
 impl Default for RenderSettings {
@@ -60,6 +64,7 @@ impl Default for RenderSettings {
             max_depth: 4,
             environment_samples: 16,
             environment_pattern: SamplePattern::Sobol,
+            stats: false,
         }
     }
 }
@@ -145,9 +150,33 @@ impl RenderSettings {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderStats {
     pub camera_rays: u64,
+    /// Shadow rays of every kind (to lights and to environment samples).
     pub shadow_rays: u64,
     pub reflection_rays: u64,
+    /// The integrator's counts by kind, skips and drops.
+    pub shading: ShadingCounters,
+    /// Intersection work: BVH visits and tests by shape (with `stats` only).
+    pub queries: QueryCounters,
+    /// Texture lookups by kind and MIP level (with `stats` only).
+    pub textures: TextureCounters,
     pub elapsed: Duration,
+}
+
+/// What one tile's worker counted.
+#[derive(Clone, Copy, Debug, Default)]
+struct TileCounts {
+    shading: ShadingCounters,
+    queries: QueryCounters,
+    textures: TextureCounters,
+}
+
+impl TileCounts {
+    fn add(mut self, other: TileCounts) -> TileCounts {
+        self.shading += other.shading;
+        self.queries += other.queries;
+        self.textures += other.textures;
+        self
+    }
 }
 
 impl RenderStats {
@@ -207,41 +236,54 @@ fn render_on_current_pool(
     let band = (TILE_SIZE * resolution.x) as usize;
     let total = film.pixels().len().div_ceil(band);
     let done = AtomicUsize::new(0);
-    let (shadow_rays, reflection_rays) = film
+    let _counting = settings.stats.then(CountingGuard::start);
+    let counts = film
         .pixels_mut()
         .par_chunks_mut(band)
         .enumerate()
         .map(|(i, pixels)| {
             let first_row = i as u32 * TILE_SIZE;
-            let rays = render_rows(scene, settings, &integrator, first_row, pixels);
+            let counts = render_rows(scene, settings, &integrator, first_row, pixels);
             on_tile_done(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-            rays
+            counts
         })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        .reduce(TileCounts::default, TileCounts::add);
+    let shading = counts.shading;
     let stats = RenderStats {
         camera_rays: resolution.x as u64 * resolution.y as u64 * settings.spp as u64,
-        shadow_rays,
-        reflection_rays,
+        shadow_rays: shading.light_shadow_rays + shading.environment_shadow_rays,
+        reflection_rays: shading.reflection_rays,
+        shading,
+        queries: counts.queries,
+        textures: counts.textures,
         elapsed: start.elapsed(),
     };
     RenderOutput { film, stats }
 }
 
 /// Renders the rows starting at `first_row` into `pixels` (whole rows, row-major);
-/// returns the numbers of shadow and reflection rays traced.
+/// returns what it counted. A camera sample whose radiance is NaN or infinite
+/// is left out of its pixel (counted in `nonfinite_samples`): one bad sample
+/// would otherwise blot out the pixel.
 fn render_rows(
     scene: &Scene,
     settings: &RenderSettings,
     integrator: &DirectIntegrator,
     first_row: u32,
     pixels: &mut [Vec3],
-) -> (u64, u64) {
+) -> TileCounts {
+    if settings.stats {
+        // Drop what other work on this thread counted: the tile's counts are its own.
+        let _ = take_counters();
+    }
     let width = scene.camera.resolution().x;
     let mut pixel_samples = vec![Vec2::ZERO; settings.spp as usize];
     let mut ctx = SampleContext::new(settings.light_samples, settings.environment_samples);
+    ctx.detailed = settings.stats;
     // Each of spp samples stands for 1/√spp of the pixel's width (pbrt-v4 scales
     // differentials the same way, never below 1/8).
     let footprint_scale = (1.0 / (settings.spp as f32).sqrt()).max(0.125);
+    let differentials = scene.needs_differentials();
     for (offset, radiance) in pixels.iter_mut().enumerate() {
         let (x, y) = (offset as u32 % width, first_row + offset as u32 / width);
         let pixel = y as u64 * width as u64 + x as u64;
@@ -254,15 +296,34 @@ fn render_rows(
         for (sample, jitter) in pixel_samples.iter().enumerate() {
             ctx.begin_sample(settings.seed, pixel, sample as u64);
             let raster = Vec2::new(x as f32, y as f32) + *jitter;
-            let (ray, diff) = camera_ray(&scene.camera, raster, footprint_scale);
-            sum += match settings.aov {
+            let (ray, diff) = if differentials {
+                camera_ray(&scene.camera, raster, footprint_scale)
+            } else {
+                let c = scene.camera.generate_ray(raster.x, raster.y);
+                let ray = Ray::new(c.origin, c.direction);
+                (ray, RayDifferential::none(&ray))
+            };
+            let value = match settings.aov {
                 None => integrator.li(scene, &ray, &diff, 0, &mut ctx),
                 Some(aov) => aov.evaluate(scene, &ray, &diff, settings.max_depth),
             };
+            if value.is_finite() {
+                sum += value;
+            } else {
+                ctx.counters.nonfinite_samples += 1;
+            }
         }
         *radiance = sum / settings.spp as f32;
     }
-    (ctx.shadow_rays, ctx.reflection_rays)
+    TileCounts {
+        shading: ctx.counters,
+        queries: if settings.stats {
+            take_counters()
+        } else {
+            QueryCounters::default()
+        },
+        textures: ctx.textures,
+    }
 }
 
 /// The camera ray through `raster`, with its differentials shrunk to `scale`

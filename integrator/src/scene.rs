@@ -44,6 +44,13 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Whether anything reads a ray's differentials: a material whose textures
+    /// filter over a footprint, or the environment (filtered by the ray's
+    /// angular width). Without either, camera rays are made without them.
+    pub fn needs_differentials(&self) -> bool {
+        self.environment.is_some() || self.materials.iter().any(PhongMaterial::uses_footprint)
+    }
+
     /// The material or light at `hit`.
     #[inline]
     pub fn surface_of(&self, hit: &Hit) -> SurfaceKind<'_> {

@@ -111,6 +111,16 @@ impl PhongMaterial {
             * n_dot_l
     }
 
+    /// [`Self::brdf_cos`] for `ks = 0`, without the specular lobe: the same value.
+    #[inline]
+    pub fn brdf_cos_diffuse(&self, kd: Vec3, n: Vec3, l: Vec3) -> Vec3 {
+        let n_dot_l = n.dot(l);
+        if n_dot_l <= 0.0 {
+            return Vec3::ZERO;
+        }
+        kd * std::f32::consts::FRAC_1_PI * n_dot_l
+    }
+
     /// `(kd, ks)` filtered over the footprint `tc` (surface uv and its derivatives).
     #[inline]
     pub fn reflectances(&self, tc: &TexCoord) -> (Vec3, Vec3) {
@@ -143,6 +153,17 @@ impl PhongMaterial {
             return Vec3::ZERO;
         }
         kd * n_dot_l + ks * self.specular_lobe(n, l, v, n_dot_l)
+    }
+
+    /// [`Self::reflect`] for `ks = 0`, without the specular lobe: the same value
+    /// (`kd · n·l`; the lobe's `0 · lobe` adds nothing).
+    #[inline]
+    pub fn reflect_diffuse(&self, kd: Vec3, n: Vec3, l: Vec3) -> Vec3 {
+        let n_dot_l = n.dot(l);
+        if n_dot_l <= 0.0 {
+            return Vec3::ZERO;
+        }
+        kd * n_dot_l
     }
 
     /// The scalar specular lobe for unit `n`, `l`, `v`.

@@ -16,9 +16,10 @@ use glint_texture::{
     load_image, Checkerboard, CubeMap, Environment, Image, ImageTexture, LatLongMap, Texture,
     TextureImage, MAX_IMAGE_TEXELS,
 };
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use toml::Spanned;
 
@@ -35,14 +36,32 @@ pub struct SceneDescription {
     /// The file's `[regions]`: names and `[x0, y0, x1, y1]` pixel rectangles of
     /// the render resolution, sorted by name.
     pub regions: Vec<(String, [u32; 4])>,
+    /// How long loading took, by phase.
+    pub timings: LoadTimings,
+}
+
+/// Time spent loading a scene, by phase.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LoadTimings {
+    /// Reading the TOML and checking every value.
+    pub parse: Duration,
+    /// Reading images, environment maps and meshes.
+    pub assets: Duration,
+    /// Building the BVH (or the linear loop's packets).
+    pub acceleration: Duration,
 }
 
 pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription, Problem> {
+    let start = Instant::now();
+    let mut asset_time = Duration::ZERO;
     let settings = settings(&file.render)?;
     let camera = camera(&file.camera, file.render.resolution.0)?;
     let regions = regions(&file)?;
     let mut assets = Vec::new();
-    let textures = textures(&file.textures, base_dir, &mut assets)?;
+    let clock = Instant::now();
+    let referenced = referenced_textures(&file.materials);
+    let textures = textures(&file.textures, &referenced, base_dir, &mut assets)?;
+    asset_time += clock.elapsed();
     let mut builder = SceneBuilder::new();
     let mut extra_material_names = Vec::new();
     let mut material_ids = BTreeMap::new();
@@ -147,8 +166,10 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
             .as_ref()
             .map(|name| lookup(format!("{field}.material"), name))
             .transpose()?;
+        let clock = Instant::now();
         let obj = load_obj(&base_dir.join(m.file.get_ref()), material.is_none())
             .map_err(|e| Problem::new(m.file.span(), format!("{field}.file"), e))?;
+        asset_time += clock.elapsed();
         assets.extend(obj.files.iter().cloned());
         let triangle_materials: Vec<u32> = match material {
             Some(id) => vec![id; obj.indices.len()],
@@ -224,11 +245,15 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
     }
     builder.ambient(file.ambient.0);
     if let Some(env) = &file.environment {
+        let clock = Instant::now();
         builder.environment(environment(env, base_dir, &mut assets)?);
+        asset_time += clock.elapsed();
     }
+    let clock = Instant::now();
     let scene = builder
         .build(camera)
         .expect("material ids were resolved above");
+    let acceleration = clock.elapsed();
     let material_names = file
         .materials
         .keys()
@@ -243,7 +268,27 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         material_names,
         assets,
         regions,
+        timings: LoadTimings {
+            parse: start.elapsed().saturating_sub(asset_time + acceleration),
+            assets: asset_time,
+            acceleration,
+        },
     })
+}
+
+/// The names of the textures some material reads: only those are loaded (an
+/// image nothing references is neither read nor checked).
+fn referenced_textures(materials: &BTreeMap<String, Spanned<MaterialTable>>) -> BTreeSet<&str> {
+    materials
+        .values()
+        .map(Spanned::get_ref)
+        .flat_map(|m| [m.diffuse.as_ref(), m.specular.as_ref()])
+        .flatten()
+        .filter_map(|value| match value.get_ref() {
+            ColorOrTexture::Texture(name) => Some(name.as_str()),
+            ColorOrTexture::Color(_) => None,
+        })
+        .collect()
 }
 
 /// The `[regions]` table: each a non-empty rectangle inside the render resolution.
@@ -312,6 +357,7 @@ fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> {
         max_depth: *render.max_depth.get_ref(),
         environment_samples: *render.environment_samples.get_ref(),
         environment_pattern: render.environment_sampler.get_ref().0,
+        stats: false,
     };
     settings.validate().map_err(|e| {
         // Point at the count if the file set it, else at its sampler.
@@ -370,12 +416,18 @@ fn camera(c: &CameraTable, resolution: glam::UVec2) -> Result<Camera, Problem> {
 /// Every named texture, with image files read from `base_dir` once each.
 fn textures<'a>(
     tables: &'a BTreeMap<String, TextureTable>,
+    referenced: &BTreeSet<&str>,
     base_dir: &Path,
     assets: &mut Vec<PathBuf>,
 ) -> Result<BTreeMap<&'a str, Texture>, Problem> {
     let mut images: HashMap<PathBuf, Arc<TextureImage>> = HashMap::new();
     let mut textures = BTreeMap::new();
     for (name, table) in tables {
+        if !referenced.contains(name.as_str()) {
+            // Kept by name only, for the list of known names in errors.
+            textures.insert(name.as_str(), Texture::Constant(Vec3::ZERO));
+            continue;
+        }
         let texture = match table {
             TextureTable::Checkerboard(c) => Texture::Checkerboard(Checkerboard {
                 analytic: c.filter.0,

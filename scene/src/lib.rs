@@ -26,7 +26,7 @@ mod format;
 mod obj;
 mod values;
 
-pub use build::SceneDescription;
+pub use build::{LoadTimings, SceneDescription};
 pub use error::SceneError;
 pub use values::{parse_resolution_parts, MAX_RESOLUTION};
 
@@ -51,6 +51,7 @@ pub fn parse(source: &str, file: &str) -> Result<SceneDescription, SceneError> {
 
 /// Parses and validates scene text whose asset paths are relative to `base_dir`.
 pub fn parse_in(source: &str, file: &str, base_dir: &Path) -> Result<SceneDescription, SceneError> {
+    let start = std::time::Instant::now();
     let deserializer = toml::de::Deserializer::parse(source)
         .map_err(|e| error::invalid(file, source, e.span(), None, e.message()))?;
     let scene_file: format::SceneFile =
@@ -64,8 +65,11 @@ pub fn parse_in(source: &str, file: &str, base_dir: &Path) -> Result<SceneDescri
             let inner = e.into_inner();
             error::invalid(file, source, inner.span(), field, inner.message())
         })?;
-    build::build(scene_file, base_dir)
-        .map_err(|p| error::invalid(file, source, Some(p.span), Some(p.field), &p.message))
+    let read = start.elapsed();
+    let mut description = build::build(scene_file, base_dir)
+        .map_err(|p| error::invalid(file, source, Some(p.span), Some(p.field), &p.message))?;
+    description.timings.parse += read;
+    Ok(description)
 }
 
 #[cfg(doctest)]

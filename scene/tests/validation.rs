@@ -53,11 +53,11 @@ fn each_kind_of_bad_input_has_its_own_message() {
         ("unknown lobe", format!("{CAMERA}[materials.m]\ndiffuse = [1, 1, 1]\nlobe = \"cook-torrance\"\n")),
         ("negative shininess", format!("{CAMERA}[materials.m]\ndiffuse = [1, 1, 1]\nshininess = -2\n")),
         ("unknown texture kind", format!("{CAMERA}[textures.t.marble]\nscale = 1\n")),
-        ("missing image file", format!("{CAMERA}[textures.t.image]\nfile = \"no/such/image.png\"\n")),
+        ("missing image file", format!("{CAMERA}[textures.t.image]\nfile = \"no/such/image.png\"\n[materials.m]\ndiffuse = \"t\"\n")),
         ("unknown image filter", format!("{CAMERA}[textures.t.image]\nfile = \"x.png\"\nfilter = \"cubic\"\n")),
         ("unknown wrap mode", format!("{CAMERA}[textures.t.image]\nfile = \"x.png\"\nwrap = \"border\"\n")),
         ("unknown checker filter", format!("{CAMERA}[textures.t.checkerboard]\ncolors = [[0, 0, 0], [1, 1, 1]]\nchecks = 4\nfilter = \"trilinear\"\n")),
-        ("checker image too large", format!("{CAMERA}[textures.t.checker_image]\ncolors = [[0, 0, 0], [1, 1, 1]]\nchecks = 1000\npixels_per_check = 32\n")),
+        ("checker image too large", format!("{CAMERA}[textures.t.checker_image]\ncolors = [[0, 0, 0], [1, 1, 1]]\nchecks = 1000\npixels_per_check = 32\n[materials.m]\ndiffuse = \"t\"\n")),
         ("zero uv scale", format!("{CAMERA}[materials.m]\ndiffuse = [1, 1, 1]\nuv_scale = [0, 1]\n")),
         ("environment with two sources", format!("{CAMERA}[environment]\ncolor = [1, 1, 1]\nlatlong = \"sky.hdr\"\n")),
         ("environment with no source", format!("{CAMERA}[environment]\nintensity = 2\n")),
@@ -199,6 +199,29 @@ fn image_paths_are_relative_to_the_scene_file_and_loaded_once() {
     // The file read, listed once, for callers that fingerprint a scene's inputs.
     assert_eq!(d.assets.len(), 1, "{:?}", d.assets);
     assert!(d.assets[0].ends_with("tex/orange.png"), "{:?}", d.assets);
+}
+
+#[test]
+fn textures_no_material_reads_are_not_loaded() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 255, 255]))
+        .save(dir.path().join("used.png"))
+        .unwrap();
+    let scene = format!(
+        "{CAMERA}[textures.used.image]\nfile = \"used.png\"\n\
+         [textures.unused.image]\nfile = \"missing.png\"\n\
+         [materials.m]\ndiffuse = \"used\"\n"
+    );
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let d = glint_scene::load(&path).unwrap();
+    assert_eq!(d.assets.len(), 1, "{:?}", d.assets);
+    assert!(d.assets[0].ends_with("used.png"));
+    // Referenced, the missing file is an error naming the field.
+    let e = error_of(&format!(
+        "{CAMERA}[textures.t.image]\nfile = \"missing.png\"\n[materials.m]\ndiffuse = \"t\"\n"
+    ));
+    assert!(e.contains("textures.t.image.file"), "{e}");
 }
 
 #[test]

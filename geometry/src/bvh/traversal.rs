@@ -6,6 +6,7 @@ use super::prepared_ray::PreparedRay;
 use super::traversal_stack::TraversalStack;
 use super::wide::{self, Link};
 use super::Bvh;
+use crate::counters::count;
 use crate::prefetch::prefetch;
 use crate::Ray;
 use std::cell::RefCell;
@@ -149,9 +150,11 @@ impl Bvh {
         read_ahead: impl FnOnce(&wide::WideNode, u32),
     ) -> ControlFlow<(), Option<Link>> {
         if link.is_leaf() {
+            count(|c| c.bvh_leaves += 1);
             *t_max = visit_leaf(link, *t_max)?;
             return ControlFlow::Continue(stack.pop_before(*t_max));
         }
+        count(|c| c.bvh_nodes += 1);
         let node = &self.tree.nodes[link.node()];
         ControlFlow::Continue(match ray.enters(node, *t_max) {
             (0, _) => stack.pop_before(*t_max),

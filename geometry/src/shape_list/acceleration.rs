@@ -4,6 +4,7 @@
 
 use super::{LinearShapes, Object, Primitive, ShapeList};
 use crate::bvh::{Bounds3, Bvh, BvhStats, LEAF_WIDTH};
+use crate::counters::count;
 use crate::triangle::WatertightRay;
 use crate::{Ray, TrianglePacket};
 use glam::Vec4;
@@ -111,8 +112,11 @@ impl ShapeList {
         t_max: f32,
     ) -> (u32, Vec4) {
         let leaf = first as usize / LEAF_WIDTH;
-        let (mut hits, mut t) = watertight.intersect4(&self.packets[leaf], t_max);
         let mut shapes = self.shape_lanes[leaf];
+        if shapes != 0xf {
+            count(|c| c.triangle_tests += 4);
+        }
+        let (mut hits, mut t) = watertight.intersect4(&self.packets[leaf], t_max);
         while shapes != 0 {
             let lane = shapes.trailing_zeros() as usize;
             shapes &= shapes - 1;

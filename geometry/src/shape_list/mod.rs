@@ -19,6 +19,7 @@ pub use closest::PrimitiveHit;
 pub use occluders::Occluders;
 
 use crate::bvh::Bvh;
+use crate::counters::count;
 use crate::triangle::WatertightRay;
 use crate::{Ray, Shape, TriangleMesh, TrianglePacket};
 use linear::LinearShapes;
@@ -177,7 +178,10 @@ impl ShapeList {
     ) -> Option<f32> {
         match self.objects[p.object as usize] {
             Object::Shape(s) => self.shapes[s as usize].hit_distance(ray, t_max),
-            Object::Mesh(m) => self.meshes[m as usize].hit_distance(p.triangle, watertight, t_max),
+            Object::Mesh(m) => {
+                count(|c| c.triangle_tests += 1);
+                self.meshes[m as usize].hit_distance(p.triangle, watertight, t_max)
+            }
         }
     }
 }

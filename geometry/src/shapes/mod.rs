@@ -25,6 +25,7 @@ pub use sphere::Sphere;
 pub use triangle_packet::TrianglePacket;
 
 use crate::bvh::Bounds3;
+use crate::counters::count;
 use crate::{Hit, Ray};
 
 /// Every kind of shape, as one enum so intersection dispatch is a `match`,
@@ -41,6 +42,12 @@ impl Shape {
     /// The ray parameter of the nearest hit in (0, t_max), without building a [`Hit`].
     #[inline]
     pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        count(|c| match self {
+            Shape::Sphere(_) => c.sphere_tests += 1,
+            Shape::Parallelogram(_) => c.parallelogram_tests += 1,
+            Shape::Plane(_) => c.plane_tests += 1,
+            Shape::Box(_) => c.box_tests += 1,
+        });
         match self {
             Shape::Sphere(s) => s.hit_distance(ray, t_max),
             Shape::Parallelogram(p) => p.hit_distance(ray, t_max),

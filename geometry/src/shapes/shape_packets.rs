@@ -11,6 +11,7 @@
 //! distance are bit for bit the scalar test's, and a caller may mix the two.
 
 use super::{Parallelogram, Sphere};
+use crate::counters::count;
 use crate::Ray;
 use glam::{BVec4A, Vec3, Vec4};
 
@@ -61,6 +62,8 @@ pub struct SpherePacket {
     center: [Vec4; 3],
     /// `radius²`, rounded as the scalar test rounds it.
     radius2: Vec4,
+    /// Lanes in use.
+    used: u32,
 }
 
 impl SpherePacket {
@@ -68,12 +71,14 @@ impl SpherePacket {
     pub const EMPTY: SpherePacket = SpherePacket {
         center: [Vec4::NAN; 3],
         radius2: Vec4::NAN,
+        used: 0,
     };
 
     /// Puts `sphere` in `lane` (0..4).
     pub fn set_lane(&mut self, lane: usize, sphere: &Sphere) {
         set(&mut self.center, lane, sphere.center);
         self.radius2[lane] = sphere.radius * sphere.radius;
+        self.used = self.used.max(lane as u32 + 1);
     }
 
     /// The scalar test of each lane: bit k of the mask is set iff
@@ -85,6 +90,7 @@ impl SpherePacket {
     /// and `q/a` with `q = −(b + sign(b)·√disc)`, the nearer one in (0, t_max) first.
     #[inline]
     pub fn hit4(&self, ray: &Ray, t_max: f32) -> (u32, Vec4) {
+        count(|c| c.sphere_tests += u64::from(self.used));
         let d = splat(ray.direction);
         let f = sub(splat(ray.origin), self.center);
         let b = dot(f, d);
@@ -127,6 +133,8 @@ pub struct ParallelogramPacket {
     w: [Vec4; 3],
     /// Lanes seen from their front side only.
     one_sided: BVec4A,
+    /// Lanes in use.
+    used: u32,
 }
 
 impl ParallelogramPacket {
@@ -138,6 +146,7 @@ impl ParallelogramPacket {
         normal: [Vec4::NAN; 3],
         w: [Vec4::NAN; 3],
         one_sided: BVec4A::FALSE,
+        used: 0,
     };
 
     /// Puts `p` in `lane` (0..4).
@@ -148,6 +157,7 @@ impl ParallelogramPacket {
         set(&mut self.normal, lane, p.normal);
         set(&mut self.w, lane, p.w);
         self.one_sided.set(lane, !p.two_sided);
+        self.used = self.used.max(lane as u32 + 1);
     }
 
     /// The scalar test of each lane, as [`SpherePacket::hit4`] for spheres: the
@@ -155,6 +165,7 @@ impl ParallelogramPacket {
     /// coordinates `α = w·((p − p₀) × e₂)`, `β = w·(e₁ × (p − p₀))` in [0, 1].
     #[inline]
     pub fn hit4(&self, ray: &Ray, t_max: f32) -> (u32, Vec4) {
+        count(|c| c.parallelogram_tests += u64::from(self.used));
         let zero = Vec4::ZERO;
         let one = Vec4::ONE;
         let d = splat(ray.direction);

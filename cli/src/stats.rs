@@ -1,0 +1,201 @@
+//! `glint render --stats` and `--stats-json`: what a render did, as a table on
+//! standard output and as a JSON document (schema in docs/command-line.md).
+
+use glint_integrator::{LookupKind, RenderStats, Scene};
+use glint_scene::LoadTimings;
+use glint_texture::Texture;
+use serde_json::{json, Value};
+use std::time::Duration;
+
+/// Everything `--stats` reports.
+pub(crate) struct StatsReport<'a> {
+    pub stats: &'a RenderStats,
+    pub scene: &'a Scene,
+    pub load: LoadTimings,
+    pub write: Duration,
+}
+
+impl StatsReport<'_> {
+    /// The report as JSON.
+    pub(crate) fn to_json(&self) -> Value {
+        let s = self.stats;
+        let sh = &s.shading;
+        let q = &s.queries;
+        let textures: serde_json::Map<String, Value> = LookupKind::ALL
+            .iter()
+            .enumerate()
+            .filter(|(_, k)| s.textures.total(**k) > 0)
+            .map(|(i, k)| {
+                let levels = s.textures.lookups[i];
+                let last = levels.iter().rposition(|&n| n > 0).unwrap_or(0);
+                (k.name().to_string(), json!(levels[..=last]))
+            })
+            .collect();
+        let (images, pyramids) = self.pyramids();
+        json!({
+            "rays": {
+                "camera": s.camera_rays,
+                "shadow_to_lights": sh.light_shadow_rays,
+                "shadow_to_environment": sh.environment_shadow_rays,
+                "reflection": sh.reflection_rays,
+                "environment_lookups": sh.environment_lookups,
+            },
+            "light_samples": sh.light_samples,
+            "shadow_rays_skipped": {
+                "behind_surface": sh.skipped_behind_surface,
+                "behind_light": sh.skipped_behind_light,
+                "zero_brdf": sh.skipped_zero_brdf,
+            },
+            "specular_lobes": sh.specular_lobes,
+            "texture_footprints": sh.footprints,
+            "nonfinite_samples_dropped": sh.nonfinite_samples,
+            "intersection_tests": {
+                "sphere": q.sphere_tests,
+                "parallelogram": q.parallelogram_tests,
+                "plane": q.plane_tests,
+                "box": q.box_tests,
+                "triangle": q.triangle_tests,
+            },
+            "bvh": {
+                "built": self.scene.shapes.bvh_stats().is_some(),
+                "nodes_visited": q.bvh_nodes,
+                "leaves_visited": q.bvh_leaves,
+            },
+            "texture_lookups_by_level": textures,
+            "mip_pyramids": { "image_textures": images, "built": pyramids },
+            "seconds": {
+                "parse": self.load.parse.as_secs_f64(),
+                "load_assets": self.load.assets.as_secs_f64(),
+                "build_acceleration": self.load.acceleration.as_secs_f64(),
+                "render": s.elapsed.as_secs_f64(),
+                "write": self.write.as_secs_f64(),
+            },
+            "peak_memory_bytes": peak_memory_bytes(),
+        })
+    }
+
+    /// The report as a table.
+    pub(crate) fn to_text(&self) -> String {
+        let s = self.stats;
+        let sh = &s.shading;
+        let q = &s.queries;
+        let rays = s.camera_rays + s.shadow_rays + s.reflection_rays;
+        let per_ray = |n: u64| n as f64 / rays.max(1) as f64;
+        let mut lines = vec![
+            "render statistics".to_string(),
+            format!(
+                "  rays            {} camera, {} shadow to lights, {} shadow to the environment, {} reflection",
+                s.camera_rays, sh.light_shadow_rays, sh.environment_shadow_rays, sh.reflection_rays
+            ),
+            format!(
+                "                  {} environment lookups by rays leaving the scene",
+                sh.environment_lookups
+            ),
+            format!(
+                "  light samples   {} on area lights; no shadow ray for {} (light below the surface), {} (surface behind the light), {} (zero BRDF)",
+                sh.light_samples, sh.skipped_behind_surface, sh.skipped_behind_light, sh.skipped_zero_brdf
+            ),
+            format!(
+                "  shading         {} specular lobes, {} texture footprints, {} NaN/Inf samples dropped",
+                sh.specular_lobes, sh.footprints, sh.nonfinite_samples
+            ),
+            format!(
+                "  tests           {} sphere, {} parallelogram, {} plane, {} box, {} triangle ({:.2} per ray)",
+                q.sphere_tests,
+                q.parallelogram_tests,
+                q.plane_tests,
+                q.box_tests,
+                q.triangle_tests,
+                per_ray(q.shape_tests())
+            ),
+        ];
+        lines.push(match self.scene.shapes.bvh_stats() {
+            Some(_) => format!(
+                "  BVH             {} nodes, {} leaves visited ({:.2} and {:.2} per ray)",
+                q.bvh_nodes,
+                q.bvh_leaves,
+                per_ray(q.bvh_nodes),
+                per_ray(q.bvh_leaves)
+            ),
+            None => "  BVH             none (the linear loop: a handful of shapes)".to_string(),
+        });
+        let mut textures = Vec::new();
+        for (i, kind) in LookupKind::ALL.iter().enumerate() {
+            let levels = s.textures.lookups[i];
+            if levels.iter().all(|&n| n == 0) {
+                continue;
+            }
+            let last = levels.iter().rposition(|&n| n > 0).unwrap_or(0);
+            let by_level: Vec<String> = levels[..=last]
+                .iter()
+                .enumerate()
+                .map(|(l, n)| format!("L{l} {n}"))
+                .collect();
+            textures.push(format!("{} ({})", kind.name(), by_level.join(", ")));
+        }
+        let (images, pyramids) = self.pyramids();
+        lines.push(format!(
+            "  textures        {}; MIP pyramids built for {pyramids} of {images} image textures",
+            if textures.is_empty() {
+                "no lookups".to_string()
+            } else {
+                textures.join("; ")
+            }
+        ));
+        lines.push(format!(
+            "  time            parse {}, load assets {}, build acceleration {}, render {}, write {}",
+            seconds(self.load.parse),
+            seconds(self.load.assets),
+            seconds(self.load.acceleration),
+            seconds(s.elapsed),
+            seconds(self.write)
+        ));
+        lines.push(match peak_memory_bytes() {
+            Some(bytes) => format!("  peak memory     {:.1} MiB", bytes as f64 / 1048576.0),
+            None => "  peak memory     unknown on this system".to_string(),
+        });
+        lines.join("\n")
+    }
+
+    /// Image textures the materials use, and how many of them built a pyramid.
+    fn pyramids(&self) -> (usize, usize) {
+        let images: Vec<_> = self
+            .scene
+            .materials
+            .iter()
+            .flat_map(|m| std::iter::once(&m.diffuse).chain(m.specular.as_ref()))
+            .filter_map(|t| match t {
+                Texture::Image(i) => Some(std::sync::Arc::as_ptr(&i.image)),
+                _ => None,
+            })
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        let built = self
+            .scene
+            .materials
+            .iter()
+            .flat_map(|m| std::iter::once(&m.diffuse).chain(m.specular.as_ref()))
+            .filter_map(|t| match t {
+                Texture::Image(i) if i.image.has_pyramid() => {
+                    Some(std::sync::Arc::as_ptr(&i.image))
+                }
+                _ => None,
+            })
+            .collect::<std::collections::BTreeSet<_>>()
+            .len();
+        (images.len(), built)
+    }
+}
+
+fn seconds(d: Duration) -> String {
+    format!("{:.3} s", d.as_secs_f64())
+}
+
+/// The process's peak resident memory (Linux: `VmHWM` of /proc/self/status).
+pub(crate) fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}

@@ -1,0 +1,283 @@
+//! What a scene doesn't need, the renderer doesn't do: each skip shown by a zero
+//! in the render's counts (`glint render --stats`), beside a scene that does need
+//! the work and counts it.
+
+use glam::{UVec2, Vec2, Vec3};
+use glint_camera::Camera;
+use glint_geometry::{Parallelogram, Plane, Sphere, TriangleMesh};
+use glint_integrator::{render, LookupKind, RenderSettings, RenderStats, Scene, SceneBuilder};
+use glint_lighting::{AreaLight, PhongMaterial, PointLight};
+use glint_texture::{Checkerboard, ImageTexture, Texture, TextureFilter, TextureImage, WrapMode};
+
+fn camera() -> Camera {
+    Camera::new(
+        Vec3::new(0.0, 2.0, 4.0),
+        Vec3::new(0.0, 0.0, -2.0),
+        Vec3::Y,
+        50.0,
+        1.0,
+        UVec2::new(24, 16),
+    )
+    .unwrap()
+}
+
+fn diffuse(kd: Vec3) -> PhongMaterial {
+    PhongMaterial {
+        specular: Some(Texture::Constant(Vec3::ZERO)),
+        ..PhongMaterial::new(kd, 1.0)
+    }
+}
+
+/// A floor and a sphere under a point light, made of `floor` and `ball`.
+fn scene_with(
+    floor: PhongMaterial,
+    ball: PhongMaterial,
+    light: impl FnOnce(&mut SceneBuilder),
+) -> Scene {
+    let mut b = SceneBuilder::new();
+    let f = b.material(floor);
+    let s = b.material(ball);
+    b.shape(Plane::new(Vec3::ZERO, Vec3::Y, false).unwrap(), f)
+        .shape(Sphere::new(Vec3::new(0.0, 0.7, -2.0), 0.7).unwrap(), s);
+    light(&mut b);
+    b.build(camera()).unwrap()
+}
+
+fn point_light(b: &mut SceneBuilder) {
+    b.point_light(PointLight {
+        position: Vec3::new(1.0, 3.0, -1.0),
+        color: Vec3::ONE,
+    });
+}
+
+fn area_light(b: &mut SceneBuilder) {
+    let light = AreaLight::new(Vec3::new(0.0, 3.0, -2.0), Vec3::X, Vec3::Z, Vec3::ONE).unwrap();
+    b.area_light(light.facing(-Vec3::Y));
+}
+
+fn stats_of(scene: &Scene) -> RenderStats {
+    let settings = RenderSettings {
+        spp: 4,
+        light_samples: 4,
+        stats: true,
+        ..RenderSettings::default()
+    };
+    render(scene, &settings, &|_, _| {}).unwrap().stats
+}
+
+fn plain() -> Scene {
+    scene_with(
+        diffuse(Vec3::splat(0.5)),
+        diffuse(Vec3::splat(0.8)),
+        point_light,
+    )
+}
+
+#[test]
+fn a_scene_without_textures_looks_up_none_and_computes_no_footprints() {
+    let stats = stats_of(&plain());
+    assert_eq!(stats.textures.all(), 0);
+    assert_eq!(stats.shading.footprints, 0);
+    // A trilinear image texture on the floor: footprints and pyramid lookups.
+    let image = TextureImage::from_checkerboard(Checkerboard::new(Vec3::ONE, Vec3::ZERO, 8), 4);
+    let textured = PhongMaterial {
+        diffuse: Texture::Image(ImageTexture::new(
+            image,
+            WrapMode::Repeat,
+            TextureFilter::Trilinear,
+        )),
+        ..diffuse(Vec3::ONE)
+    };
+    let stats = stats_of(&scene_with(textured, diffuse(Vec3::ONE), point_light));
+    assert!(stats.textures.total(LookupKind::Trilinear) > 0);
+    assert_eq!(
+        stats.textures.total(LookupKind::Trilinear),
+        stats.shading.footprints
+    );
+}
+
+#[test]
+fn textures_never_filtered_build_no_pyramid() {
+    let image = TextureImage::from_checkerboard(Checkerboard::new(Vec3::ONE, Vec3::ZERO, 8), 4);
+    for (filter, pyramid) in [(TextureFilter::Nearest, false), (TextureFilter::Ewa, true)] {
+        let texture = ImageTexture::new(image.clone(), WrapMode::Repeat, filter);
+        let material = PhongMaterial {
+            diffuse: Texture::Image(texture),
+            ..diffuse(Vec3::ONE)
+        };
+        let stats = stats_of(&scene_with(material, diffuse(Vec3::ONE), point_light));
+        assert!(stats.textures.all() > 0);
+        assert_eq!(image.has_pyramid(), pyramid, "{filter:?}");
+    }
+}
+
+#[test]
+fn no_specular_lobe_where_ks_is_zero() {
+    assert_eq!(stats_of(&plain()).shading.specular_lobes, 0);
+    let shiny = PhongMaterial::new(Vec3::splat(0.5), 20.0);
+    let stats = stats_of(&scene_with(diffuse(Vec3::ONE), shiny, point_light));
+    assert!(stats.shading.specular_lobes > 0);
+}
+
+#[test]
+fn point_lights_take_no_light_samples_and_area_lights_do() {
+    let stats = stats_of(&plain());
+    assert_eq!(stats.shading.light_samples, 0);
+    assert!(stats.shading.light_shadow_rays > 0);
+    let lit = scene_with(diffuse(Vec3::ONE), diffuse(Vec3::ONE), area_light);
+    let stats = stats_of(&lit);
+    // 4 samples per camera sample at every hit that is not the light itself.
+    assert!(stats.shading.light_samples > 0);
+    assert_eq!(stats.shading.light_samples % 4, 0);
+}
+
+#[test]
+fn no_shadow_ray_for_a_light_behind_the_surface_or_a_surface_behind_the_light() {
+    // A light under the floor: every floor sample is skipped, none is traced.
+    let below = |b: &mut SceneBuilder| {
+        b.point_light(PointLight {
+            position: Vec3::new(0.0, -1.0, -2.0),
+            color: Vec3::ONE,
+        });
+    };
+    let mut b = SceneBuilder::new();
+    let m = b.material(diffuse(Vec3::ONE));
+    b.shape(Plane::new(Vec3::ZERO, Vec3::Y, false).unwrap(), m);
+    below(&mut b);
+    let stats = stats_of(&b.build(camera()).unwrap());
+    assert_eq!(stats.shading.light_shadow_rays, 0);
+    assert!(stats.shading.skipped_behind_surface > 0);
+    // An area light facing up, above the floor: the floor is behind it.
+    let mut b = SceneBuilder::new();
+    let m = b.material(diffuse(Vec3::ONE));
+    b.shape(Plane::new(Vec3::ZERO, Vec3::Y, false).unwrap(), m);
+    let light = AreaLight::new(Vec3::new(0.0, 3.0, -2.0), Vec3::X, Vec3::Z, Vec3::ONE).unwrap();
+    b.area_light(light.facing(Vec3::Y));
+    let stats = stats_of(&b.build(camera()).unwrap());
+    assert_eq!(stats.shading.light_shadow_rays, 0);
+    assert_eq!(
+        stats.shading.skipped_behind_light,
+        stats.shading.light_samples
+    );
+}
+
+#[test]
+fn no_environment_work_without_an_environment() {
+    let stats = stats_of(&plain());
+    assert_eq!(stats.shading.environment_lookups, 0);
+    assert_eq!(stats.shading.environment_shadow_rays, 0);
+}
+
+#[test]
+fn no_reflection_rays_without_reflectivity() {
+    assert_eq!(stats_of(&plain()).shading.reflection_rays, 0);
+    let mirror = PhongMaterial::mirror(Vec3::ONE);
+    let stats = stats_of(&scene_with(diffuse(Vec3::ONE), mirror, point_light));
+    assert!(stats.shading.reflection_rays > 0);
+}
+
+#[test]
+fn a_handful_of_shapes_takes_the_linear_loop_and_a_mesh_the_bvh() {
+    let stats = stats_of(&plain());
+    assert_eq!((stats.queries.bvh_nodes, stats.queries.bvh_leaves), (0, 0));
+    assert!(stats.queries.sphere_tests > 0 && stats.queries.plane_tests > 0);
+    // A 16 × 16 grid of quads (512 triangles): through the BVH.
+    let n = 16;
+    let positions: Vec<Vec3> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| Vec3::new(i as f32 / 4.0 - 2.0, 0.0, -(j as f32) / 4.0)))
+        .collect();
+    let indices: Vec<[u32; 3]> = (0..n)
+        .flat_map(|j| {
+            (0..n).flat_map(move |i| {
+                let k = j * (n + 1) + i;
+                [[k, k + 1, k + n + 2], [k, k + n + 2, k + n + 1]]
+            })
+        })
+        .collect();
+    let triangles = indices.len();
+    let mesh = TriangleMesh::new(positions, indices, vec![], Vec::<Vec2>::new()).unwrap();
+    let mut b = SceneBuilder::new();
+    let m = b.material(diffuse(Vec3::ONE));
+    b.mesh(mesh, vec![m; triangles]);
+    point_light(&mut b);
+    let stats = stats_of(&b.build(camera()).unwrap());
+    assert!(stats.queries.bvh_nodes > 0 && stats.queries.bvh_leaves > 0);
+    assert!(stats.queries.triangle_tests > 0);
+    assert_eq!(stats.queries.sphere_tests, 0);
+}
+
+#[test]
+fn counting_changes_no_pixel_and_detailed_counts_wait_for_stats() {
+    let scene = scene_with(
+        diffuse(Vec3::ONE),
+        PhongMaterial::new(Vec3::ONE, 8.0),
+        area_light,
+    );
+    let quiet = RenderSettings {
+        spp: 4,
+        light_samples: 4,
+        ..RenderSettings::default()
+    };
+    let counted = RenderSettings {
+        stats: true,
+        ..quiet.clone()
+    };
+    let a = render(&scene, &quiet, &|_, _| {}).unwrap();
+    let b = render(&scene, &counted, &|_, _| {}).unwrap();
+    assert_eq!(a.film.pixels(), b.film.pixels());
+    assert_eq!(a.stats.shading, b.stats.shading);
+    assert_eq!(a.stats.queries.shape_tests(), 0);
+    assert!(b.stats.queries.shape_tests() > 0);
+}
+
+#[test]
+fn nan_and_infinite_samples_are_dropped_and_counted() {
+    let scene = scene_with(diffuse(Vec3::ONE), diffuse(Vec3::ONE), |b| {
+        b.point_light(PointLight {
+            position: Vec3::new(1.0, 3.0, -1.0),
+            color: Vec3::INFINITY,
+        });
+    });
+    let out = render(
+        &scene,
+        &RenderSettings {
+            spp: 2,
+            ..RenderSettings::default()
+        },
+        &|_, _| {},
+    )
+    .unwrap();
+    assert!(out.stats.shading.nonfinite_samples > 0);
+    assert!(out.film.pixels().iter().all(|p| p.is_finite()));
+}
+
+#[test]
+fn parallelogram_walls_cull_their_own_shadow_rays() {
+    // A floor parallelogram under an area light, a sphere between: the floor's
+    // shadow rays are traced, and only against what can block them.
+    let mut b = SceneBuilder::new();
+    let m = b.material(diffuse(Vec3::ONE));
+    let floor = Parallelogram::new(
+        Vec3::new(-3.0, 0.0, 1.0),
+        Vec3::X * 6.0,
+        -Vec3::Z * 6.0,
+        false,
+    )
+    .unwrap();
+    b.shape(floor.facing(Vec3::Y), m)
+        .shape(Sphere::new(Vec3::new(0.0, 1.0, -2.0), 0.5).unwrap(), m);
+    area_light(&mut b);
+    let scene = b.build(camera()).unwrap();
+    let stats = stats_of(&scene);
+    assert!(stats.shading.light_shadow_rays > 0);
+    // Camera rays test both parallelograms (floor and light). A floor point's
+    // shadow rays test neither (they cannot hit the floor, and end short of the
+    // light); only the sphere's points keep the floor (the pyramid's faces do not
+    // separate it from them), so shadow rays test very few.
+    let by_shadow_rays = stats.queries.parallelogram_tests - 2 * stats.camera_rays;
+    assert!(
+        by_shadow_rays * 10 < stats.shading.light_shadow_rays,
+        "{by_shadow_rays} tests by {} shadow rays",
+        stats.shading.light_shadow_rays
+    );
+}

@@ -32,7 +32,14 @@
 //!   `surface_at` answer for one ray.
 //! - [`ShapeList`]: a scene's objects; [`ShapeList::build_acceleration`], then
 //!   [`ShapeList::closest_hit`] (a [`Hit`]), [`ShapeList::closest_primitive`] (a
-//!   [`PrimitiveHit`]) and [`ShapeList::any_hit`], or their batch forms.
+//!   [`PrimitiveHit`]) and [`ShapeList::any_hit`], or their batch forms; for
+//!   shadow rays to an area light, [`ShapeList::occluders_towards`] culls the
+//!   shapes that cannot block them once per point and
+//!   [`ShapeList::any_hit_among`] tests the rest. Small scenes' spheres and
+//!   parallelograms are tested four at a time ([`SpherePacket`],
+//!   [`ParallelogramPacket`]).
+//! - [`CountingGuard`] and [`take_counters`]: counts of BVH visits and tests by
+//!   shape ([`QueryCounters`]) for `--stats`.
 //! - [`spawn_ray`] and [`spawn_ray_to`] start secondary rays off a [`Hit`].
 //! - [`Hit::differentials`] turns a [`RayDifferential`] into the pixel's footprint
 //!   on the surface ([`SurfaceDifferentials`]); [`reflect_differential`] follows it

@@ -23,10 +23,9 @@ impl StatsReport<'_> {
         let q = &s.queries;
         let textures: serde_json::Map<String, Value> = LookupKind::ALL
             .iter()
-            .enumerate()
-            .filter(|(_, k)| s.textures.total(**k) > 0)
-            .map(|(i, k)| {
-                let levels = s.textures.lookups[i];
+            .filter(|&&k| s.textures.total(k) > 0)
+            .map(|&k| {
+                let levels = s.textures.lookups[k as usize];
                 let last = levels.iter().rposition(|&n| n > 0).unwrap_or(0);
                 (k.name().to_string(), json!(levels[..=last]))
             })
@@ -120,8 +119,8 @@ impl StatsReport<'_> {
             None => "  BVH             none (the linear loop: a handful of shapes)".to_string(),
         });
         let mut textures = Vec::new();
-        for (i, kind) in LookupKind::ALL.iter().enumerate() {
-            let levels = s.textures.lookups[i];
+        for kind in LookupKind::ALL {
+            let levels = s.textures.lookups[kind as usize];
             if levels.iter().all(|&n| n == 0) {
                 continue;
             }
@@ -157,34 +156,25 @@ impl StatsReport<'_> {
         lines.join("\n")
     }
 
-    /// Image textures the materials use, and how many of them built a pyramid.
+    /// Image textures the materials use (each image once), and how many of them
+    /// built a pyramid.
     fn pyramids(&self) -> (usize, usize) {
-        let images: Vec<_> = self
+        let images: std::collections::BTreeMap<_, bool> = self
             .scene
             .materials
             .iter()
             .flat_map(|m| std::iter::once(&m.diffuse).chain(m.specular.as_ref()))
             .filter_map(|t| match t {
-                Texture::Image(i) => Some(std::sync::Arc::as_ptr(&i.image)),
-                _ => None,
-            })
-            .collect::<std::collections::BTreeSet<_>>()
-            .into_iter()
-            .collect();
-        let built = self
-            .scene
-            .materials
-            .iter()
-            .flat_map(|m| std::iter::once(&m.diffuse).chain(m.specular.as_ref()))
-            .filter_map(|t| match t {
-                Texture::Image(i) if i.image.has_pyramid() => {
-                    Some(std::sync::Arc::as_ptr(&i.image))
+                Texture::Image(i) => {
+                    Some((std::sync::Arc::as_ptr(&i.image), i.image.has_pyramid()))
                 }
                 _ => None,
             })
-            .collect::<std::collections::BTreeSet<_>>()
-            .len();
-        (images.len(), built)
+            .collect();
+        (
+            images.len(),
+            images.values().filter(|&&built| built).count(),
+        )
     }
 }
 

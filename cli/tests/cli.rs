@@ -2,17 +2,8 @@
 
 mod common;
 
-use common::{assert_input_error, glint, scene, stderr};
+use common::{assert_input_error, glint, scene, stderr, SMALL};
 use std::path::Path;
-
-const SMALL: [&str; 6] = [
-    "--resolution",
-    "24x24",
-    "--spp",
-    "4",
-    "--light-samples",
-    "4",
-];
 
 #[test]
 fn renders_png_exr_and_pfm_and_prints_a_summary() {

@@ -3,16 +3,7 @@
 
 mod common;
 
-use common::{glint, scene, stderr, stdout};
-
-const SMALL: [&str; 6] = [
-    "--resolution",
-    "24x24",
-    "--spp",
-    "4",
-    "--light-samples",
-    "4",
-];
+use common::{glint, scene, stderr, stdout, SMALL};
 
 #[test]
 fn stats_print_every_section_write_json_and_change_no_pixel() {

@@ -52,7 +52,8 @@ impl std::ops::AddAssign for ShadingCounters {
     }
 }
 
-/// How textures are looked up, in [`TextureCounters`].
+/// How textures are looked up, in [`TextureCounters`] (in the order of
+/// [`LookupKind::ALL`], which indexes its rows).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LookupKind {
     Constant,
@@ -129,17 +130,13 @@ impl TextureCounters {
             } else {
                 0
             };
-            let kind = LookupKind::ALL
-                .iter()
-                .position(|&k| k == LookupKind::of(texture));
-            self.lookups[kind.unwrap_or(0)][bin] += 1;
+            self.lookups[LookupKind::of(texture) as usize][bin] += 1;
         }
     }
 
     /// All lookups of `kind`.
     pub fn total(&self, kind: LookupKind) -> u64 {
-        let k = LookupKind::ALL.iter().position(|&x| x == kind).unwrap_or(0);
-        self.lookups[k].iter().sum()
+        self.lookups[kind as usize].iter().sum()
     }
 
     /// Every lookup.

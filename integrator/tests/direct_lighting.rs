@@ -1,35 +1,18 @@
 //! The direct integrator against closed forms and the report's rules.
 
+mod common;
+
+use common::{camera, diffuse};
 use glam::{UVec2, Vec3};
 use glint_camera::Camera;
 use glint_geometry::{Parallelogram, Plane, Sphere};
 use glint_integrator::{render, RenderSettings, SamplePattern, Scene, SceneBuilder};
 use glint_lighting::{AreaLight, PhongMaterial, PointLight};
-use glint_texture::Texture;
 
 const KD: Vec3 = Vec3::new(0.8, 0.6, 0.4);
 const LIGHT_POS: Vec3 = Vec3::new(1.0, 3.0, -2.0);
 const LIGHT_COLOR: Vec3 = Vec3::new(1.0, 0.9, 0.8);
 const AMBIENT: Vec3 = Vec3::new(0.05, 0.04, 0.03);
-
-fn diffuse(kd: Vec3) -> PhongMaterial {
-    PhongMaterial {
-        specular: Some(Texture::Constant(Vec3::ZERO)),
-        ..PhongMaterial::new(kd, 1.0)
-    }
-}
-
-fn camera(resolution: UVec2) -> Camera {
-    Camera::new(
-        Vec3::new(0.0, 2.0, 4.0),
-        Vec3::new(0.0, 0.0, -2.0),
-        Vec3::Y,
-        50.0,
-        1.0,
-        resolution,
-    )
-    .unwrap()
-}
 
 fn one_sample_at_pixel_centres() -> RenderSettings {
     RenderSettings {

@@ -2,6 +2,9 @@
 //! in the render's counts (`glint render --stats`), beside a scene that does need
 //! the work and counts it.
 
+mod common;
+
+use common::diffuse;
 use glam::{UVec2, Vec2, Vec3};
 use glint_camera::Camera;
 use glint_geometry::{Parallelogram, Plane, Sphere, TriangleMesh};
@@ -9,23 +12,9 @@ use glint_integrator::{render, LookupKind, RenderSettings, RenderStats, Scene, S
 use glint_lighting::{AreaLight, PhongMaterial, PointLight};
 use glint_texture::{Checkerboard, ImageTexture, Texture, TextureFilter, TextureImage, WrapMode};
 
+/// The tests' camera, on a tiny film.
 fn camera() -> Camera {
-    Camera::new(
-        Vec3::new(0.0, 2.0, 4.0),
-        Vec3::new(0.0, 0.0, -2.0),
-        Vec3::Y,
-        50.0,
-        1.0,
-        UVec2::new(24, 16),
-    )
-    .unwrap()
-}
-
-fn diffuse(kd: Vec3) -> PhongMaterial {
-    PhongMaterial {
-        specular: Some(Texture::Constant(Vec3::ZERO)),
-        ..PhongMaterial::new(kd, 1.0)
-    }
+    common::camera(UVec2::new(24, 16))
 }
 
 /// A floor and a sphere under a point light, made of `floor` and `ball`.

@@ -6,6 +6,17 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+/// Flags that make a shipped scene render in milliseconds: 24 × 24 pixels, 4
+/// camera samples and 4 light samples each.
+pub const SMALL: [&str; 6] = [
+    "--resolution",
+    "24x24",
+    "--spp",
+    "4",
+    "--light-samples",
+    "4",
+];
+
 /// Runs the built `glint` with `args` in `dir`.
 pub fn glint(args: &[&str], dir: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_glint"))

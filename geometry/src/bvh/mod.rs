@@ -46,7 +46,7 @@ mod sah;
 mod stats;
 mod stream;
 #[cfg(test)]
-mod test_support;
+pub(crate) mod test_support;
 #[cfg(test)]
 mod tests;
 mod traversal;

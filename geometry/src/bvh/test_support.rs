@@ -9,10 +9,10 @@ use crate::Ray;
 use glam::Vec3;
 
 /// Marsaglia's xorshift64 ("Xorshift RNGs", 2003): tiny, seeded, deterministic.
-pub(super) struct XorShift(pub(super) u64);
+pub(crate) struct XorShift(pub(crate) u64);
 
 impl XorShift {
-    pub(super) fn next_u64(&mut self) -> u64 {
+    pub(crate) fn next_u64(&mut self) -> u64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
@@ -20,15 +20,15 @@ impl XorShift {
     }
 
     /// Uniform in [0, 1), from the top 24 bits.
-    pub(super) fn unit(&mut self) -> f32 {
+    pub(crate) fn unit(&mut self) -> f32 {
         (self.next_u64() >> 40) as f32 / (1u32 << 24) as f32
     }
 
-    pub(super) fn range(&mut self, lo: f32, hi: f32) -> f32 {
+    pub(crate) fn range(&mut self, lo: f32, hi: f32) -> f32 {
         lo + (hi - lo) * self.unit()
     }
 
-    pub(super) fn vec3(&mut self, lo: f32, hi: f32) -> Vec3 {
+    pub(crate) fn vec3(&mut self, lo: f32, hi: f32) -> Vec3 {
         Vec3::new(self.range(lo, hi), self.range(lo, hi), self.range(lo, hi))
     }
 }

@@ -198,6 +198,7 @@ fn pyramid_planes(apex: Vec3, corners: &[Vec3; 4]) -> Option<[Face; 5]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bvh::test_support::XorShift;
     use crate::{Parallelogram, Sphere};
 
     /// The course's Cornell box (walls one-sided, facing in), its four spheres and
@@ -275,13 +276,8 @@ mod tests {
                 plain.push(*s);
             }
         }
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
+        let mut next = move || rng.unit();
         let (mut blocked, mut culled) = (0, 0);
         for _ in 0..4000 {
             let aim = Vec3::new(

@@ -188,35 +188,27 @@ impl ParallelogramPacket {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// xorshift64*: deterministic test rays and shapes.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f32 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
-        }
-        fn vec(&mut self, scale: f32) -> Vec3 {
-            Vec3::new(self.next(), self.next(), self.next()) * 2.0 * scale - scale
-        }
-    }
+    use crate::bvh::test_support::XorShift;
 
     /// Every lane agrees with the scalar test bit for bit, on random rays
     /// (origins inside and outside, grazing and tangent ones included by volume).
     #[test]
     fn packets_agree_with_the_scalar_tests_bit_for_bit() {
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
         let mut hits = 0;
         for _ in 0..2000 {
             let spheres: Vec<Sphere> = (0..3)
-                .map(|_| Sphere::new(rng.vec(3.0), 0.2 + 2.0 * rng.next()).unwrap())
+                .map(|_| Sphere::new(rng.vec3(-3.0, 3.0), 0.2 + 2.0 * rng.unit()).unwrap())
                 .collect();
             let walls: Vec<Parallelogram> = (0..4)
                 .map(|k| {
-                    Parallelogram::new(rng.vec(3.0), rng.vec(4.0), rng.vec(4.0), k % 2 == 0)
-                        .unwrap()
+                    Parallelogram::new(
+                        rng.vec3(-3.0, 3.0),
+                        rng.vec3(-4.0, 4.0),
+                        rng.vec3(-4.0, 4.0),
+                        k % 2 == 0,
+                    )
+                    .unwrap()
                 })
                 .collect();
             let mut sphere_packet = SpherePacket::EMPTY;
@@ -228,12 +220,12 @@ mod tests {
                 wall_packet.set_lane(lane, p);
             }
             // From anywhere, towards the shapes' neighbourhood.
-            let origin = rng.vec(5.0);
-            let ray = Ray::new(origin, rng.vec(3.0) - origin);
-            let t_max = if rng.next() < 0.5 {
+            let origin = rng.vec3(-5.0, 5.0);
+            let ray = Ray::new(origin, rng.vec3(-3.0, 3.0) - origin);
+            let t_max = if rng.unit() < 0.5 {
                 f32::INFINITY
             } else {
-                6.0 * rng.next()
+                6.0 * rng.unit()
             };
             let (mask, t) = sphere_packet.hit4(&ray, t_max);
             for (lane, s) in spheres.iter().enumerate() {

@@ -44,12 +44,15 @@
 //! - [`Hit::differentials`] turns a [`RayDifferential`] into the pixel's footprint
 //!   on the surface ([`SurfaceDifferentials`]); [`reflect_differential`] follows it
 //!   through a mirror.
+//! - [`lanes::Vec3x8`]: eight 3-vectors in SIMD lanes, each lane bit for bit the
+//!   scalar arithmetic, for shading a point's light samples together.
 //! - [`bvh::Bvh`] on its own: a BVH over any primitives given by their bounds.
 
 pub mod bvh;
 mod counters;
 mod differentials;
 mod hit;
+pub mod lanes;
 mod offset;
 mod prefetch;
 mod ray;
@@ -64,8 +67,8 @@ pub use ray::Ray;
 pub use shape_list::{ObjectRef, Occluders, PrimitiveHit, ShapeList};
 pub use shapes::{triangle, triangle_packet};
 pub use shapes::{
-    AaBox, MeshError, Parallelogram, ParallelogramPacket, Plane, Shape, Sphere, SpherePacket,
-    TriangleMesh, TrianglePacket,
+    AaBox, MeshError, Parallelogram, ParallelogramPacket, Plane, RayLanes, Shape, Sphere,
+    SpherePacket, TriangleMesh, TrianglePacket,
 };
 
 #[cfg(doctest)]

@@ -192,16 +192,8 @@ impl DirectIntegrator {
         } else {
             Occluders::ALL
         };
-        let mut sum = Vec3::ZERO;
         ctx.counters.light_samples += samples.len() as u64;
-        for &u in &samples {
-            let position = light.sample_point(u);
-            if light.illuminates(position, point.hit.point) {
-                sum += point.unoccluded_reflection(scene, position, &occluders, ctx);
-            } else {
-                ctx.counters.skipped_behind_light += 1;
-            }
-        }
+        let sum = point.area_light_sum(scene, light, &samples, &occluders, ctx);
         ctx.light_points = samples;
         light.color * sum / self.light_samples as f32
     }
@@ -273,21 +265,21 @@ pub(crate) fn texture_footprint(
 /// A surface point being shaded: the hit, its material and reflectances, the
 /// unit shading normal `n` (on the viewer's side), the geometric normal `ng` on the
 /// same side, and the direction `v` towards the viewer.
-struct ShadingPoint<'a> {
-    hit: &'a Hit,
-    material: &'a PhongMaterial,
-    kd: Vec3,
-    ks: Vec3,
-    n: Vec3,
-    ng: Vec3,
-    v: Vec3,
+pub(crate) struct ShadingPoint<'a> {
+    pub(crate) hit: &'a Hit,
+    pub(crate) material: &'a PhongMaterial,
+    pub(crate) kd: Vec3,
+    pub(crate) ks: Vec3,
+    pub(crate) n: Vec3,
+    pub(crate) ng: Vec3,
+    pub(crate) v: Vec3,
     /// Whether `ks` is nonzero: without it the specular lobe is never evaluated.
-    has_specular: bool,
+    pub(crate) has_specular: bool,
 }
 
 impl<'a> ShadingPoint<'a> {
     /// The point `hit` of `material`, seen along `ray`, with its texture lookup `tc`.
-    fn new(hit: &'a Hit, material: &'a PhongMaterial, ray: &Ray, tc: &TexCoord) -> Self {
+    pub(crate) fn new(hit: &'a Hit, material: &'a PhongMaterial, ray: &Ray, tc: &TexCoord) -> Self {
         let (kd, ks) = material.reflectances(tc);
         let n = hit.facing_normal(ray.direction);
         let ng = if hit.geometric_normal.dot(n) < 0.0 {
@@ -334,7 +326,7 @@ impl ShadingPoint<'_> {
     /// Phong reflection towards `v` of a unit light at `position`, or zero if the
     /// light is behind the surface or a shadow ray finds it occluded (testing only
     /// `occluders`). The shadow ray is only traced when the light could contribute.
-    fn unoccluded_reflection(
+    pub(crate) fn unoccluded_reflection(
         &self,
         scene: &Scene,
         position: Vec3,

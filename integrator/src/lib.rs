@@ -29,6 +29,7 @@
 mod aov;
 pub mod counters;
 mod direct;
+mod light_samples;
 mod render;
 pub mod sampling;
 mod scene;

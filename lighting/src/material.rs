@@ -1,4 +1,5 @@
 use glam::{Vec2, Vec3};
+use glint_geometry::lanes::{self, f32x8, Vec3x8};
 use glint_texture::{TexCoord, Texture};
 
 /// A per-material change of texture coordinates: `uv' = uv · scale + offset`
@@ -178,32 +179,84 @@ impl PhongMaterial {
         };
         if cosine <= 0.0 {
             0.0
-        } else if self.shininess.fract() == 0.0 && self.shininess <= 1024.0 {
+        } else if self.integral_exponent() {
             // Integral exponents (the usual case) by repeated squaring: several
             // times faster than powf, and as accurate to a few ULPs.
-            powi(cosine, self.shininess as i32)
+            powi(cosine, self.shininess as i32, 1.0)
         } else {
             cosine.powf(self.shininess)
         }
+    }
+
+    /// Whether the exponent is taken by [`powi`] (integral, up to 1024) rather
+    /// than `powf`.
+    #[inline]
+    fn integral_exponent(&self) -> bool {
+        self.shininess.fract() == 0.0 && self.shininess <= 1024.0
+    }
+
+    /// [`Self::reflect`] (with `specular`) or [`Self::reflect_diffuse`] (without)
+    /// for eight light directions `l` at once, each lane bit for bit the scalar
+    /// value: the same operations in the same order, nothing fused.
+    #[inline]
+    pub fn reflect_lanes(
+        &self,
+        kd: Vec3,
+        ks: Vec3,
+        n: Vec3,
+        l: &Vec3x8,
+        v: Vec3,
+        specular: bool,
+    ) -> Vec3x8 {
+        let n_dot_l = l.dot_splat(n);
+        let diffuse = Vec3x8::scaled_splat(kd, n_dot_l);
+        let reflected = if specular {
+            diffuse + Vec3x8::scaled_splat(ks, self.specular_lobe_lanes(n, l, v, n_dot_l))
+        } else {
+            diffuse
+        };
+        // `n·l ≤ 0` gives zero (a NaN goes on, as in the scalar test).
+        let behind = lanes::le(n_dot_l, f32x8::ZERO);
+        Vec3x8::select(behind, &Vec3x8::default(), &reflected)
+    }
+
+    /// [`Self::specular_lobe`] for eight directions at once.
+    #[inline]
+    fn specular_lobe_lanes(&self, n: Vec3, l: &Vec3x8, v: Vec3, n_dot_l: f32x8) -> f32x8 {
+        if self.lobe != SpecularLobe::Phong || !self.integral_exponent() {
+            let n_dot_l = n_dot_l.as_array();
+            return f32x8::new(std::array::from_fn(|k| {
+                self.specular_lobe(n, l.lane(k), v, n_dot_l[k])
+            }));
+        }
+        // (2·(n·l))·n − l, then its dot product with v.
+        let mirror = Vec3x8::scaled_splat(n, f32x8::splat(2.0) * n_dot_l) - *l;
+        let cosine = mirror.dot_splat(v);
+        let lobe = powi(cosine, self.shininess as i32, f32x8::ONE);
+        lanes::le(cosine, f32x8::ZERO).select(f32x8::ZERO, lobe)
     }
 }
 
 /// `base^exponent` by binary exponentiation, inlined: the multiplications of
 /// `f32::powi` (the runtime's `__powisf2`, which the compiler calls out of line for
-/// an exponent unknown at compile time) in the same order, so the same bits.
+/// an exponent unknown at compile time) in the same order, so the same bits. For
+/// `f32` or for lanes of them (`one` is 1 in the type).
 #[inline]
-fn powi(mut base: f32, exponent: i32) -> f32 {
+fn powi<T>(mut base: T, exponent: i32, one: T) -> T
+where
+    T: Copy + std::ops::Mul<Output = T> + std::ops::Div<Output = T>,
+{
     let mut n = exponent.unsigned_abs();
-    let mut result = if n & 1 == 1 { base } else { 1.0 };
+    let mut result = if n & 1 == 1 { base } else { one };
     while n > 1 {
         n >>= 1;
-        base *= base;
+        base = base * base;
         if n & 1 == 1 {
-            result *= base;
+            result = result * base;
         }
     }
     if exponent < 0 {
-        1.0 / result
+        one / result
     } else {
         result
     }
@@ -223,10 +276,61 @@ mod tests {
                 let base = k as f32 / 199.0 * 1.25;
                 let expected = std::hint::black_box(base).powi(std::hint::black_box(exponent));
                 assert_eq!(
-                    powi(base, exponent).to_bits(),
+                    powi(base, exponent, 1.0).to_bits(),
                     expected.to_bits(),
                     "{base}^{exponent}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn eight_lanes_reflect_the_scalar_bits() {
+        let n = Vec3::new(0.2, 0.9, -0.1).normalize();
+        let v = Vec3::new(-0.3, 0.8, 0.6).normalize();
+        let (kd, ks) = (Vec3::new(0.7, 0.5, 0.2), Vec3::new(0.3, 0.3, 0.9));
+        // Directions around the horizon and the mirror peak, a zero and a NaN.
+        let direction = |k: usize, batch: usize| match (batch, k) {
+            (0, 0) => Vec3::ZERO,
+            (0, 1) => Vec3::new(f32::NAN, 1.0, 0.0),
+            _ => {
+                let a = (k + 8 * batch) as f32 * 0.37 - 1.5;
+                Vec3::new(a.sin(), a.cos(), 0.3 * a).normalize()
+            }
+        };
+        for lobe in [SpecularLobe::Phong, SpecularLobe::BlinnPhong] {
+            for shininess in [1.0, 16.0, 22.0, 120.0, 7.5, 2000.0] {
+                let m = PhongMaterial {
+                    lobe,
+                    ..PhongMaterial::new(kd, shininess)
+                };
+                for batch in 0..4 {
+                    let l: [Vec3; 8] = std::array::from_fn(|k| direction(k, batch));
+                    let lanes = Vec3x8 {
+                        x: f32x8::new(l.map(|l| l.x)),
+                        y: f32x8::new(l.map(|l| l.y)),
+                        z: f32x8::new(l.map(|l| l.z)),
+                    };
+                    for specular in [true, false] {
+                        let out = m.reflect_lanes(kd, ks, n, &lanes, v, specular);
+                        for (k, &l) in l.iter().enumerate() {
+                            let scalar = if specular {
+                                m.reflect(kd, ks, n, l, v)
+                            } else {
+                                m.reflect_diffuse(kd, n, l)
+                            };
+                            let lane = out.lane(k);
+                            for axis in 0..3 {
+                                assert!(
+                                    lane[axis].to_bits() == scalar[axis].to_bits()
+                                        || (lane[axis].is_nan() && scalar[axis].is_nan()),
+                                    "{lobe:?} s={shininess} l={l} specular={specular}: \
+                                     {lane} against {scalar}"
+                                );
+                            }
+                        }
+                    }
+                }
             }
         }
     }

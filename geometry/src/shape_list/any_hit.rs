@@ -90,7 +90,12 @@ impl ShapeList {
     }
 
     /// Whether an object of the linear loop outside its packets lies on the ray.
+    #[inline]
     pub(super) fn others_hit(&self, linear: &LinearShapes, ray: &Ray, t_max: f32) -> bool {
+        !linear.others.is_empty() && self.others_hit_one_by_one(linear, ray, t_max)
+    }
+
+    fn others_hit_one_by_one(&self, linear: &LinearShapes, ray: &Ray, t_max: f32) -> bool {
         linear.others.iter().any(|&object| {
             let watertight = WatertightRay::new(ray);
             self.primitives_of(object).any(|p| {

@@ -11,8 +11,10 @@
 //! are skipped. (In the Cornell box a floor point's 16 shadow rays to the light
 //! then test one or two spheres instead of ten shapes.)
 
-use super::ShapeList;
-use crate::Ray;
+use super::{ObjectRef, ShapeList};
+use crate::counters::count;
+use crate::lanes::LANES;
+use crate::{Ray, RayLanes, Shape};
 use glam::{Vec3, Vec4};
 
 /// The shapes of a [`ShapeList`] that may block shadow rays from one point to one
@@ -128,6 +130,69 @@ impl ShapeList {
                 lanes != 0 && packet.hit4(ray, t_max).0 & lanes != 0
             })
             || self.others_hit(linear, ray, t_max)
+    }
+}
+
+impl ShapeList {
+    /// [`ShapeList::any_hit_among`] for the rays in the lanes of `rays` that
+    /// `active` names (bit k for lane k), all with the same `t_max`: the lanes
+    /// whose ray is blocked. Each lane's answer is the one its ray gets alone.
+    /// One shape is tested against all eight rays at once
+    /// ([`Sphere::hits_lanes`](crate::Sphere::hits_lanes)), which pays for the
+    /// shadow rays of one point, all meeting the same few shapes.
+    pub fn any_hits_among(
+        &self,
+        occluders: &Occluders,
+        rays: &RayLanes,
+        t_max: f32,
+        active: u32,
+    ) -> u32 {
+        let Some(linear) = &self.linear else {
+            return self.lane_by_lane(active, |lane| {
+                self.any_hit_among(occluders, &rays.lane(lane), t_max)
+            });
+        };
+        let tested = u64::from(active.count_ones());
+        let mut blocked = 0;
+        let spheres = linear.spheres.iter().map(|(_, objects)| objects);
+        let parallelograms = linear.parallelograms.iter().map(|(_, objects)| objects);
+        for (k, objects) in spheres.chain(parallelograms).enumerate() {
+            let kept = occluders.packet(k);
+            for (lane, &object) in objects.iter().enumerate() {
+                if kept >> lane & 1 == 0 || object == u32::MAX {
+                    continue;
+                }
+                blocked |= active
+                    & match self.object(object) {
+                        ObjectRef::Shape(Shape::Sphere(s)) => {
+                            count(|c| c.sphere_tests += tested);
+                            s.hits_lanes(rays, t_max)
+                        }
+                        ObjectRef::Shape(Shape::Parallelogram(p)) => {
+                            count(|c| c.parallelogram_tests += tested);
+                            p.hits_lanes(rays, t_max)
+                        }
+                        _ => unreachable!("packets hold spheres and parallelograms"),
+                    };
+                if blocked == active {
+                    return blocked;
+                }
+            }
+        }
+        if linear.others.is_empty() {
+            return blocked;
+        }
+        blocked
+            | self.lane_by_lane(active & !blocked, |lane| {
+                self.others_hit(linear, &rays.lane(lane), t_max)
+            })
+    }
+
+    /// The lanes of `active` for which `blocked(lane)` holds.
+    fn lane_by_lane(&self, active: u32, mut blocked: impl FnMut(usize) -> bool) -> u32 {
+        (0..LANES)
+            .filter(|&lane| active >> lane & 1 == 1 && blocked(lane))
+            .fold(0, |bits, lane| bits | 1 << lane)
     }
 }
 

@@ -25,7 +25,9 @@
 
 use super::streams::mix64;
 use glam::Vec2;
+use glint_geometry::lanes::{f32x8, LANES};
 use sobol_burley::parts::{hash, owen_scramble_rev, u32_to_f32_norm};
+use wide::{bytemuck::cast, u32x8};
 
 /// Which 2D sample dimensions of a pixel a set of points is for; each has its own
 /// Sobol sequence, so that no two of them correlate.
@@ -140,16 +142,19 @@ impl SobolSequence {
         self.scrambles(index).point(index as u32 & BLOCK_MASK)
     }
 
-    /// Points `first..first + out.len()`.
+    /// Points `first..first + out.len()`, eight at a time
+    /// ([`Scrambles::points`]) where eight consecutive ones share a block.
     #[inline]
     pub fn fill(self, first: u64, out: &mut [Vec2]) {
-        let mut scrambles = self.scrambles(first);
-        for (p, index) in out.iter_mut().zip(first..) {
-            let i = index as u32 & BLOCK_MASK;
-            if i == 0 && index != first {
-                scrambles = self.scrambles(index);
+        for (chunk, start) in out.chunks_mut(LANES).zip((first..).step_by(LANES)) {
+            let i = start as u32 & BLOCK_MASK;
+            if i as usize + chunk.len() <= 1 << BLOCK_BITS {
+                self.scrambles(start).points(i, chunk);
+            } else {
+                for (p, index) in chunk.iter_mut().zip(start..) {
+                    *p = self.point(index);
+                }
             }
-            *p = scrambles.point(i);
         }
     }
 }
@@ -186,6 +191,37 @@ impl Scrambles {
         }
     }
 
+    /// Points `i..i + out.len()` (at most eight, all below 2^16), as
+    /// [`Self::point`] computes each, bit for bit: the integer hashing of the
+    /// eight in SIMD lanes (wrapping products, exact), the table lookups lane by
+    /// lane.
+    #[inline]
+    fn points(self, i: u32, out: &mut [Vec2]) {
+        let index = u32x8::new(std::array::from_fn(|k| i.wrapping_add(k as u32)));
+        let shuffled = owen_scramble_lanes(reverse_bits_lanes(index), self.index).to_array();
+        let tables = self.tables();
+        let sobol = |axis: usize| {
+            u32x8::new(std::array::from_fn(|k| {
+                let (low, high) = (shuffled[k] >> 24, shuffled[k] >> 16 & 0xff);
+                tables[axis][0][low as usize] ^ tables[axis][1][high as usize]
+            }))
+        };
+        let x = unit_lanes(sobol(0), self.x);
+        let y = unit_lanes(sobol(1), self.y);
+        for (k, p) in out.iter_mut().enumerate() {
+            *p = Vec2::new(x[k], y[k]);
+        }
+    }
+
+    /// The generator tables of this sequence's two dimensions.
+    #[inline]
+    fn tables(self) -> &'static [[[u32; 256]; 2]; 2] {
+        match self.dimensions {
+            0 => &GENERATOR_TABLES,
+            k => &JOINT_TABLES[k as usize - 1],
+        }
+    }
+
     /// Point `i < 2^16`: the index shuffled (an Owen scramble of its reversed
     /// bits), the Sobol point of the shuffled index, each coordinate Owen-scrambled.
     #[inline]
@@ -193,10 +229,7 @@ impl Scrambles {
         let shuffled = owen_scramble_rev(i.reverse_bits(), self.index);
         // The shuffled index's bits 0–7 and 8–15, still reversed.
         let (low, high) = ((shuffled >> 24) as usize, (shuffled >> 16 & 0xff) as usize);
-        let tables = match self.dimensions {
-            0 => &GENERATOR_TABLES,
-            k => &JOINT_TABLES[k as usize - 1],
-        };
+        let tables = self.tables();
         // By reference: `map` on the arrays themselves would copy 4 KB a point.
         let (x, y) = (
             tables[0][0][low] ^ tables[0][1][high],
@@ -206,6 +239,43 @@ impl Scrambles {
             |v: u32, scramble: u32| u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits());
         Vec2::new(unit(x, self.x), unit(y, self.y))
     }
+}
+
+/// `sobol_burley::parts::owen_scramble_rev` on eight integers (wrapping
+/// products and sums, so the same bits).
+#[inline]
+fn owen_scramble_lanes(mut n_rev: u32x8, scramble: u32) -> u32x8 {
+    n_rev ^= n_rev * u32x8::splat(0x3d20_adea);
+    n_rev += u32x8::splat(scramble);
+    n_rev *= u32x8::splat((scramble >> 16) | 1);
+    n_rev ^= n_rev * u32x8::splat(0x0552_6c56);
+    n_rev ^= n_rev * u32x8::splat(0x53a2_2864);
+    n_rev
+}
+
+/// `u32::reverse_bits` on eight integers: swaps of ever larger bit groups.
+#[inline]
+fn reverse_bits_lanes(mut v: u32x8) -> u32x8 {
+    for (shift, mask) in [
+        (1, 0x5555_5555),
+        (2, 0x3333_3333),
+        (4, 0x0f0f_0f0f),
+        (8, 0x00ff_00ff),
+    ] {
+        let mask = u32x8::splat(mask);
+        v = ((v >> shift) & mask) | ((v & mask) << shift);
+    }
+    (v >> 16) | (v << 16)
+}
+
+/// The coordinates in [0, 1) of eight scrambled Sobol values, as
+/// `u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits())`: the top 23
+/// bits as the mantissa of a float in [1, 2), minus 1.
+#[inline]
+fn unit_lanes(v: u32x8, scramble: u32) -> [f32; LANES] {
+    let bits =
+        (reverse_bits_lanes(owen_scramble_lanes(v, scramble)) >> 9) | u32x8::splat(0x3f80_0000);
+    (cast::<u32x8, f32x8>(bits) - f32x8::ONE).to_array()
 }
 
 /// The unscrambled Sobol points of dimensions 0 and 1 by bytes of the index, bits

@@ -84,6 +84,28 @@ fn a_sequence_is_sobol_burley_dimensions_0_and_1_with_the_block_seed() {
     }
 }
 
+#[test]
+fn filling_eight_at_a_time_gives_each_point_bit_for_bit() {
+    // Fills of every length up to 19 from offsets around the block boundary and
+    // through a whole block: the SIMD lanes give each point `point` gives alone.
+    for pair in [DimensionPair::Pixel, DimensionPair::Joint { k: 1 }] {
+        let sequence = SobolSequence::new(11, 4242, pair);
+        let mut whole = vec![Vec2::ZERO; 1 << 16];
+        sequence.fill(1 << 16, &mut whole);
+        for (k, p) in whole.iter().enumerate() {
+            assert_eq!(*p, sequence.point((1 << 16) + k as u64), "point {k}");
+        }
+        for len in 1..20 {
+            for first in ((1 << 16) - 20..(1 << 16) + 3).chain(0..9) {
+                let mut out = vec![Vec2::ZERO; len];
+                sequence.fill(first, &mut out);
+                let expected: Vec<Vec2> = (first..).take(len).map(|i| sequence.point(i)).collect();
+                assert_eq!(out, expected, "{len} points from {first}");
+            }
+        }
+    }
+}
+
 /// Whether each elementary interval `2^a × 2^b` with `a + b = k` holds exactly
 /// one of the `2^k` points, for every such shape; the first failure otherwise.
 fn elementary_intervals_hold_one_point_each(points: &[Vec2]) -> Result<(), String> {

@@ -1,0 +1,262 @@
+//! Eight 3-vectors at once, in structure-of-arrays form ([`Vec3x8`]), for work
+//! that repeats the same arithmetic on many rays or samples (a shading point's
+//! light samples and their shadow rays).
+//!
+//! Each lane performs exactly the IEEE operations of glam's scalar [`Vec3`]
+//! methods, in the same order: `a.dot(b)` is `(a.x·b.x + a.y·b.y) + a.z·b.z`,
+//! `a + s·b` rounds the product then the sum, and nothing is fused into a
+//! multiply-add. So a lane's result is bit for bit the scalar result, whatever
+//! instructions the CPU has (`wide` uses AVX when the build allows it, two SSE
+//! halves otherwise).
+
+use glam::Vec3;
+pub use wide::f32x8;
+
+/// The number of lanes.
+pub const LANES: usize = 8;
+
+/// Eight 3-vectors, one per lane.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Vec3x8 {
+    pub x: f32x8,
+    pub y: f32x8,
+    pub z: f32x8,
+}
+
+impl Vec3x8 {
+    /// `v` in every lane.
+    #[inline]
+    pub fn splat(v: Vec3) -> Self {
+        Self {
+            x: f32x8::splat(v.x),
+            y: f32x8::splat(v.y),
+            z: f32x8::splat(v.z),
+        }
+    }
+
+    /// Lane `lane` as a scalar vector.
+    #[inline]
+    pub fn lane(&self, lane: usize) -> Vec3 {
+        Vec3::new(
+            self.x.as_array()[lane],
+            self.y.as_array()[lane],
+            self.z.as_array()[lane],
+        )
+    }
+
+    /// `self · other`, as [`Vec3::dot`] rounds it.
+    #[inline]
+    pub fn dot(&self, other: &Self) -> f32x8 {
+        self.x * other.x + self.y * other.y + self.z * other.z
+    }
+
+    /// `self · v` for the same `v` in every lane.
+    #[inline]
+    pub fn dot_splat(&self, v: Vec3) -> f32x8 {
+        self.x * f32x8::splat(v.x) + self.y * f32x8::splat(v.y) + self.z * f32x8::splat(v.z)
+    }
+
+    /// Each lane times its own scalar, as `Vec3 * f32`.
+    #[inline]
+    pub fn scale(&self, s: f32x8) -> Self {
+        Self {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+
+    /// `s · v` per lane, as `f32 * Vec3`.
+    #[inline]
+    pub fn scaled_splat(v: Vec3, s: f32x8) -> Self {
+        Self {
+            x: f32x8::splat(v.x) * s,
+            y: f32x8::splat(v.y) * s,
+            z: f32x8::splat(v.z) * s,
+        }
+    }
+
+    /// `self − v` for the same `v` in every lane.
+    #[inline]
+    pub fn sub_splat(&self, v: Vec3) -> Self {
+        Self {
+            x: self.x - f32x8::splat(v.x),
+            y: self.y - f32x8::splat(v.y),
+            z: self.z - f32x8::splat(v.z),
+        }
+    }
+
+    /// `v − self` for the same `v` in every lane.
+    #[inline]
+    pub fn splat_sub(v: Vec3, other: &Self) -> Self {
+        Self {
+            x: f32x8::splat(v.x) - other.x,
+            y: f32x8::splat(v.y) - other.y,
+            z: f32x8::splat(v.z) - other.z,
+        }
+    }
+
+    /// `self × v` for the same `v` in every lane, as [`Vec3::cross`] rounds it.
+    #[inline]
+    pub fn cross_splat(&self, v: Vec3) -> Self {
+        let (x, y, z) = (f32x8::splat(v.x), f32x8::splat(v.y), f32x8::splat(v.z));
+        Self {
+            x: self.y * z - y * self.z,
+            y: self.z * x - z * self.x,
+            z: self.x * y - x * self.y,
+        }
+    }
+
+    /// `v × self` for the same `v` in every lane, as [`Vec3::cross`] rounds it.
+    #[inline]
+    pub fn splat_cross(v: Vec3, other: &Self) -> Self {
+        let (x, y, z) = (f32x8::splat(v.x), f32x8::splat(v.y), f32x8::splat(v.z));
+        Self {
+            x: y * other.z - other.y * z,
+            y: z * other.x - other.z * x,
+            z: x * other.y - other.x * y,
+        }
+    }
+
+    /// Per lane, `if_true` where `mask` is set, else `if_false`.
+    #[inline]
+    pub fn select(mask: f32x8, if_true: &Self, if_false: &Self) -> Self {
+        Self {
+            x: mask.select(if_true.x, if_false.x),
+            y: mask.select(if_true.y, if_false.y),
+            z: mask.select(if_true.z, if_false.z),
+        }
+    }
+
+    /// [`Vec3::try_normalize`] per lane: the unit vectors, and the mask of the
+    /// lanes where it succeeds (`1/length` finite and positive).
+    #[inline]
+    pub fn try_normalize(&self) -> (Self, f32x8) {
+        let rcp = f32x8::ONE / self.dot(self).sqrt();
+        let ok = rcp.is_finite() & rcp.simd_gt(f32x8::ZERO);
+        (self.scale(rcp), ok)
+    }
+
+    /// The lanes equal to zero in every component (as `Vec3 == Vec3::ZERO`).
+    #[inline]
+    pub fn is_zero(&self) -> f32x8 {
+        self.x.simd_eq(f32x8::ZERO) & self.y.simd_eq(f32x8::ZERO) & self.z.simd_eq(f32x8::ZERO)
+    }
+}
+
+impl std::ops::Sub for Vec3x8 {
+    type Output = Self;
+    #[inline]
+    fn sub(self, o: Self) -> Self {
+        Self {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+}
+
+impl std::ops::Add for Vec3x8 {
+    type Output = Self;
+    #[inline]
+    fn add(self, o: Self) -> Self {
+        Self {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+
+/// `a > b` per lane.
+#[inline]
+pub fn gt(a: f32x8, b: f32x8) -> f32x8 {
+    a.simd_gt(b)
+}
+
+/// `a < b` per lane.
+#[inline]
+pub fn lt(a: f32x8, b: f32x8) -> f32x8 {
+    a.simd_lt(b)
+}
+
+/// `a <= b` per lane.
+#[inline]
+pub fn le(a: f32x8, b: f32x8) -> f32x8 {
+    a.simd_le(b)
+}
+
+/// The lanes of `mask` as bits, lane k as bit k.
+#[inline]
+pub fn bits(mask: f32x8) -> u32 {
+    mask.to_bitmask()
+}
+
+/// The mask of the first `n` lanes.
+#[inline]
+pub fn first_lanes(n: usize) -> f32x8 {
+    const INDEX: f32x8 = f32x8::new([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+    INDEX.simd_lt(f32x8::splat(n as f32))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lanes(f: impl Fn(usize) -> Vec3) -> Vec3x8 {
+        let v: [Vec3; LANES] = std::array::from_fn(f);
+        Vec3x8 {
+            x: f32x8::new(v.map(|v| v.x)),
+            y: f32x8::new(v.map(|v| v.y)),
+            z: f32x8::new(v.map(|v| v.z)),
+        }
+    }
+
+    /// Awkward values: tiny, huge, negative zero, zero vectors and NaN.
+    fn sample(k: usize, salt: f32) -> Vec3 {
+        let t = k as f32 + salt;
+        match k {
+            0 => Vec3::ZERO,
+            1 => Vec3::new(-0.0, 1e-30, 1e30),
+            2 => Vec3::new(f32::NAN, 1.0, 2.0),
+            _ => Vec3::new(t.sin() * 3.7, (t * 1.3).cos() / 7.0, t.sqrt() - 1.1),
+        }
+    }
+
+    #[test]
+    fn every_lane_is_the_scalar_result_bit_for_bit() {
+        let a = lanes(|k| sample(k, 0.25));
+        let b = lanes(|k| sample(k, 0.75));
+        let s = f32x8::new(std::array::from_fn(|k| sample(k, 0.5).z));
+        let (unit, ok) = a.try_normalize();
+        let zero = (a - a).is_zero();
+        for k in 0..LANES {
+            let (sa, sb) = (sample(k, 0.25), sample(k, 0.75));
+            let same = |x: f32, y: f32| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan());
+            assert!(same(a.dot(&b).as_array()[k], sa.dot(sb)), "dot, lane {k}");
+            assert!(same(a.dot_splat(sb).as_array()[k], sa.dot(sb)));
+            let scaled = a.scale(s).lane(k);
+            let expected = sa * s.as_array()[k];
+            for axis in 0..3 {
+                assert!(same(scaled[axis], expected[axis]), "scale, lane {k}");
+                assert!(same((a - b).lane(k)[axis], (sa - sb)[axis]));
+                assert!(same((a + b).lane(k)[axis], (sa + sb)[axis]));
+                assert!(same(a.cross_splat(sb).lane(k)[axis], sa.cross(sb)[axis]));
+                assert!(same(
+                    Vec3x8::splat_cross(sb, &a).lane(k)[axis],
+                    sb.cross(sa)[axis]
+                ));
+            }
+            match sa.try_normalize() {
+                Some(n) => {
+                    assert!(ok.as_array()[k] != 0.0, "normalize ok, lane {k}");
+                    assert_eq!(unit.lane(k), n);
+                }
+                None => assert!(ok.as_array()[k] == 0.0, "normalize fails, lane {k}"),
+            }
+            assert_eq!(bits(zero) >> k & 1 == 1, (sa - sa) == Vec3::ZERO);
+        }
+        assert_eq!(bits(first_lanes(3)), 0b111);
+        assert_eq!(bits(first_lanes(8)), 0xff);
+    }
+}

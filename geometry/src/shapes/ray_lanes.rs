@@ -1,0 +1,158 @@
+//! One shape against eight rays at once ([`RayLanes`]): the shadow rays of one
+//! shading point, which all meet the same few shapes.
+//!
+//! [`SpherePacket`](super::SpherePacket) puts four shapes in lanes against one
+//! ray; this puts eight rays in lanes against one shape. As there, every lane
+//! performs exactly the IEEE operations of the scalar test
+//! ([`Sphere::hit_distance`], [`Parallelogram::hit_distance`]) in the same order,
+//! so a lane's verdict is bit for bit the scalar test's.
+
+use super::{Parallelogram, Sphere};
+use crate::lanes::{self, f32x8, Vec3x8};
+use crate::Ray;
+
+/// Eight rays, `origin + t·direction` in each lane.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RayLanes {
+    pub origin: Vec3x8,
+    pub direction: Vec3x8,
+}
+
+impl RayLanes {
+    /// Lane `lane` as a scalar ray.
+    #[inline]
+    pub fn lane(&self, lane: usize) -> Ray {
+        Ray::new(self.origin.lane(lane), self.direction.lane(lane))
+    }
+}
+
+/// Whether `t` lies in (0, t_max), per lane.
+#[inline(always)]
+fn in_range(t: f32x8, t_max: f32x8) -> f32x8 {
+    lanes::gt(t, f32x8::ZERO) & lanes::lt(t, t_max)
+}
+
+impl Sphere {
+    /// The lanes (bit k for lane k) whose ray [`Self::hit_distance`] finds a hit
+    /// in (0, `t_max`): the same verdict, bit for bit, as the scalar test's.
+    #[inline]
+    pub fn hits_lanes(&self, rays: &RayLanes, t_max: f32) -> u32 {
+        let zero = f32x8::ZERO;
+        let d = &rays.direction;
+        let f = rays.origin.sub_splat(self.center);
+        let b = f.dot(d);
+        let r2 = f32x8::splat(self.radius * self.radius);
+        let c = f.dot(&f) - r2;
+        let receding = lanes::gt(c, zero) & lanes::gt(b, zero);
+        let a = d.dot(d);
+        let perpendicular = f - d.scale(b / a);
+        let disc = a * (r2 - perpendicular.dot(&perpendicular));
+        let missed = receding | lanes::lt(disc, zero);
+        let q = -(b + b.signum() * disc.sqrt());
+        // q = 0: the roots ±√(−c/a).
+        let h = (-c / a).max(zero).sqrt();
+        let (x, y) = (c / q, q / a);
+        let q_zero = q.simd_eq(zero);
+        let t0 = q_zero.select(-h, x.min(y));
+        let t1 = q_zero.select(h, x.max(y));
+        let t_max = f32x8::splat(t_max);
+        let hit = (in_range(t0, t_max) | in_range(t1, t_max)) & !missed;
+        lanes::bits(hit)
+    }
+}
+
+impl Parallelogram {
+    /// The lanes whose ray [`Self::hit_distance`] finds a hit in (0, `t_max`),
+    /// as [`Sphere::hits_lanes`] for spheres.
+    #[inline]
+    pub fn hits_lanes(&self, rays: &RayLanes, t_max: f32) -> u32 {
+        let zero = f32x8::ZERO;
+        let one = f32x8::ONE;
+        let denom = rays.direction.dot_splat(self.normal);
+        let mut facing_away = denom.simd_eq(zero);
+        if !self.two_sided {
+            facing_away |= lanes::gt(denom, zero);
+        }
+        let t = Vec3x8::splat_sub(self.origin, &rays.origin).dot_splat(self.normal) / denom;
+        // ray.at(t) = o + t·d, then its edge coordinates α, β.
+        let local = (rays.origin + rays.direction.scale(t)).sub_splat(self.origin);
+        let alpha = local.cross_splat(self.edge2).dot_splat(self.w);
+        let beta = Vec3x8::splat_cross(self.edge1, &local).dot_splat(self.w);
+        let within = |x: f32x8| x.simd_ge(zero) & x.simd_le(one);
+        let hit = in_range(t, f32x8::splat(t_max)) & within(alpha) & within(beta) & !facing_away;
+        lanes::bits(hit)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::test_support::XorShift;
+    use glam::Vec3;
+
+    fn rays_from(origin: Vec3, targets: [Vec3; 8]) -> RayLanes {
+        let directions = targets.map(|t| t - origin);
+        RayLanes {
+            origin: Vec3x8::splat(origin),
+            direction: Vec3x8 {
+                x: f32x8::new(directions.map(|d| d.x)),
+                y: f32x8::new(directions.map(|d| d.y)),
+                z: f32x8::new(directions.map(|d| d.z)),
+            },
+        }
+    }
+
+    /// Every lane agrees with the scalar test, on random rays (origins inside
+    /// and outside, grazing and tangent ones included by volume).
+    #[test]
+    fn lanes_agree_with_the_scalar_tests() {
+        let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
+        let mut hits = 0;
+        for round in 0..3000 {
+            let sphere = Sphere::new(rng.vec3(-3.0, 3.0), 0.2 + 2.0 * rng.unit()).unwrap();
+            let wall = Parallelogram::new(
+                rng.vec3(-3.0, 3.0),
+                rng.vec3(-4.0, 4.0),
+                rng.vec3(-4.0, 4.0),
+                round % 2 == 0,
+            )
+            .unwrap();
+            let origin = rng.vec3(-5.0, 5.0);
+            let rays = rays_from(origin, std::array::from_fn(|_| rng.vec3(-3.0, 3.0)));
+            let t_max = if rng.unit() < 0.5 {
+                f32::INFINITY
+            } else {
+                2.0 * rng.unit()
+            };
+            let (spheres, walls) = (
+                sphere.hits_lanes(&rays, t_max),
+                wall.hits_lanes(&rays, t_max),
+            );
+            for k in 0..8 {
+                let ray = rays.lane(k);
+                assert_eq!(
+                    spheres >> k & 1 == 1,
+                    sphere.hit_distance(&ray, t_max).is_some()
+                );
+                assert_eq!(
+                    walls >> k & 1 == 1,
+                    wall.hit_distance(&ray, t_max).is_some()
+                );
+            }
+            hits += spheres.count_ones() + walls.count_ones();
+        }
+        assert!(hits > 3000, "the test rays hit something ({hits} hits)");
+    }
+
+    #[test]
+    fn rays_from_a_sphere_s_centre_hit_it_and_nan_rays_nothing() {
+        let sphere = Sphere::new(Vec3::ZERO, 2.0).unwrap();
+        let rays = rays_from(
+            Vec3::ZERO,
+            std::array::from_fn(|k| Vec3::new(1.0, k as f32, 0.5)),
+        );
+        assert_eq!(sphere.hits_lanes(&rays, f32::INFINITY), 0xff);
+        let nan = rays_from(Vec3::NAN, [Vec3::X; 8]);
+        assert_eq!(sphere.hits_lanes(&nan, f32::INFINITY), 0);
+    }
+}

@@ -1,0 +1,286 @@
+//! A shading point's samples of one area light, shaded eight at a time.
+//!
+//! For N samples of an area light, the integrator sums, over the samples that
+//! face the point, the Phong reflection of each unoccluded one (report section
+//! 2.5). Sample by sample the work is a chain of dependent steps (the light
+//! point, the direction and its square root, the Phong lobe, the shadow ray's
+//! origin), each waiting on the last. [`ShadingPoint::area_light_sum`] runs the
+//! chain on eight samples at once in SIMD lanes ([`Vec3x8`]) and traces the
+//! shadow rays of the lanes that need one. Every lane does the scalar path's
+//! operations in its order, and the sum is taken sample by sample in the same
+//! order, so the result and the counts are those of
+//! [`ShadingPoint::area_light_sum_one_by_one`], bit for bit (the tests compare
+//! them).
+
+use crate::direct::{SampleContext, ShadingPoint};
+use crate::Scene;
+use glam::{Vec2, Vec3};
+use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
+use glint_geometry::{offset_ray_origin, Occluders, RayLanes, SHADOW_EPSILON};
+use glint_lighting::AreaLight;
+
+/// From this many samples per light on, the samples are shaded in lanes; below
+/// it, one by one (the same result: the lanes only cost more for one sample).
+pub(crate) const LANES_FROM_SAMPLES: usize = 2;
+
+impl ShadingPoint<'_> {
+    /// The sum over `samples` (coordinates on `light`) of the point's Phong
+    /// reflection of each light point that shines on it and is not blocked
+    /// (testing only `occluders`), before the light's colour and the average.
+    pub(crate) fn area_light_sum(
+        &self,
+        scene: &Scene,
+        light: &AreaLight,
+        samples: &[Vec2],
+        occluders: &Occluders,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        if samples.len() < LANES_FROM_SAMPLES {
+            return self.area_light_sum_one_by_one(scene, light, samples, occluders, ctx);
+        }
+        let point = self.hit.point;
+        let normal = self.hit.geometric_normal;
+        // A shadow ray leaves from the side of the surface its target is on: one of
+        // two offset origins, the same for all of the point's samples.
+        let origins = [
+            Vec3x8::splat(offset_ray_origin(point, normal)),
+            Vec3x8::splat(offset_ray_origin(point, -normal)),
+        ];
+        let mut sum = Vec3::ZERO;
+        for chunk in samples.chunks(LANES) {
+            let (ux, uy) = gather(chunk);
+            let position = light.sample_points(ux, uy);
+            let towards = position.sub_splat(point);
+            let (l, normalized) = towards.try_normalize();
+            let reflected = self.material.reflect_lanes(
+                self.kd,
+                self.ks,
+                self.n,
+                &l,
+                self.v,
+                self.has_specular,
+            );
+            let used = lanes::bits(lanes::first_lanes(chunk.len()));
+            let lit = used & lanes::bits(light.illuminates_lanes(&position, point));
+            let above = lanes::bits(lanes::gt(l.dot_splat(self.ng), f32x8::ZERO));
+            let shaded = lit & lanes::bits(normalized) & above;
+            let traced = shaded & !lanes::bits(reflected.is_zero());
+            let from_back = lanes::lt(towards.dot_splat(normal), f32x8::ZERO);
+            self.count(ctx, used, lit, normalized, shaded, traced);
+            let origin = Vec3x8::select(from_back, &origins[1], &origins[0]);
+            let shadow_rays = RayLanes {
+                origin,
+                direction: position - origin,
+            };
+            let blocked =
+                scene
+                    .shapes
+                    .any_hits_among(occluders, &shadow_rays, 1.0 - SHADOW_EPSILON, traced);
+            let visible = traced & !blocked;
+            for k in 0..chunk.len() {
+                if lit >> k & 1 == 1 {
+                    sum += if visible >> k & 1 == 1 {
+                        reflected.lane(k)
+                    } else {
+                        Vec3::ZERO
+                    };
+                }
+            }
+        }
+        sum
+    }
+
+    /// Adds one chunk's lanes to the counts, as the scalar path counts them.
+    fn count(
+        &self,
+        ctx: &mut SampleContext,
+        used: u32,
+        lit: u32,
+        normalized: f32x8,
+        shaded: u32,
+        traced: u32,
+    ) {
+        let counters = &mut ctx.counters;
+        let ones = |bits: u32| bits.count_ones() as u64;
+        counters.skipped_behind_light += ones(used & !lit);
+        counters.skipped_behind_surface += ones(lit & lanes::bits(normalized) & !shaded);
+        if self.has_specular {
+            counters.specular_lobes += ones(shaded);
+        }
+        counters.skipped_zero_brdf += ones(shaded & !traced);
+        counters.light_shadow_rays += ones(traced);
+    }
+
+    /// [`Self::area_light_sum`] one sample at a time.
+    pub(crate) fn area_light_sum_one_by_one(
+        &self,
+        scene: &Scene,
+        light: &AreaLight,
+        samples: &[Vec2],
+        occluders: &Occluders,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let mut sum = Vec3::ZERO;
+        for &u in samples {
+            let position = light.sample_point(u);
+            if light.illuminates(position, self.hit.point) {
+                sum += self.unoccluded_reflection(scene, position, occluders, ctx);
+            } else {
+                ctx.counters.skipped_behind_light += 1;
+            }
+        }
+        sum
+    }
+}
+
+/// Up to eight sample coordinates as x and y lanes (unused lanes 0).
+#[inline]
+fn gather(chunk: &[Vec2]) -> (f32x8, f32x8) {
+    let coordinate = |axis: usize| {
+        f32x8::new(std::array::from_fn(|k| {
+            chunk.get(k).map_or(0.0, |u| u[axis])
+        }))
+    };
+    (coordinate(0), coordinate(1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{SceneBuilder, SurfaceKind};
+    use glam::UVec2;
+    use glint_camera::Camera;
+    use glint_geometry::{Parallelogram, Ray, Sphere};
+    use glint_lighting::{Light, PhongMaterial, SpecularLobe};
+    use glint_texture::{TexCoord, Texture};
+    use rand_core::RngCore;
+
+    /// A floor, a ceiling above the light (behind its one emitting side), a
+    /// sphere between them and a one-sided light, in materials `material`.
+    fn scene(material: PhongMaterial) -> crate::Scene {
+        let mut b = SceneBuilder::new();
+        let m = b.material(material);
+        let floor = Parallelogram::new(
+            Vec3::new(-4.0, 0.0, -6.0),
+            Vec3::Z * 8.0,
+            Vec3::X * 8.0,
+            false,
+        )
+        .unwrap()
+        .facing(Vec3::Y);
+        let ceiling = Parallelogram::new(
+            Vec3::new(-4.0, 4.0, -6.0),
+            Vec3::X * 8.0,
+            Vec3::Z * 8.0,
+            false,
+        )
+        .unwrap()
+        .facing(-Vec3::Y);
+        b.shape(floor, m)
+            .shape(ceiling, m)
+            .shape(Sphere::new(Vec3::new(0.3, 1.0, -2.0), 0.6).unwrap(), m);
+        let light = AreaLight::new(Vec3::new(0.0, 3.0, -2.0), Vec3::X, Vec3::Z, Vec3::ONE).unwrap();
+        b.area_light(light.facing(-Vec3::Y));
+        let camera = Camera::new(
+            Vec3::new(0.0, 2.0, 4.0),
+            Vec3::new(0.0, 1.0, -2.0),
+            Vec3::Y,
+            60.0,
+            1.0,
+            UVec2::new(8, 8),
+        )
+        .unwrap();
+        b.build(camera).unwrap()
+    }
+
+    #[test]
+    fn eight_lanes_give_the_one_by_one_sum_and_counts_bit_for_bit() {
+        let materials = [
+            PhongMaterial::new(Vec3::new(0.7, 0.4, 0.2), 16.0),
+            PhongMaterial::new(Vec3::new(0.7, 0.4, 0.2), 7.5),
+            PhongMaterial {
+                lobe: SpecularLobe::BlinnPhong,
+                ..PhongMaterial::new(Vec3::new(0.2, 0.4, 0.9), 40.0)
+            },
+            PhongMaterial {
+                specular: Some(Texture::Constant(Vec3::ZERO)),
+                ..PhongMaterial::new(Vec3::splat(0.5), 1.0)
+            },
+            // Black: every lane's reflection is zero, and no shadow ray is traced.
+            PhongMaterial {
+                specular: Some(Texture::Constant(Vec3::ZERO)),
+                ..PhongMaterial::new(Vec3::ZERO, 1.0)
+            },
+        ];
+        let mut rng = crate::sampling::pixel_rng(7, 0, 0);
+        let mut uniform = || (rng.next_u32() >> 8) as f32 / (1 << 24) as f32;
+        let mut compared = 0;
+        let mut total = crate::ShadingCounters::default();
+        for material in materials {
+            let scene = scene(material);
+            let Light::Area(light) = &scene.lights[0] else {
+                unreachable!()
+            };
+            for _ in 0..60 {
+                // Rays from inside the room towards the floor, ceiling and sphere.
+                let origin = Vec3::new(
+                    uniform() * 4.0 - 2.0,
+                    0.5 + uniform() * 3.0,
+                    uniform() * 2.0 - 3.0,
+                );
+                let direction = Vec3::new(uniform() - 0.5, uniform() * 2.0 - 1.0, uniform() - 0.5);
+                let ray = Ray::new(origin, direction);
+                let Some(hit) = scene.shapes.closest_hit(&ray, f32::INFINITY) else {
+                    continue;
+                };
+                let SurfaceKind::Material(material) = scene.surface_of(&hit) else {
+                    continue;
+                };
+                let point = ShadingPoint::new(&hit, material, &ray, &TexCoord::point(hit.uv));
+                for n in [1usize, 2, 7, 8, 9, 16, 19] {
+                    let mut samples: Vec<Vec2> =
+                        (0..n).map(|_| Vec2::new(uniform(), uniform())).collect();
+                    samples[0] = Vec2::ZERO; // a corner, exactly
+                    let culled = scene.shapes.occluders_towards(
+                        hit.point,
+                        &light.surface().corners(),
+                        [hit.shape, scene.light_objects[0]],
+                    );
+                    for occluders in [Occluders::ALL, culled] {
+                        let mut lanes = SampleContext::new(0, 0);
+                        let mut scalar = SampleContext::new(0, 0);
+                        let a =
+                            point.area_light_sum(&scene, light, &samples, &occluders, &mut lanes);
+                        let b = point.area_light_sum_one_by_one(
+                            &scene,
+                            light,
+                            &samples,
+                            &occluders,
+                            &mut scalar,
+                        );
+                        assert_eq!(
+                            a.to_array().map(f32::to_bits),
+                            b.to_array().map(f32::to_bits),
+                            "{n} samples at {}",
+                            hit.point
+                        );
+                        assert_eq!(
+                            lanes.counters, scalar.counters,
+                            "{n} samples at {}",
+                            hit.point
+                        );
+                        compared += 1;
+                        total += scalar.counters;
+                    }
+                }
+            }
+        }
+        // Every branch was taken: lanes behind the light, below the horizon, with
+        // zero reflection, and traced.
+        assert!(compared > 1000, "only {compared} comparisons");
+        assert!(total.skipped_behind_light > 0, "{total:?}");
+        assert!(total.skipped_behind_surface > 0, "{total:?}");
+        assert!(total.skipped_zero_brdf > 0, "{total:?}");
+        assert!(total.light_shadow_rays > 0, "{total:?}");
+    }
+}

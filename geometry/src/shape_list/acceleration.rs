@@ -1,22 +1,29 @@
-//! The acceleration structure of a [`ShapeList`]: a BVH over every bounded
-//! primitive (each analytic shape, each triangle), with the primitives stored in
-//! the BVH's leaf order and each leaf's triangles as one four-lane packet.
+//! The acceleration structure of a [`ShapeList`]: a BVH over the bounded
+//! primitives (each analytic shape, each triangle; or, beside the linear
+//! layout's packets of spheres and parallelograms, the others), with the
+//! primitives stored in the BVH's leaf order and each leaf's triangles as one
+//! four-lane packet.
 
 use super::{LinearShapes, Object, Primitive, ShapeList};
 use crate::bvh::{Bounds3, Bvh, BvhStats, LEAF_WIDTH};
 use crate::counters::count;
 use crate::triangle::WatertightRay;
-use crate::{Ray, TrianglePacket};
+use crate::{Ray, Shape, TrianglePacket};
 use glam::Vec4;
 
 /// Below this many primitives [`ShapeList::build_acceleration`] builds no BVH.
 pub const LINEAR_LIMIT: usize = 32;
 
 impl ShapeList {
-    /// Builds the BVH if the scene is large enough for it to pay: below
-    /// 32 primitives (`LINEAR_LIMIT`) the linear loop is faster (and gives the same
-    /// answers), so none is built, and spheres and parallelograms are laid out in
-    /// packets of four for it instead.
+    /// Builds what makes the scene's queries fastest, with the same answers
+    /// whichever it builds:
+    /// - below 32 primitives (`LINEAR_LIMIT`), no BVH: the linear loop, with
+    ///   spheres and parallelograms laid out in packets of four;
+    /// - with more, and at most 32 spheres and parallelograms (a mesh in a
+    ///   room, say), those in packets and a BVH over the rest. Big walls in a
+    ///   BVH would widen every box above them; in packets, shadow rays skip
+    ///   them wholesale ([`ShapeList::occluders_towards`]);
+    /// - otherwise a BVH over every bounded primitive.
     pub fn build_acceleration(&mut self) {
         let primitives: usize = self
             .objects
@@ -26,22 +33,49 @@ impl ShapeList {
                 Object::Mesh(m) => self.meshes[m as usize].triangle_count(),
             })
             .sum();
-        if primitives >= LINEAR_LIMIT {
-            self.build_bvh();
-        } else {
+        let packed = (0..self.objects.len() as u32)
+            .filter(|&o| self.packs(o))
+            .count();
+        if primitives < LINEAR_LIMIT || packed == primitives && packed <= LINEAR_LIMIT {
             self.bvh = None;
-            self.linear = Some(LinearShapes::new(self));
+            self.linear = Some(LinearShapes::new(self, true));
+        } else if packed > 0 && packed <= LINEAR_LIMIT {
+            self.build_bvh_over(|list, object| !list.packs(object));
+            self.linear = Some(LinearShapes::new(self, false));
+        } else {
+            self.build_bvh();
+        }
+    }
+
+    /// Whether object `object` goes in a packet of the linear layout: a sphere
+    /// or a parallelogram.
+    fn packs(&self, object: u32) -> bool {
+        match self.objects[object as usize] {
+            Object::Shape(s) => matches!(
+                self.shapes[s as usize],
+                Shape::Sphere(_) | Shape::Parallelogram(_)
+            ),
+            Object::Mesh(_) => false,
         }
     }
 
     /// Builds the BVH over every bounded primitive (binned SAH; see [`Bvh`]).
     pub fn build_bvh(&mut self) {
+        self.build_bvh_over(|_, _| true);
+    }
+
+    /// Builds the BVH over the bounded primitives of the objects `include`
+    /// takes, and drops the linear layout.
+    fn build_bvh_over(&mut self, include: impl Fn(&ShapeList, u32) -> bool) {
         self.linear = None;
         let mut primitives = Vec::new();
         let mut bounds = Vec::new();
         self.unbounded.clear();
         for (object, kind) in self.objects.iter().enumerate() {
             let object = object as u32;
+            if !include(self, object) {
+                continue;
+            }
             match *kind {
                 Object::Shape(s) => match self.shapes[s as usize].bounds() {
                     Some(b) => {

@@ -2,7 +2,7 @@
 //! one ray or a batch traced as an interleaved stream.
 
 use super::{LinearShapes, Object, ShapeList};
-use crate::bvh::RayStream;
+use crate::bvh::{Bvh, RayStream};
 use crate::triangle::WatertightRay;
 use crate::Ray;
 use glam::Vec3;
@@ -13,17 +13,10 @@ impl ShapeList {
     pub fn any_hit(&self, ray: &Ray, t_max: f32) -> bool {
         match &self.bvh {
             Some(bvh) => {
-                let watertight = WatertightRay::new(ray);
-                self.unbounded_hit(ray, &watertight, t_max)
-                    || bvh
-                        .traverse_leaves(ray, t_max, |first, _, t_max| {
-                            if self.leaf_occludes(first, ray, &watertight, t_max) {
-                                ControlFlow::Break(())
-                            } else {
-                                ControlFlow::Continue(t_max)
-                            }
-                        })
-                        .is_break()
+                self.linear
+                    .as_ref()
+                    .is_some_and(|linear| self.packets_hit(linear, ray, t_max))
+                    || self.bvh_hit(bvh, ray, t_max)
             }
             None if self.linear.is_some() => self.linear_any_hit(ray, t_max),
             // Without meshes the objects are the shapes, in order: the course's loop.
@@ -78,6 +71,11 @@ impl ShapeList {
         let Some(linear) = &self.linear else {
             return false;
         };
+        self.packets_hit(linear, ray, t_max) || self.others_hit(linear, ray, t_max)
+    }
+
+    /// Whether a shape of the linear layout's packets lies on the ray.
+    fn packets_hit(&self, linear: &LinearShapes, ray: &Ray, t_max: f32) -> bool {
         linear
             .spheres
             .iter()
@@ -86,7 +84,38 @@ impl ShapeList {
                 .parallelograms
                 .iter()
                 .any(|(packet, _)| packet.hit4(ray, t_max).0 != 0)
-            || self.others_hit(linear, ray, t_max)
+    }
+
+    /// Whether a primitive the BVH holds, or an unbounded plane, lies on the ray.
+    pub(super) fn bvh_hit(&self, bvh: &Bvh, ray: &Ray, t_max: f32) -> bool {
+        let watertight = WatertightRay::new(ray);
+        self.unbounded_hit(ray, &watertight, t_max)
+            || bvh
+                .traverse_leaves(ray, t_max, |first, _, t_max| {
+                    if self.leaf_occludes(first, ray, &watertight, t_max) {
+                        ControlFlow::Break(())
+                    } else {
+                        ControlFlow::Continue(t_max)
+                    }
+                })
+                .is_break()
+    }
+
+    /// Whether an object outside the linear layout's packets lies on the ray:
+    /// one tested one by one, or one in the BVH beside the packets.
+    #[inline]
+    pub(super) fn rest_hit(&self, linear: &LinearShapes, ray: &Ray, t_max: f32) -> bool {
+        self.others_hit(linear, ray, t_max)
+            || self
+                .bvh
+                .as_ref()
+                .is_some_and(|bvh| self.bvh_hit(bvh, ray, t_max))
+    }
+
+    /// Whether anything outside the packets is left to test.
+    #[inline]
+    pub(super) fn has_rest(&self, linear: &LinearShapes) -> bool {
+        !linear.others.is_empty() || self.bvh.is_some()
     }
 
     /// Whether an object of the linear loop outside its packets lies on the ray.
@@ -153,7 +182,12 @@ impl RayStream for AnyHitStream<'_> {
         let (ray, t_max) = (self.rays[index], self.t_max[index]);
         search.ray = ray;
         search.watertight = WatertightRay::new(&ray);
-        search.occluded = self.list.unbounded_hit(&ray, &search.watertight, t_max);
+        search.occluded = self.list.unbounded_hit(&ray, &search.watertight, t_max)
+            || self
+                .list
+                .linear
+                .as_ref()
+                .is_some_and(|linear| self.list.packets_hit(linear, &ray, t_max));
         (!search.occluded).then_some((ray, t_max))
     }
 

@@ -60,7 +60,7 @@ impl ShapeList {
         let mut search = ClosestSearch::new(ray, t_max);
         match &self.bvh {
             Some(bvh) => {
-                search.test_unbounded(self);
+                search.test_outside_bvh(self);
                 let _ = bvh.traverse_leaves(ray, search.limit(), |first, _, _| {
                     ControlFlow::Continue(search.visit_leaf(self, first))
                 });
@@ -214,10 +214,14 @@ impl ClosestSearch {
         }
     }
 
-    /// Tests the primitives the BVH leaves out: unbounded planes.
-    fn test_unbounded(&mut self, list: &ShapeList) {
+    /// Tests the primitives the BVH leaves out: unbounded planes, and the
+    /// spheres and parallelograms of the linear layout's packets beside it.
+    fn test_outside_bvh(&mut self, list: &ShapeList) {
         for p in list.unbounded_primitives() {
             self.test(list, p);
+        }
+        if let Some(linear) = &list.linear {
+            self.test_linear(list, linear);
         }
     }
 
@@ -268,7 +272,7 @@ impl RayStream for ClosestStream<'_> {
     fn begin(&self, index: usize, search: &mut ClosestSearch) -> Option<(Ray, f32)> {
         let ray = &self.rays[index];
         *search = ClosestSearch::new(ray, self.t_max[index]);
-        search.test_unbounded(self.list);
+        search.test_outside_bvh(self.list);
         Some((*ray, search.limit()))
     }
 

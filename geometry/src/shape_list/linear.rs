@@ -28,7 +28,9 @@ pub(super) struct LinearShapes {
 }
 
 impl LinearShapes {
-    pub(super) fn new(list: &ShapeList) -> Self {
+    /// The packets of `list`'s spheres and parallelograms, and with `others`
+    /// its other objects to be tested one by one (without, a BVH holds them).
+    pub(super) fn new(list: &ShapeList, with_others: bool) -> Self {
         let mut spheres = Vec::new();
         let mut parallelograms = Vec::new();
         let mut others = Vec::new();
@@ -42,6 +44,9 @@ impl LinearShapes {
                 },
                 Object::Mesh(_) => others.push(object),
             }
+        }
+        if !with_others {
+            others.clear();
         }
         let mut flat_bits = vec![None; list.objects.len()];
         let first_flat = 4 * spheres.len().div_ceil(4);

@@ -67,7 +67,10 @@ impl Primitive {
 /// triangle in [`Hit::primitive`](crate::Hit::primitive). After [`ShapeList::build_bvh`], bounded
 /// primitives (each shape, each triangle) are found through a BVH and only
 /// unbounded planes are tested one by one; before it, every object is tested in
-/// turn (the course's linear loop), with the same answers. Batches of rays can be
+/// turn (the course's linear loop), with the same answers.
+/// [`ShapeList::build_acceleration`] chooses between them, and for a mesh in a
+/// room of a few walls and spheres, keeps those in packets beside a BVH over the
+/// mesh. Batches of rays can be
 /// handed over at once ([`ShapeList::closest_primitives`], [`ShapeList::any_hits`]),
 /// to be traced several at a time.
 #[derive(Clone, Debug, Default)]
@@ -86,7 +89,8 @@ pub struct ShapeList {
     /// …and per leaf, the lanes holding analytic shapes, tested one by one.
     shape_lanes: Vec<u8>,
     unbounded: Vec<u32>,
-    /// The linear loop's packets, when [`ShapeList::build_acceleration`] chose it.
+    /// The linear loop's packets, when [`ShapeList::build_acceleration`] chose
+    /// it (alone, or beside a BVH over the objects not in packets).
     linear: Option<LinearShapes>,
 }
 

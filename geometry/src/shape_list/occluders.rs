@@ -20,7 +20,7 @@ use glam::{Vec3, Vec4};
 /// The shapes of a [`ShapeList`] that may block shadow rays from one point to one
 /// light: bit `4k + lane` for lane `lane` of the linear loop's packet `k` (sphere
 /// packets, then parallelogram packets). Objects outside the packets (planes,
-/// boxes, meshes), and every object of a list with a BVH, are always tested.
+/// boxes, meshes, whatever a BVH holds) are always tested.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Occluders {
     lanes: u64,
@@ -129,7 +129,7 @@ impl ShapeList {
                 let lanes = occluders.packet(spheres + k);
                 lanes != 0 && packet.hit4(ray, t_max).0 & lanes != 0
             })
-            || self.others_hit(linear, ray, t_max)
+            || self.rest_hit(linear, ray, t_max)
     }
 }
 
@@ -179,12 +179,12 @@ impl ShapeList {
                 }
             }
         }
-        if linear.others.is_empty() {
+        if !self.has_rest(linear) {
             return blocked;
         }
         blocked
             | self.lane_by_lane(active & !blocked, |lane| {
-                self.others_hit(linear, &rays.lane(lane), t_max)
+                self.rest_hit(linear, &rays.lane(lane), t_max)
             })
     }
 

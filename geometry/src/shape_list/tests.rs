@@ -92,6 +92,59 @@ mod bvh_agreement {
         TriangleMesh::new(positions, indices, vec![], vec![]).unwrap()
     }
 
+    /// Even scenes: a BVH over everything; odd ones: what
+    /// `build_acceleration` builds for them, spheres and parallelograms in
+    /// packets beside a BVH over the rest.
+    fn build(list: &mut ShapeList, scene: u32) {
+        if scene % 2 == 0 {
+            list.build_bvh();
+        } else {
+            list.build_acceleration();
+            assert!(
+                list.bvh.is_some() && list.linear.is_some(),
+                "packets and a BVH"
+            );
+        }
+    }
+
+    #[test]
+    fn shadow_rays_among_culled_occluders_get_the_full_answer_beside_a_bvh() {
+        let mut rng = Rng(0x51_7cc1_b727_220a);
+        let mut blocked = 0;
+        for _ in 0..20 {
+            let mut list = random_scene(&mut rng);
+            list.build_acceleration();
+            for _ in 0..50 {
+                let from = rng.in_cube(6.0);
+                let (corner, e1, e2) = (rng.in_cube(5.0), rng.in_cube(2.0), rng.in_cube(2.0));
+                let corners = [corner, corner + e1, corner + e1 + e2, corner + e2];
+                let occluders = list.occluders_towards(from, &corners, [u32::MAX; 2]);
+                let targets: [Vec3; 8] =
+                    std::array::from_fn(|_| corner + rng.next() * e1 + rng.next() * e2);
+                let rays = targets.map(|t| Ray::new(from, t - from));
+                let lanes = crate::RayLanes {
+                    origin: crate::lanes::Vec3x8::splat(from),
+                    direction: crate::lanes::Vec3x8 {
+                        x: crate::lanes::f32x8::new(rays.map(|r| r.direction.x)),
+                        y: crate::lanes::f32x8::new(rays.map(|r| r.direction.y)),
+                        z: crate::lanes::f32x8::new(rays.map(|r| r.direction.z)),
+                    },
+                };
+                let t_max = 1.0 - crate::SHADOW_EPSILON;
+                let active = 0b1011_1111;
+                let lanes_blocked = list.any_hits_among(&occluders, &lanes, t_max, active);
+                for (k, ray) in rays.iter().enumerate() {
+                    let alone = list.any_hit(ray, t_max);
+                    assert_eq!(list.any_hit_among(&occluders, ray, t_max), alone);
+                    let expected = alone && active >> k & 1 == 1;
+                    assert_eq!(lanes_blocked >> k & 1 == 1, expected, "lane {k}");
+                    blocked += expected as u32;
+                }
+            }
+        }
+        assert!(blocked > 100, "only {blocked} blocked rays");
+    }
+
     fn random_scene(rng: &mut Rng) -> ShapeList {
         let mut list = ShapeList::new();
         for _ in 0..20 {
@@ -133,10 +186,10 @@ mod bvh_agreement {
     #[test]
     fn bvh_and_brute_force_agree_on_random_rays_over_random_scenes() {
         let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-        for _ in 0..20 {
+        for scene in 0..40 {
             let linear = random_scene(&mut rng);
             let mut accelerated = linear.clone();
-            accelerated.build_bvh();
+            build(&mut accelerated, scene);
             for _ in 0..500 {
                 let origin = rng.in_cube(8.0);
                 let toward = rng.in_cube(5.0);
@@ -187,7 +240,7 @@ mod bvh_agreement {
                     .push(Plane::new(rng.in_cube(4.0), rng.in_cube(1.0), scene % 4 == 0).unwrap());
             }
             let mut accelerated = linear.clone();
-            accelerated.build_bvh();
+            build(&mut accelerated, scene);
             let mut rays: Vec<Ray> = (0..300)
                 .map(|_| {
                     let origin = rng.in_cube(8.0);

@@ -88,7 +88,22 @@ impl DirectIntegrator {
         depth: u32,
         ctx: &mut SampleContext,
     ) -> Vec3 {
-        let Some(hit) = scene.shapes.closest_hit(ray, f32::INFINITY) else {
+        let hit = scene.shapes.closest_hit(ray, f32::INFINITY);
+        self.li_at(scene, ray, diff, hit, depth, ctx)
+    }
+
+    /// [`Self::li`] for a ray whose closest hit is already found: `hit`, or
+    /// `None` for a miss.
+    pub fn li_at(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        diff: &RayDifferential,
+        hit: Option<Hit>,
+        depth: u32,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let Some(hit) = hit else {
             return match &scene.environment {
                 Some(env) => {
                     ctx.counters.environment_lookups += 1;

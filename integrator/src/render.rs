@@ -4,7 +4,8 @@ use crate::sampling::{pixel_rng, SamplePattern, SobolPoints, PIXEL_STREAM};
 use crate::{Aov, DirectIntegrator, Scene};
 use glam::{Vec2, Vec3};
 use glint_camera::{Camera, Film};
-use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential};
+use glint_geometry::lanes::{f32x8, Vec3x8, LANES};
+use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential, RayLanes};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -293,24 +294,41 @@ fn render_rows(
             .pixel_pattern
             .fill(&mut rng, sobol, &mut pixel_samples);
         let mut sum = Vec3::ZERO;
-        for (sample, jitter) in pixel_samples.iter().enumerate() {
-            ctx.begin_sample(settings.seed, pixel, sample as u64);
-            let raster = Vec2::new(x as f32, y as f32) + *jitter;
-            let (ray, diff) = if differentials {
-                camera_ray(&scene.camera, raster, footprint_scale)
-            } else {
-                let c = scene.camera.generate_ray(raster.x, raster.y);
-                let ray = Ray::new(c.origin, c.direction);
-                (ray, RayDifferential::none(&ray))
-            };
-            let value = match settings.aov {
-                None => integrator.li(scene, &ray, &diff, 0, &mut ctx),
-                Some(aov) => aov.evaluate(scene, &ray, &diff, settings.max_depth),
-            };
-            if value.is_finite() {
-                sum += value;
-            } else {
-                ctx.counters.nonfinite_samples += 1;
+        for (chunk, jitters) in pixel_samples.chunks(LANES).enumerate() {
+            let rays: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
+                let raster = Vec2::new(x as f32, y as f32) + jitters[k.min(jitters.len() - 1)];
+                if differentials {
+                    camera_ray(&scene.camera, raster, footprint_scale)
+                } else {
+                    let c = scene.camera.generate_ray(raster.x, raster.y);
+                    let ray = Ray::new(c.origin, c.direction);
+                    (ray, RayDifferential::none(&ray))
+                }
+            });
+            // Several camera rays at once: their closest hits one shape against
+            // all of them, where the scene's layout allows it (the same hits).
+            let hits = (settings.aov.is_none() && jitters.len() > 1)
+                .then(|| {
+                    scene
+                        .shapes
+                        .closest_primitives_lanes(&lanes_of(&rays), jitters.len())
+                })
+                .flatten();
+            for (k, (ray, diff)) in rays.iter().take(jitters.len()).enumerate() {
+                ctx.begin_sample(settings.seed, pixel, (chunk * LANES + k) as u64);
+                let value = match (settings.aov, &hits) {
+                    (None, Some(hits)) => {
+                        let hit = hits[k].and_then(|found| scene.shapes.surface_record(ray, found));
+                        integrator.li_at(scene, ray, diff, hit, 0, &mut ctx)
+                    }
+                    (None, None) => integrator.li(scene, ray, diff, 0, &mut ctx),
+                    (Some(aov), _) => aov.evaluate(scene, ray, diff, settings.max_depth),
+                };
+                if value.is_finite() {
+                    sum += value;
+                } else {
+                    ctx.counters.nonfinite_samples += 1;
+                }
             }
         }
         *radiance = sum / settings.spp as f32;
@@ -323,6 +341,20 @@ fn render_rows(
             QueryCounters::default()
         },
         textures: ctx.textures,
+    }
+}
+
+/// The rays of `rays` in SIMD lanes.
+fn lanes_of(rays: &[(Ray, RayDifferential); LANES]) -> RayLanes {
+    let axis = |of: fn(&Ray) -> Vec3, i: usize| f32x8::new(rays.each_ref().map(|(r, _)| of(r)[i]));
+    let vectors = |of: fn(&Ray) -> Vec3| Vec3x8 {
+        x: axis(of, 0),
+        y: axis(of, 1),
+        z: axis(of, 2),
+    };
+    RayLanes {
+        origin: vectors(|r| r.origin),
+        direction: vectors(|r| r.direction),
     }
 }
 

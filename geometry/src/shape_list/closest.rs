@@ -3,11 +3,14 @@
 //! exactly equal distances go to the lowest (object, triangle), with or without
 //! the BVH.
 
-use super::{LinearShapes, Object, Primitive, ShapeList};
+use super::{LinearShapes, Object, ObjectRef, Primitive, ShapeList};
 use crate::bvh::RayStream;
+use crate::counters::count;
+use crate::lanes::LANES;
 use crate::prefetch::prefetch;
 use crate::triangle::WatertightRay;
 use crate::{Hit, Ray};
+use crate::{RayLanes, Shape};
 use glam::{Vec3, Vec4};
 use std::ops::ControlFlow;
 
@@ -36,7 +39,12 @@ impl ShapeList {
     /// meet) go to the lowest object index, then the lowest triangle: the same
     /// answer with or without the BVH, whatever its layout.
     pub fn closest_hit(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let found = self.closest_primitive(ray, t_max)?;
+        self.surface_record(ray, self.closest_primitive(ray, t_max)?)
+    }
+
+    /// The surface record of the hit `found` along `ray`, as
+    /// [`ShapeList::closest_hit`] reports it.
+    pub fn surface_record(&self, ray: &Ray, found: PrimitiveHit) -> Option<Hit> {
         let hit = match self.objects[found.object as usize] {
             Object::Shape(s) => Some(self.shapes[s as usize].surface_at(ray, found.t)),
             // Re-run the (same, deterministic) test for the barycentrics. Without an
@@ -71,6 +79,63 @@ impl ShapeList {
             },
         }
         search.finish(self)
+    }
+
+    /// [`ShapeList::closest_primitive`] without an upper limit for each of the
+    /// eight rays of `rays`, one shape against the eight rays at a time: the same
+    /// answers. The first `used` lanes hold real rays (the others are counted
+    /// by no `--stats` test, and their answers are to be ignored). `None` unless the list is the linear loop with every object in
+    /// its packets (spheres and parallelograms: the course's scenes), where this
+    /// pays; ask the rays one by one then.
+    pub fn closest_primitives_lanes(
+        &self,
+        rays: &RayLanes,
+        used: usize,
+    ) -> Option<[Option<PrimitiveHit>; LANES]> {
+        let tested = used.min(LANES) as u64;
+        let linear = self
+            .linear
+            .as_ref()
+            .filter(|linear| linear.others.is_empty() && self.bvh.is_none())?;
+        let mut best_t = [f32::INFINITY; LANES];
+        let mut best_object = [u32::MAX; LANES];
+        let spheres = linear.spheres.iter().map(|(_, objects)| objects);
+        let parallelograms = linear.parallelograms.iter().map(|(_, objects)| objects);
+        let used = spheres
+            .chain(parallelograms)
+            .flatten()
+            .filter(|&&o| o != u32::MAX);
+        for &object in used {
+            let (mut hits, t) = match self.object(object) {
+                ObjectRef::Shape(Shape::Sphere(s)) => {
+                    count(|c| c.sphere_tests += tested);
+                    s.hit_distance_lanes(rays, f32::INFINITY)
+                }
+                ObjectRef::Shape(Shape::Parallelogram(p)) => {
+                    count(|c| c.parallelogram_tests += tested);
+                    p.hit_distance_lanes(rays, f32::INFINITY)
+                }
+                _ => unreachable!("packets hold spheres and parallelograms"),
+            };
+            let t = t.to_array();
+            while hits != 0 {
+                let lane = hits.trailing_zeros() as usize;
+                hits &= hits - 1;
+                // The rule of `ClosestSearch::consider`: nearer, or as near and lower.
+                let (bt, bo) = (best_t[lane], best_object[lane]);
+                if t[lane] < bt || (t[lane] == bt && object < bo) {
+                    best_t[lane] = t[lane];
+                    best_object[lane] = object;
+                }
+            }
+        }
+        Some(std::array::from_fn(|lane| {
+            (best_object[lane] != u32::MAX).then(|| PrimitiveHit {
+                t: best_t[lane],
+                object: best_object[lane],
+                primitive: 0,
+            })
+        }))
     }
 
     /// [`ShapeList::closest_primitive`] for each of `rays`, with its own

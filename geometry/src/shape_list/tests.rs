@@ -306,3 +306,68 @@ mod found_hits_stay_found {
         assert!(found > 10_000);
     }
 }
+
+mod lanes {
+    use super::*;
+    use crate::bvh::test_support::XorShift;
+    use crate::lanes::{f32x8, Vec3x8};
+    use crate::{Parallelogram, RayLanes};
+
+    fn lanes_of(rays: &[Ray; 8]) -> RayLanes {
+        let axis = |f: fn(&Ray) -> Vec3| Vec3x8 {
+            x: f32x8::new(rays.each_ref().map(|r| f(r).x)),
+            y: f32x8::new(rays.each_ref().map(|r| f(r).y)),
+            z: f32x8::new(rays.each_ref().map(|r| f(r).z)),
+        };
+        RayLanes {
+            origin: axis(|r| r.origin),
+            direction: axis(|r| r.direction),
+        }
+    }
+
+    #[test]
+    fn eight_rays_at_once_find_the_hits_each_finds_alone() {
+        let mut rng = XorShift(0x0dd_b1a5_e5ba_d5ee);
+        let mut hits = 0;
+        for scene in 0..60 {
+            let mut list = ShapeList::new();
+            for k in 0..(3 + scene % 9) {
+                if k % 3 == 0 {
+                    list.push(Sphere::new(rng.vec3(-3.0, 3.0), 0.3 + rng.unit()).unwrap());
+                } else {
+                    let p = Parallelogram::new(
+                        rng.vec3(-3.0, 3.0),
+                        rng.vec3(-3.0, 3.0),
+                        rng.vec3(-3.0, 3.0),
+                        k % 2 == 0,
+                    )
+                    .unwrap();
+                    list.push(p);
+                }
+            }
+            // A duplicate of the first shape: every hit on it is a tie at equal t,
+            // which must go to the lower index.
+            let first = *list.shapes().first().unwrap();
+            list.push(first);
+            list.build_acceleration();
+            for _ in 0..40 {
+                let origin = rng.vec3(-5.0, 5.0);
+                let rays: [Ray; 8] =
+                    std::array::from_fn(|_| Ray::new(origin, rng.vec3(-3.0, 3.0) - origin));
+                let found = list.closest_primitives_lanes(&lanes_of(&rays), 8).unwrap();
+                for (ray, lane) in rays.iter().zip(found) {
+                    assert_eq!(lane, list.closest_primitive(ray, f32::INFINITY));
+                    hits += lane.is_some() as u32;
+                }
+            }
+        }
+        assert!(hits > 3000, "only {hits} hits");
+        // Layouts it does not serve: a plane outside the packets, and a BVH.
+        let rays = lanes_of(&[Ray::new(Vec3::ZERO, Vec3::X); 8]);
+        let mut list = scene();
+        list.build_acceleration();
+        assert!(list.closest_primitives_lanes(&rays, 8).is_none());
+        list.build_bvh();
+        assert!(list.closest_primitives_lanes(&rays, 8).is_none());
+    }
+}

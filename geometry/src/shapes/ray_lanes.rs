@@ -37,6 +37,13 @@ impl Sphere {
     /// in (0, `t_max`): the same verdict, bit for bit, as the scalar test's.
     #[inline]
     pub fn hits_lanes(&self, rays: &RayLanes, t_max: f32) -> u32 {
+        self.hit_distance_lanes(rays, t_max).0
+    }
+
+    /// [`Self::hit_distance`] for each lane's ray: the lanes with a hit in
+    /// (0, `t_max`), and in those lanes its distance, bit for bit the scalar one.
+    #[inline]
+    pub fn hit_distance_lanes(&self, rays: &RayLanes, t_max: f32) -> (u32, f32x8) {
         let zero = f32x8::ZERO;
         let d = &rays.direction;
         let f = rays.origin.sub_splat(self.center);
@@ -56,8 +63,9 @@ impl Sphere {
         let t0 = q_zero.select(-h, x.min(y));
         let t1 = q_zero.select(h, x.max(y));
         let t_max = f32x8::splat(t_max);
-        let hit = (in_range(t0, t_max) | in_range(t1, t_max)) & !missed;
-        lanes::bits(hit)
+        let near = in_range(t0, t_max);
+        let hit = (near | in_range(t1, t_max)) & !missed;
+        (lanes::bits(hit), near.select(t0, t1))
     }
 }
 
@@ -66,6 +74,13 @@ impl Parallelogram {
     /// as [`Sphere::hits_lanes`] for spheres.
     #[inline]
     pub fn hits_lanes(&self, rays: &RayLanes, t_max: f32) -> u32 {
+        self.hit_distance_lanes(rays, t_max).0
+    }
+
+    /// [`Self::hit_distance`] for each lane's ray, as
+    /// [`Sphere::hit_distance_lanes`] for spheres.
+    #[inline]
+    pub fn hit_distance_lanes(&self, rays: &RayLanes, t_max: f32) -> (u32, f32x8) {
         let zero = f32x8::ZERO;
         let one = f32x8::ONE;
         let denom = rays.direction.dot_splat(self.normal);
@@ -80,7 +95,7 @@ impl Parallelogram {
         let beta = Vec3x8::splat_cross(self.edge1, &local).dot_splat(self.w);
         let within = |x: f32x8| x.simd_ge(zero) & x.simd_le(one);
         let hit = in_range(t, f32x8::splat(t_max)) & within(alpha) & within(beta) & !facing_away;
-        lanes::bits(hit)
+        (lanes::bits(hit), t)
     }
 }
 
@@ -124,20 +139,20 @@ mod tests {
             } else {
                 2.0 * rng.unit()
             };
-            let (spheres, walls) = (
-                sphere.hits_lanes(&rays, t_max),
-                wall.hits_lanes(&rays, t_max),
-            );
+            let (spheres, sphere_t) = sphere.hit_distance_lanes(&rays, t_max);
+            let (walls, wall_t) = wall.hit_distance_lanes(&rays, t_max);
+            assert_eq!(spheres, sphere.hits_lanes(&rays, t_max));
+            assert_eq!(walls, wall.hits_lanes(&rays, t_max));
             for k in 0..8 {
                 let ray = rays.lane(k);
+                let lane =
+                    |bits: u32, t: f32x8| (bits >> k & 1 == 1).then(|| t.to_array()[k].to_bits());
+                let scalar = |t: Option<f32>| t.map(f32::to_bits);
                 assert_eq!(
-                    spheres >> k & 1 == 1,
-                    sphere.hit_distance(&ray, t_max).is_some()
+                    lane(spheres, sphere_t),
+                    scalar(sphere.hit_distance(&ray, t_max))
                 );
-                assert_eq!(
-                    walls >> k & 1 == 1,
-                    wall.hit_distance(&ray, t_max).is_some()
-                );
+                assert_eq!(lane(walls, wall_t), scalar(wall.hit_distance(&ray, t_max)));
             }
             hits += spheres.count_ones() + walls.count_ones();
         }

@@ -143,7 +143,7 @@ impl SobolSequence {
     }
 
     /// Points `first..first + out.len()`, eight at a time
-    /// ([`Scrambles::points`]) where eight consecutive ones share a block.
+    /// (hashed in SIMD lanes) where eight consecutive ones share a block.
     #[inline]
     pub fn fill(self, first: u64, out: &mut [Vec2]) {
         for (chunk, start) in out.chunks_mut(LANES).zip((first..).step_by(LANES)) {

@@ -66,7 +66,7 @@ impl ShadingPoint<'_> {
             let shaded = lit & lanes::bits(normalized) & above;
             let traced = shaded & !lanes::bits(reflected.is_zero());
             let from_back = lanes::lt(towards.dot_splat(normal), f32x8::ZERO);
-            self.count(ctx, used, lit, normalized, shaded, traced);
+            self.count(ctx, used, lit, lanes::bits(normalized), shaded, traced);
             let origin = Vec3x8::select(from_back, &origins[1], &origins[0]);
             let shadow_rays = RayLanes {
                 origin,
@@ -90,20 +90,21 @@ impl ShadingPoint<'_> {
         sum
     }
 
-    /// Adds one chunk's lanes to the counts, as the scalar path counts them.
+    /// Adds one chunk's lanes to the counts, as the scalar path counts them
+    /// (each argument a set of lanes, bit k for lane k).
     fn count(
         &self,
         ctx: &mut SampleContext,
         used: u32,
         lit: u32,
-        normalized: f32x8,
+        normalized: u32,
         shaded: u32,
         traced: u32,
     ) {
         let counters = &mut ctx.counters;
         let ones = |bits: u32| bits.count_ones() as u64;
         counters.skipped_behind_light += ones(used & !lit);
-        counters.skipped_behind_surface += ones(lit & lanes::bits(normalized) & !shaded);
+        counters.skipped_behind_surface += ones(lit & normalized & !shaded);
         if self.has_specular {
             counters.specular_lobes += ones(shaded);
         }

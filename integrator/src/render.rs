@@ -4,7 +4,7 @@ use crate::sampling::{pixel_rng, SamplePattern, SobolPoints, PIXEL_STREAM};
 use crate::{Aov, DirectIntegrator, Scene};
 use glam::{Vec2, Vec3};
 use glint_camera::{Camera, Film};
-use glint_geometry::lanes::{f32x8, Vec3x8, LANES};
+use glint_geometry::lanes::LANES;
 use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential, RayLanes};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -309,9 +309,10 @@ fn render_rows(
             // all of them, where the scene's layout allows it (the same hits).
             let hits = (settings.aov.is_none() && jitters.len() > 1)
                 .then(|| {
-                    scene
-                        .shapes
-                        .closest_primitives_lanes(&lanes_of(&rays), jitters.len())
+                    scene.shapes.closest_primitives_lanes(
+                        &RayLanes::new(rays.map(|(ray, _)| ray)),
+                        jitters.len(),
+                    )
                 })
                 .flatten();
             for (k, (ray, diff)) in rays.iter().take(jitters.len()).enumerate() {
@@ -341,20 +342,6 @@ fn render_rows(
             QueryCounters::default()
         },
         textures: ctx.textures,
-    }
-}
-
-/// The rays of `rays` in SIMD lanes.
-fn lanes_of(rays: &[(Ray, RayDifferential); LANES]) -> RayLanes {
-    let axis = |of: fn(&Ray) -> Vec3, i: usize| f32x8::new(rays.each_ref().map(|(r, _)| of(r)[i]));
-    let vectors = |of: fn(&Ray) -> Vec3| Vec3x8 {
-        x: axis(of, 0),
-        y: axis(of, 1),
-        z: axis(of, 2),
-    };
-    RayLanes {
-        origin: vectors(|r| r.origin),
-        direction: vectors(|r| r.direction),
     }
 }
 

@@ -122,14 +122,7 @@ mod bvh_agreement {
                 let targets: [Vec3; 8] =
                     std::array::from_fn(|_| corner + rng.next() * e1 + rng.next() * e2);
                 let rays = targets.map(|t| Ray::new(from, t - from));
-                let lanes = crate::RayLanes {
-                    origin: crate::lanes::Vec3x8::splat(from),
-                    direction: crate::lanes::Vec3x8 {
-                        x: crate::lanes::f32x8::new(rays.map(|r| r.direction.x)),
-                        y: crate::lanes::f32x8::new(rays.map(|r| r.direction.y)),
-                        z: crate::lanes::f32x8::new(rays.map(|r| r.direction.z)),
-                    },
-                };
+                let lanes = crate::RayLanes::new(rays);
                 let t_max = 1.0 - crate::SHADOW_EPSILON;
                 let active = 0b1011_1111;
                 let lanes_blocked = list.any_hits_among(&occluders, &lanes, t_max, active);
@@ -310,20 +303,7 @@ mod found_hits_stay_found {
 mod lanes {
     use super::*;
     use crate::bvh::test_support::XorShift;
-    use crate::lanes::{f32x8, Vec3x8};
     use crate::{Parallelogram, RayLanes};
-
-    fn lanes_of(rays: &[Ray; 8]) -> RayLanes {
-        let axis = |f: fn(&Ray) -> Vec3| Vec3x8 {
-            x: f32x8::new(rays.each_ref().map(|r| f(r).x)),
-            y: f32x8::new(rays.each_ref().map(|r| f(r).y)),
-            z: f32x8::new(rays.each_ref().map(|r| f(r).z)),
-        };
-        RayLanes {
-            origin: axis(|r| r.origin),
-            direction: axis(|r| r.direction),
-        }
-    }
 
     #[test]
     fn eight_rays_at_once_find_the_hits_each_finds_alone() {
@@ -354,7 +334,9 @@ mod lanes {
                 let origin = rng.vec3(-5.0, 5.0);
                 let rays: [Ray; 8] =
                     std::array::from_fn(|_| Ray::new(origin, rng.vec3(-3.0, 3.0) - origin));
-                let found = list.closest_primitives_lanes(&lanes_of(&rays), 8).unwrap();
+                let found = list
+                    .closest_primitives_lanes(&RayLanes::new(rays), 8)
+                    .unwrap();
                 for (ray, lane) in rays.iter().zip(found) {
                     assert_eq!(lane, list.closest_primitive(ray, f32::INFINITY));
                     hits += lane.is_some() as u32;
@@ -363,7 +345,7 @@ mod lanes {
         }
         assert!(hits > 3000, "only {hits} hits");
         // Layouts it does not serve: a plane outside the packets, and a BVH.
-        let rays = lanes_of(&[Ray::new(Vec3::ZERO, Vec3::X); 8]);
+        let rays = RayLanes::new([Ray::new(Vec3::ZERO, Vec3::X); 8]);
         let mut list = scene();
         list.build_acceleration();
         assert!(list.closest_primitives_lanes(&rays, 8).is_none());

@@ -8,8 +8,9 @@
 //! so a lane's verdict is bit for bit the scalar test's.
 
 use super::{Parallelogram, Sphere};
-use crate::lanes::{self, f32x8, Vec3x8};
+use crate::lanes::{self, f32x8, Vec3x8, LANES};
 use crate::Ray;
+use glam::Vec3;
 
 /// Eight rays, `origin + t·direction` in each lane.
 #[derive(Clone, Copy, Debug, Default)]
@@ -19,6 +20,19 @@ pub struct RayLanes {
 }
 
 impl RayLanes {
+    /// The eight rays `rays`, lane k holding `rays[k]`.
+    pub fn new(rays: [Ray; LANES]) -> Self {
+        let lanes = |of: fn(&Ray) -> Vec3| Vec3x8 {
+            x: f32x8::new(rays.each_ref().map(|r| of(r).x)),
+            y: f32x8::new(rays.each_ref().map(|r| of(r).y)),
+            z: f32x8::new(rays.each_ref().map(|r| of(r).z)),
+        };
+        Self {
+            origin: lanes(|r| r.origin),
+            direction: lanes(|r| r.direction),
+        }
+    }
+
     /// Lane `lane` as a scalar ray.
     #[inline]
     pub fn lane(&self, lane: usize) -> Ray {
@@ -103,18 +117,9 @@ impl Parallelogram {
 mod tests {
     use super::*;
     use crate::bvh::test_support::XorShift;
-    use glam::Vec3;
 
     fn rays_from(origin: Vec3, targets: [Vec3; 8]) -> RayLanes {
-        let directions = targets.map(|t| t - origin);
-        RayLanes {
-            origin: Vec3x8::splat(origin),
-            direction: Vec3x8 {
-                x: f32x8::new(directions.map(|d| d.x)),
-                y: f32x8::new(directions.map(|d| d.y)),
-                z: f32x8::new(directions.map(|d| d.z)),
-            },
-        }
+        RayLanes::new(targets.map(|t| Ray::new(origin, t - origin)))
     }
 
     /// Every lane agrees with the scalar test, on random rays (origins inside

@@ -41,6 +41,7 @@
 
 mod bounds;
 mod build;
+mod packet;
 mod prepared_ray;
 mod sah;
 mod stats;

@@ -112,12 +112,6 @@ impl ShapeList {
                 .is_some_and(|bvh| self.bvh_hit(bvh, ray, t_max))
     }
 
-    /// Whether anything outside the packets is left to test.
-    #[inline]
-    pub(super) fn has_rest(&self, linear: &LinearShapes) -> bool {
-        !linear.others.is_empty() || self.bvh.is_some()
-    }
-
     /// Whether an object of the linear loop outside its packets lies on the ray.
     #[inline]
     pub(super) fn others_hit(&self, linear: &LinearShapes, ray: &Ray, t_max: f32) -> bool {
@@ -136,14 +130,20 @@ impl ShapeList {
 
     /// Whether an unbounded plane (which the BVH leaves out) lies on the ray in
     /// (0, t_max).
-    fn unbounded_hit(&self, ray: &Ray, watertight: &WatertightRay, t_max: f32) -> bool {
+    pub(super) fn unbounded_hit(&self, ray: &Ray, watertight: &WatertightRay, t_max: f32) -> bool {
         self.unbounded_primitives()
             .any(|p| self.primitive_distance(p, ray, watertight, t_max).is_some())
     }
 
     /// Whether the leaf at `first` holds a primitive on the ray in (0, t_max).
     #[inline]
-    fn leaf_occludes(&self, first: u32, ray: &Ray, watertight: &WatertightRay, t_max: f32) -> bool {
+    pub(super) fn leaf_occludes(
+        &self,
+        first: u32,
+        ray: &Ray,
+        watertight: &WatertightRay,
+        t_max: f32,
+    ) -> bool {
         self.leaf_hits(first, ray, watertight, t_max).0 != 0
     }
 }

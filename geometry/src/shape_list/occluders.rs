@@ -14,6 +14,7 @@
 use super::{ObjectRef, ShapeList};
 use crate::counters::count;
 use crate::lanes::LANES;
+use crate::triangle::WatertightRay;
 use crate::{Ray, RayLanes, Shape};
 use glam::{Vec3, Vec4};
 
@@ -148,9 +149,7 @@ impl ShapeList {
         active: u32,
     ) -> u32 {
         let Some(linear) = &self.linear else {
-            return self.lane_by_lane(active, |lane| {
-                self.any_hit_among(occluders, &rays.lane(lane), t_max)
-            });
+            return self.bvh_hits_lanes(rays, t_max, active);
         };
         let tested = u64::from(active.count_ones());
         let mut blocked = 0;
@@ -179,13 +178,30 @@ impl ShapeList {
                 }
             }
         }
-        if !self.has_rest(linear) {
-            return blocked;
+        if !linear.others.is_empty() {
+            blocked |= self.lane_by_lane(active & !blocked, |lane| {
+                self.others_hit(linear, &rays.lane(lane), t_max)
+            });
         }
+        blocked | self.bvh_hits_lanes(rays, t_max, active & !blocked)
+    }
+
+    /// The lanes of `active` whose ray meets an unbounded plane or a primitive
+    /// of the BVH (none without one), the BVH walked by all the lanes at once
+    /// ([`Bvh::any_hit_lanes`](crate::bvh::Bvh::any_hit_lanes)).
+    fn bvh_hits_lanes(&self, rays: &RayLanes, t_max: f32, active: u32) -> u32 {
+        let Some(bvh) = &self.bvh else {
+            return 0;
+        };
+        let watertight: [WatertightRay; LANES] =
+            std::array::from_fn(|lane| WatertightRay::new(&rays.lane(lane)));
+        let mut blocked = self.lane_by_lane(active, |lane| {
+            self.unbounded_hit(&rays.lane(lane), &watertight[lane], t_max)
+        });
+        blocked |= bvh.any_hit_lanes(rays, t_max, active & !blocked, |first, _, lane| {
+            self.leaf_occludes(first, &rays.lane(lane), &watertight[lane], t_max)
+        });
         blocked
-            | self.lane_by_lane(active & !blocked, |lane| {
-                self.rest_hit(linear, &rays.lane(lane), t_max)
-            })
     }
 
     /// The lanes of `active` for which `blocked(lane)` holds.

@@ -109,18 +109,35 @@ mod bvh_agreement {
 
     #[test]
     fn shadow_rays_among_culled_occluders_get_the_full_answer_beside_a_bvh() {
+        // Eight shadow rays from one point to a quad, traced in lanes (the BVH
+        // walked by all eight at once) and one by one, in both layouts with a BVH;
+        // some rays run parallel to an axis, one is NaN, one lane is inactive.
         let mut rng = Rng(0x51_7cc1_b727_220a);
         let mut blocked = 0;
-        for _ in 0..20 {
+        for scene in 0..40 {
             let mut list = random_scene(&mut rng);
-            list.build_acceleration();
-            for _ in 0..50 {
+            if scene % 2 == 0 {
+                list.build_acceleration();
+            } else {
+                list.build_bvh();
+            }
+            for round in 0..50 {
                 let from = rng.in_cube(6.0);
                 let (corner, e1, e2) = (rng.in_cube(5.0), rng.in_cube(2.0), rng.in_cube(2.0));
                 let corners = [corner, corner + e1, corner + e1 + e2, corner + e2];
-                let occluders = list.occluders_towards(from, &corners, [u32::MAX; 2]);
-                let targets: [Vec3; 8] =
+                let mut targets: [Vec3; 8] =
                     std::array::from_fn(|_| corner + rng.next() * e1 + rng.next() * e2);
+                // Odd rounds: no culling, and targets off the quad.
+                let occluders = if round % 2 == 0 {
+                    list.occluders_towards(from, &corners, [u32::MAX; 2])
+                } else {
+                    targets[1].x = from.x;
+                    targets[2].y = from.y;
+                    if round % 3 == 0 {
+                        targets[3] = Vec3::NAN;
+                    }
+                    Occluders::ALL
+                };
                 let rays = targets.map(|t| Ray::new(from, t - from));
                 let lanes = crate::RayLanes::new(rays);
                 let t_max = 1.0 - crate::SHADOW_EPSILON;
@@ -130,12 +147,16 @@ mod bvh_agreement {
                     let alone = list.any_hit(ray, t_max);
                     assert_eq!(list.any_hit_among(&occluders, ray, t_max), alone);
                     let expected = alone && active >> k & 1 == 1;
-                    assert_eq!(lanes_blocked >> k & 1 == 1, expected, "lane {k}");
+                    assert_eq!(
+                        lanes_blocked >> k & 1 == 1,
+                        expected,
+                        "scene {scene}, lane {k}"
+                    );
                     blocked += expected as u32;
                 }
             }
         }
-        assert!(blocked > 100, "only {blocked} blocked rays");
+        assert!(blocked > 200, "only {blocked} blocked rays");
     }
 
     fn random_scene(rng: &mut Rng) -> ShapeList {

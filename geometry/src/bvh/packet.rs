@@ -1,0 +1,211 @@
+//! Eight shadow rays through the tree together ([`Bvh::any_hit_lanes`]): the
+//! shadow rays of one shading point start at the same point and end on the same
+//! light, so they enter nearly the same nodes, and one walk of the tree with all
+//! eight in SIMD lanes replaces eight walks.
+//!
+//! The node test is [`PreparedRay::enters`](super::prepared_ray) lane by lane:
+//! each (ray, child) pair performs its scalar operations in the same order, the
+//! maxima and minima included (`a > b ? a : b`, as `maxps` picks), so a ray
+//! enters exactly the children it enters alone. An any-hit query's answer does
+//! not depend on the order leaves are visited in, only on which leaves the ray
+//! reaches, so each lane's answer is the one its ray gets alone.
+
+use super::bounds::EXIT_SCALE;
+use super::wide::{Link, WIDTH};
+use super::Bvh;
+use crate::counters::count;
+use crate::lanes::{f32x8, LANES};
+use crate::RayLanes;
+use std::cell::RefCell;
+
+thread_local! {
+    /// Each thread's stack of (link, lanes that reach it), reused query after query.
+    static STACK: RefCell<Vec<(Link, u32)>> = const { RefCell::new(Vec::new()) };
+}
+
+impl Bvh {
+    /// Which of the rays of `rays` in the lanes of `active` (bit k for lane k)
+    /// meet a primitive in (0, `t_max`): `blocked(first, count, lane)` says
+    /// whether the leaf with positions `first..first + count` holds a primitive
+    /// on lane `lane`'s ray (as the visit of [`Bvh::traverse_leaves`] would).
+    /// Lanes whose ray has a NaN component meet nothing, as alone.
+    pub fn any_hit_lanes(
+        &self,
+        rays: &RayLanes,
+        t_max: f32,
+        active: u32,
+        mut blocked: impl FnMut(u32, u32, usize) -> bool,
+    ) -> u32 {
+        let finite = !(nan_lanes(rays));
+        let active = active & finite & ((1 << LANES) - 1);
+        if active == 0 || self.is_empty() {
+            return 0;
+        }
+        let lanes = PreparedLanes::new(rays, t_max);
+        STACK.with(|cell| {
+            let mut own = Vec::new();
+            let mut borrowed = cell.try_borrow_mut();
+            let stack = match borrowed.as_mut() {
+                Ok(stack) => &mut **stack,
+                // A query made from inside another's leaf visit: a stack of its own.
+                Err(_) => &mut own,
+            };
+            stack.clear();
+            stack.push((Link::ROOT, active));
+            let mut found = 0u32;
+            while let Some((link, reach)) = stack.pop() {
+                let reach = reach & !found;
+                if reach == 0 {
+                    continue;
+                }
+                if link.is_leaf() {
+                    count(|c| c.bvh_leaves += u64::from(reach.count_ones()));
+                    let (first, n) = link.leaf_range();
+                    for lane in (0..LANES).filter(|&k| reach >> k & 1 == 1) {
+                        if blocked(first, n, lane) {
+                            found |= 1 << lane;
+                        }
+                    }
+                    if found == active {
+                        break;
+                    }
+                    continue;
+                }
+                count(|c| c.bvh_nodes += u64::from(reach.count_ones()));
+                let node = &self.tree.nodes[link.node()];
+                for child in 0..WIDTH {
+                    let hits = reach & lanes.enter_child(&node.planes, child);
+                    if hits != 0 {
+                        stack.push((node.link(child), hits));
+                    }
+                }
+            }
+            found
+        })
+    }
+}
+
+/// The lanes of `rays` with a NaN in the origin or direction.
+fn nan_lanes(rays: &RayLanes) -> u32 {
+    let nan = |v: f32x8| v.is_nan();
+    let (o, d) = (&rays.origin, &rays.direction);
+    (nan(o.x) | nan(o.y) | nan(o.z) | nan(d.x) | nan(d.y) | nan(d.z)).to_bitmask()
+}
+
+/// Eight rays set up for box tests, as [`PreparedRay`](super::prepared_ray) sets
+/// up one.
+struct PreparedLanes {
+    origin: [f32x8; 3],
+    inv_dir: [f32x8; 3],
+    /// Per axis, the lanes whose `1/d ≥ 0` meet the minimum plane first.
+    min_first: [f32x8; 3],
+    t_max: f32x8,
+}
+
+impl PreparedLanes {
+    fn new(rays: &RayLanes, t_max: f32) -> Self {
+        let (o, d) = (&rays.origin, &rays.direction);
+        let inv_dir = [f32x8::ONE / d.x, f32x8::ONE / d.y, f32x8::ONE / d.z];
+        Self {
+            origin: [o.x, o.y, o.z],
+            min_first: inv_dir.map(|inv| inv.simd_ge(f32x8::ZERO)),
+            inv_dir,
+            t_max: f32x8::splat(t_max),
+        }
+    }
+
+    /// The lanes whose ray enters child `child` of a node with bounding planes
+    /// `planes` (minima x, y, z, then maxima, one `Vec4` lane per child) before
+    /// `t_max`: the scalar test's verdict in each lane.
+    #[inline]
+    fn enter_child(&self, planes: &[glam::Vec4; 6], child: usize) -> u32 {
+        let mut enter = f32x8::ZERO;
+        let mut exit = self.t_max;
+        for axis in 0..3 {
+            let lo = f32x8::splat(planes[axis][child]);
+            let hi = f32x8::splat(planes[axis + 3][child]);
+            let near_plane = self.min_first[axis].select(lo, hi);
+            let far_plane = self.min_first[axis].select(hi, lo);
+            let near = (near_plane - self.origin[axis]) * self.inv_dir[axis];
+            let far = (far_plane - self.origin[axis]) * self.inv_dir[axis];
+            // `maxps`/`minps` semantics: the first operand if it compares
+            // greater (less), else the second, NaN included.
+            enter = near.simd_gt(enter).select(near, enter);
+            exit = far.simd_lt(exit).select(far, exit);
+        }
+        let hit = enter.simd_le(exit * f32x8::splat(EXIT_SCALE)) & enter.simd_lt(self.t_max);
+        hit.to_bitmask()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::prepared_ray::PreparedRay;
+    use crate::bvh::test_support::XorShift;
+    use crate::bvh::wide::tests::node_of;
+    use crate::bvh::Bounds3;
+    use crate::Ray;
+    use glam::Vec3;
+
+    /// Each (ray, child) verdict in lanes is the scalar node test's, on random
+    /// boxes and rays, including rays that start on a box face and run along it
+    /// and rays through a box's corner (where the exit distance's rounding
+    /// allowance decides).
+    #[test]
+    fn lanes_enter_the_children_each_ray_enters_alone() {
+        let mut rng = XorShift(0xb0c5);
+        let mut entered = 0;
+        for _ in 0..4000 {
+            let boxes = [0, 1, 2, 3].map(|_| {
+                let lo = rng.vec3(-4.0, 4.0);
+                Bounds3::new(lo, lo + rng.vec3(0.0, 3.0))
+            });
+            let node = node_of(&boxes);
+            let rays: [Ray; LANES] = std::array::from_fn(|_| {
+                let mut origin = rng.vec3(-6.0, 6.0);
+                let mut direction = rng.vec3(-1.0, 1.0);
+                let axis = (rng.next_u64() % 3) as usize;
+                let b = &boxes[(rng.next_u64() % 4) as usize];
+                let case = rng.next_u64() % 3;
+                if case == 2 {
+                    // Through a corner: entry and exit agree up to rounding.
+                    let corner = Vec3::new(
+                        if rng.unit() < 0.5 { b.min.x } else { b.max.x },
+                        if rng.unit() < 0.5 { b.min.y } else { b.max.y },
+                        if rng.unit() < 0.5 { b.min.z } else { b.max.z },
+                    );
+                    direction = corner - origin;
+                } else if case == 1 {
+                    origin = b.min + rng.vec3(0.0, 1.0) * (b.max - b.min);
+                    origin[axis] = if rng.unit() < 0.5 {
+                        b.min[axis]
+                    } else {
+                        b.max[axis]
+                    };
+                    direction[axis] = if rng.unit() < 0.5 { 0.0 } else { -0.0 };
+                }
+                Ray::new(origin, direction)
+            });
+            let t_max = if rng.unit() < 0.5 {
+                f32::INFINITY
+            } else {
+                rng.range(0.0, 8.0)
+            };
+            let lanes = PreparedLanes::new(&RayLanes::new(rays), t_max);
+            for child in 0..WIDTH {
+                let in_lanes = lanes.enter_child(&node.planes, child);
+                for (k, ray) in rays.iter().enumerate() {
+                    let (alone, _) = PreparedRay::new(ray).enters(&node, t_max);
+                    assert_eq!(
+                        in_lanes >> k & 1,
+                        alone >> child & 1,
+                        "{ray:?}, child {child}"
+                    );
+                    entered += alone >> child & 1;
+                }
+            }
+        }
+        assert!(entered > 10_000, "only {entered} entries");
+    }
+}

@@ -15,17 +15,20 @@
 //!   points on a 2 × 2 light) on a Cornell-like list of 5 parallelograms and 4
 //!   spheres (linear loop), and on a displaced grid of about 10k triangles (BVH),
 //!   asked one at a time (`any_hit`), as one batch (`any_hits`), and, for the
-//!   Cornell list, the way the integrator asks from 4 light samples on
-//!   (`occluders_towards` once per shading point, then `any_hit_among`).
+//!   Cornell list, the way the integrator asked from 4 light samples on
+//!   (`occluders_towards` once per shading point, then `any_hit_among`), and
+//!   for both, the way it asks now: a point's rays eight at a time in SIMD lanes
+//!   (`any_hits_among`, the BVH walked by the eight together).
 //!
 //! Throughput is in rays; the time per ray is the iteration time / 256. See
 //! `docs/microbenchmarks.md`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 use glam::{Vec2, Vec3};
+use glint_geometry::lanes::LANES;
 use glint_geometry::triangle::WatertightRay;
 use glint_geometry::{
-    spawn_ray_to, AaBox, Hit, Parallelogram, Plane, Ray, ShapeList, Sphere, TriangleMesh,
+    spawn_ray_to, AaBox, Hit, Parallelogram, Plane, Ray, RayLanes, ShapeList, Sphere, TriangleMesh,
 };
 use std::hint::black_box;
 use std::time::Duration;
@@ -412,6 +415,40 @@ fn bench_shadows(
             })
         });
     }
+    // What the integrator does: each point's rays eight at a time in SIMD lanes,
+    // against the shapes its culling keeps (all of them beside a mesh's BVH,
+    // which the eight walk together).
+    let corners = light.corners();
+    let batches: Vec<(usize, RayLanes)> = (0..POINTS)
+        .flat_map(|p| {
+            (0..LIGHT_SAMPLES / LANES).map(move |half| (p, p * LIGHT_SAMPLES + half * LANES))
+        })
+        .map(|(p, first)| {
+            let rays: [Ray; LANES] = std::array::from_fn(|k| shadows.rays[first + k]);
+            (p, RayLanes::new(rays))
+        })
+        .collect();
+    let t_max = shadows.t_max[0];
+    assert!(shadows.t_max.iter().all(|&t| t == t_max));
+    group.bench_function("occluders_towards+any_hits_among (lanes)", |b| {
+        b.iter(|| {
+            let mut blocked = 0u32;
+            for pair in batches.chunks(LIGHT_SAMPLES / LANES) {
+                let point = &shadows.points[pair[0].0];
+                let occluders = list.occluders_towards(
+                    black_box(point.point),
+                    &corners,
+                    [point.shape, u32::MAX],
+                );
+                for (_, rays) in pair {
+                    blocked += list
+                        .any_hits_among(&occluders, black_box(rays), t_max, 0xff)
+                        .count_ones();
+                }
+            }
+            black_box(blocked)
+        })
+    });
     group.finish();
 }
 

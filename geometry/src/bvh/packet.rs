@@ -142,11 +142,9 @@ impl PreparedLanes {
 mod tests {
     use super::*;
     use crate::bvh::prepared_ray::PreparedRay;
-    use crate::bvh::test_support::XorShift;
+    use crate::bvh::test_support::{awkward_ray, node_boxes, some_t_max, XorShift};
     use crate::bvh::wide::tests::node_of;
-    use crate::bvh::Bounds3;
     use crate::Ray;
-    use glam::Vec3;
 
     /// Each (ray, child) verdict in lanes is the scalar node test's, on random
     /// boxes and rays, including rays that start on a box face and run along it
@@ -157,41 +155,10 @@ mod tests {
         let mut rng = XorShift(0xb0c5);
         let mut entered = 0;
         for _ in 0..4000 {
-            let boxes = [0, 1, 2, 3].map(|_| {
-                let lo = rng.vec3(-4.0, 4.0);
-                Bounds3::new(lo, lo + rng.vec3(0.0, 3.0))
-            });
+            let boxes = node_boxes(&mut rng);
             let node = node_of(&boxes);
-            let rays: [Ray; LANES] = std::array::from_fn(|_| {
-                let mut origin = rng.vec3(-6.0, 6.0);
-                let mut direction = rng.vec3(-1.0, 1.0);
-                let axis = (rng.next_u64() % 3) as usize;
-                let b = &boxes[(rng.next_u64() % 4) as usize];
-                let case = rng.next_u64() % 3;
-                if case == 2 {
-                    // Through a corner: entry and exit agree up to rounding.
-                    let corner = Vec3::new(
-                        if rng.unit() < 0.5 { b.min.x } else { b.max.x },
-                        if rng.unit() < 0.5 { b.min.y } else { b.max.y },
-                        if rng.unit() < 0.5 { b.min.z } else { b.max.z },
-                    );
-                    direction = corner - origin;
-                } else if case == 1 {
-                    origin = b.min + rng.vec3(0.0, 1.0) * (b.max - b.min);
-                    origin[axis] = if rng.unit() < 0.5 {
-                        b.min[axis]
-                    } else {
-                        b.max[axis]
-                    };
-                    direction[axis] = if rng.unit() < 0.5 { 0.0 } else { -0.0 };
-                }
-                Ray::new(origin, direction)
-            });
-            let t_max = if rng.unit() < 0.5 {
-                f32::INFINITY
-            } else {
-                rng.range(0.0, 8.0)
-            };
+            let rays: [Ray; LANES] = std::array::from_fn(|_| awkward_ray(&mut rng, &boxes, true));
+            let t_max = some_t_max(&mut rng);
             let lanes = PreparedLanes::new(&RayLanes::new(rays), t_max);
             for child in 0..WIDTH {
                 let in_lanes = lanes.enter_child(&node.planes, child);

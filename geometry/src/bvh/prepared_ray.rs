@@ -96,7 +96,7 @@ fn min_or_second(a: Vec4, b: Vec4) -> Vec4 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::test_support::{box_hit, XorShift};
+    use crate::bvh::test_support::{awkward_ray, box_hit, node_boxes, some_t_max, XorShift};
     use crate::bvh::wide::tests::node_of;
     use crate::bvh::Bounds3;
     use glam::Vec3;
@@ -113,36 +113,9 @@ mod tests {
         let mut rng = XorShift(0x5EED);
         let mut checked = 0;
         for _ in 0..20_000 {
-            let boxes = [0, 1, 2, 3].map(|_| {
-                let lo = rng.vec3(-4.0, 4.0);
-                Bounds3::new(lo, lo + rng.vec3(0.0, 3.0))
-            });
-            // Origins anywhere, or on a face of a box (and so, with a zero
-            // direction component across it, lying in the face's plane).
-            let mut origin = rng.vec3(-6.0, 6.0);
-            let mut direction = rng.vec3(-1.0, 1.0);
-            let axis = (rng.next_u64() % 3) as usize;
-            match rng.next_u64() % 4 {
-                0 => {}
-                1 => direction[axis] = 0.0,
-                2 => direction[axis] = -0.0,
-                _ => {
-                    let b = &boxes[(rng.next_u64() % 4) as usize];
-                    origin = b.min + rng.vec3(0.0, 1.0) * (b.max - b.min);
-                    origin[axis] = if rng.unit() < 0.5 {
-                        b.min[axis]
-                    } else {
-                        b.max[axis]
-                    };
-                    direction[axis] = if rng.unit() < 0.5 { 0.0 } else { -0.0 };
-                }
-            }
-            let t_max = if rng.unit() < 0.5 {
-                f32::INFINITY
-            } else {
-                rng.range(0.0, 8.0)
-            };
-            let ray = Ray::new(origin, direction);
+            let boxes = node_boxes(&mut rng);
+            let ray = awkward_ray(&mut rng, &boxes, false);
+            let t_max = some_t_max(&mut rng);
             let want = boxes.map(|b| box_hit(&b, &ray, t_max));
             assert_eq!(node_hits(&boxes, &ray, t_max), want, "{ray:?} {boxes:?}");
             checked += want.iter().flatten().count();

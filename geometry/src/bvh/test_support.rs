@@ -69,6 +69,57 @@ pub(super) fn random_boxes(
         .collect()
 }
 
+/// Four boxes for one node's children: corners in [-4, 4]³, sides up to 3.
+pub(super) fn node_boxes(rng: &mut XorShift) -> [Bounds3; 4] {
+    [0, 1, 2, 3].map(|_| {
+        let lo = rng.vec3(-4.0, 4.0);
+        Bounds3::new(lo, lo + rng.vec3(0.0, 3.0))
+    })
+}
+
+/// A ray for testing node tests against `boxes`: from anywhere, with a +0 or −0
+/// direction component, or starting on a box face and running along it (so
+/// lying in the face's plane); with `through_corners`, also aimed at a box's
+/// corner, where entry and exit distances agree up to rounding.
+pub(super) fn awkward_ray(rng: &mut XorShift, boxes: &[Bounds3; 4], through_corners: bool) -> Ray {
+    let mut origin = rng.vec3(-6.0, 6.0);
+    let mut direction = rng.vec3(-1.0, 1.0);
+    let axis = (rng.next_u64() % 3) as usize;
+    let b = &boxes[(rng.next_u64() % 4) as usize];
+    match rng.next_u64() % if through_corners { 5 } else { 4 } {
+        0 => {}
+        1 => direction[axis] = 0.0,
+        2 => direction[axis] = -0.0,
+        3 => {
+            origin = b.min + rng.vec3(0.0, 1.0) * (b.max - b.min);
+            origin[axis] = if rng.unit() < 0.5 {
+                b.min[axis]
+            } else {
+                b.max[axis]
+            };
+            direction[axis] = if rng.unit() < 0.5 { 0.0 } else { -0.0 };
+        }
+        _ => {
+            let corner = Vec3::select(
+                glam::BVec3::new(rng.unit() < 0.5, rng.unit() < 0.5, rng.unit() < 0.5),
+                b.min,
+                b.max,
+            );
+            direction = corner - origin;
+        }
+    }
+    Ray::new(origin, direction)
+}
+
+/// Infinite half the time, else uniform in [0, 8).
+pub(super) fn some_t_max(rng: &mut XorShift) -> f32 {
+    if rng.unit() < 0.5 {
+        f32::INFINITY
+    } else {
+        rng.range(0.0, 8.0)
+    }
+}
+
 pub(super) fn contains(outer: &Bounds3, inner: &Bounds3) -> bool {
     outer.min.cmple(inner.min).all() && inner.max.cmple(outer.max).all()
 }

@@ -8,9 +8,10 @@
 //! chain on eight samples at once in SIMD lanes ([`Vec3x8`]) and traces the
 //! shadow rays of the lanes that need one. Every lane does the scalar path's
 //! operations in its order, and the sum is taken sample by sample in the same
-//! order, so the result and the counts are those of
-//! [`ShadingPoint::area_light_sum_one_by_one`], bit for bit (the tests compare
-//! them).
+//! order, so the result and the shading counts ([`crate::ShadingCounters`]) are
+//! those of [`ShadingPoint::area_light_sum_one_by_one`], bit for bit (the tests
+//! compare them). The intersection counts of `--stats` are not: tested in
+//! lanes, a shape counts one test per ray in the batch.
 
 use crate::direct::{SampleContext, ShadingPoint};
 use crate::Scene;

@@ -138,6 +138,8 @@ impl ShapeList {
     /// [`ShapeList::any_hit_among`] for the rays in the lanes of `rays` that
     /// `active` names (bit k for lane k), all with the same `t_max`: the lanes
     /// whose ray is blocked. Each lane's answer is the one its ray gets alone.
+    /// (The `--stats` counts differ: a kept shape counts one test per active
+    /// ray, and BVH nodes and leaves count once per ray that reaches them.)
     /// One shape is tested against all eight rays at once
     /// ([`Sphere::hits_lanes`](crate::Sphere::hits_lanes)), which pays for the
     /// shadow rays of one point, all meeting the same few shapes.
@@ -149,7 +151,11 @@ impl ShapeList {
         active: u32,
     ) -> u32 {
         let Some(linear) = &self.linear else {
-            return self.bvh_hits_lanes(rays, t_max, active);
+            return match self.bvh {
+                Some(_) => self.bvh_hits_lanes(rays, t_max, active),
+                // Not built: the rays one by one, through every object.
+                None => self.lane_by_lane(active, |lane| self.any_hit(&rays.lane(lane), t_max)),
+            };
         };
         let tested = u64::from(active.count_ones());
         let mut blocked = 0;

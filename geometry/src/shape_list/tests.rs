@@ -110,16 +110,31 @@ mod bvh_agreement {
     #[test]
     fn shadow_rays_among_culled_occluders_get_the_full_answer_beside_a_bvh() {
         // Eight shadow rays from one point to a quad, traced in lanes (the BVH
-        // walked by all eight at once) and one by one, in both layouts with a BVH;
-        // some rays run parallel to an axis, one is NaN, one lane is inactive.
+        // walked by all eight at once) and one by one, in every layout: packets
+        // beside a BVH, a BVH alone, the linear loop with objects outside its
+        // packets, and no acceleration built. Some rays run parallel to an axis,
+        // one is NaN, one lane is inactive, and in odd rounds the rays start at
+        // eight different points.
         let mut rng = Rng(0x51_7cc1_b727_220a);
         let mut blocked = 0;
         for scene in 0..40 {
             let mut list = random_scene(&mut rng);
-            if scene % 2 == 0 {
-                list.build_acceleration();
-            } else {
-                list.build_bvh();
+            match scene % 4 {
+                0 => {
+                    list.build_acceleration();
+                    assert!(
+                        list.bvh.is_some() && list.linear.is_some(),
+                        "packets and a BVH"
+                    );
+                }
+                1 => list.build_bvh(),
+                2 => {
+                    list = small_scene(&mut rng);
+                    list.build_acceleration();
+                    let linear = list.linear.as_ref().expect("the linear loop");
+                    assert!(list.bvh.is_none() && !linear.others.is_empty());
+                }
+                _ => list = small_scene(&mut rng),
             }
             for round in 0..50 {
                 let from = rng.in_cube(6.0);
@@ -138,7 +153,14 @@ mod bvh_agreement {
                     }
                     Occluders::ALL
                 };
-                let rays = targets.map(|t| Ray::new(from, t - from));
+                let rays: [Ray; 8] = std::array::from_fn(|k| {
+                    let origin = if round % 2 == 0 {
+                        from
+                    } else {
+                        from + rng.in_cube(0.5)
+                    };
+                    Ray::new(origin, targets[k] - origin)
+                });
                 let lanes = crate::RayLanes::new(rays);
                 let t_max = 1.0 - crate::SHADOW_EPSILON;
                 let active = 0b1011_1111;
@@ -157,6 +179,23 @@ mod bvh_agreement {
             }
         }
         assert!(blocked > 200, "only {blocked} blocked rays");
+    }
+
+    /// Three spheres, three parallelograms, a box and a plane: the linear loop,
+    /// with the box and the plane outside its packets.
+    fn small_scene(rng: &mut Rng) -> ShapeList {
+        let mut list = ShapeList::new();
+        for _ in 0..3 {
+            list.push(Sphere::new(rng.in_cube(4.0), 0.3 + rng.next()).unwrap());
+            let corner = rng.in_cube(4.0);
+            list.push(
+                Parallelogram::new(corner, rng.in_cube(2.0), rng.in_cube(2.0), true).unwrap(),
+            );
+        }
+        let c = rng.in_cube(3.0);
+        list.push(AaBox::new(c, c + Vec3::splat(0.5) + rng.in_cube(0.5).abs()).unwrap());
+        list.push(Plane::new(rng.in_cube(3.0), rng.in_cube(1.0), false).unwrap());
+        list
     }
 
     fn random_scene(rng: &mut Rng) -> ShapeList {

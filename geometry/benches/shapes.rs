@@ -324,25 +324,6 @@ fn cornell() -> ShapeList {
     list
 }
 
-/// A grid of `n × n` quads over [−1, 1]² in x, z, displaced in y by a few
-/// sines (as `glint_tests::displaced_grid`, which this crate cannot use).
-fn displaced_grid(n: u32) -> TriangleMesh {
-    let height = |x: f32, z: f32| {
-        0.1 * (7.0 * x).sin() * (5.0 * z).cos() + 0.05 * (23.0 * x + 17.0 * z).sin()
-    };
-    let mut positions = Vec::with_capacity(((n + 1) * (n + 1)) as usize);
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, z) = (
-                2.0 * i as f32 / n as f32 - 1.0,
-                2.0 * j as f32 / n as f32 - 1.0,
-            );
-            positions.push(Vec3::new(x, height(x, z), z));
-        }
-    }
-    TriangleMesh::new(positions, TriangleMesh::grid_indices(n, n), vec![], vec![]).unwrap()
-}
-
 /// Rays from `eye` through a 4 × 4 grid of points spread over `extent` around
 /// `centre` in the plane through `centre` spanned by `right` and `up`.
 fn camera_grid(eye: Vec3, centre: Vec3, right: Vec3, up: Vec3) -> Vec<Ray> {
@@ -474,7 +455,7 @@ fn shadows(c: &mut Criterion) {
     // The grid from above, lit by a square low on one side: shadow rays graze
     // the bumps.
     let mut list = ShapeList::new();
-    let mesh = displaced_grid(71);
+    let mesh = TriangleMesh::displaced_grid(71);
     let triangles = mesh.triangle_count();
     list.push_mesh(mesh);
     list.build_acceleration();

@@ -32,27 +32,12 @@ pub fn shipped_scenes() -> Vec<String> {
     names
 }
 
-/// A displaced grid of about `triangles` triangles over [−1, 1]² in x, z with a
-/// bumpy height `y = 0.1·sin(7x)·cos(5z) + 0.05·sin(23x + 17z)`: a mesh of any size
-/// for benchmarks, made by code (two triangles per grid cell).
+/// A displaced grid of about `triangles` triangles
+/// ([`TriangleMesh::displaced_grid`](glint_geometry::TriangleMesh::displaced_grid)
+/// with a side of `⌈√(triangles / 2)⌉` quads): a mesh of any size for benchmarks.
 pub fn displaced_grid(triangles: usize) -> glint_geometry::TriangleMesh {
-    use glam::Vec3;
     let n = ((triangles as f64 / 2.0).sqrt().ceil() as u32).max(1);
-    let height = |x: f32, z: f32| {
-        0.1 * (7.0 * x).sin() * (5.0 * z).cos() + 0.05 * (23.0 * x + 17.0 * z).sin()
-    };
-    let mut positions = Vec::with_capacity(((n + 1) * (n + 1)) as usize);
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, z) = (
-                2.0 * i as f32 / n as f32 - 1.0,
-                2.0 * j as f32 / n as f32 - 1.0,
-            );
-            positions.push(Vec3::new(x, height(x, z), z));
-        }
-    }
-    let indices = glint_geometry::TriangleMesh::grid_indices(n, n);
-    glint_geometry::TriangleMesh::new(positions, indices, vec![], vec![]).expect("a valid grid")
+    glint_geometry::TriangleMesh::displaced_grid(n)
 }
 
 #[cfg(doctest)]

@@ -8,6 +8,7 @@ The grid spans [-2, 2] in x and z at y = 0.1·sin(7x)·cos(5z): two triangles pe
 quad, ceil(sqrt(N / 2)) quads a side.
 """
 import math
+import os
 import sys
 
 
@@ -16,7 +17,24 @@ def main() -> int:
         print("usage: grid_obj.py TRIANGLES FILE (TRIANGLES at least 2)", file=sys.stderr)
         return 2
     n = max(1, math.ceil(math.sqrt(int(sys.argv[1]) / 2)))
-    with open(sys.argv[2], "w") as out:
+    path = sys.argv[2]
+    # Written beside the target and renamed at the end: a failed or interrupted
+    # run leaves no partial OBJ and any existing file untouched.
+    partial = f"{path}.partial-{os.getpid()}"
+    try:
+        write_grid(n, partial)
+        os.replace(partial, path)
+    except OSError as e:
+        if os.path.exists(partial):
+            os.remove(partial)
+        print(f"grid_obj.py: error: cannot write {path}: {e.strerror}", file=sys.stderr)
+        return 2
+    print(f"wrote {path}: {2 * n * n} triangles")
+    return 0
+
+
+def write_grid(n: int, path: str) -> None:
+    with open(path, "w") as out:
         for j in range(n + 1):
             for i in range(n + 1):
                 x, z = i / n * 4 - 2, j / n * 4 - 2
@@ -25,8 +43,6 @@ def main() -> int:
             for i in range(n):
                 a = j * (n + 1) + i + 1
                 out.write(f"f {a} {a + 1} {a + n + 2}\nf {a} {a + n + 2} {a + n + 1}\n")
-    print(f"wrote {sys.argv[2]}: {2 * n * n} triangles")
-    return 0
 
 
 if __name__ == "__main__":

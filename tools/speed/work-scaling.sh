@@ -26,7 +26,11 @@ out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 
 # The scene's own settings, from a one-sample probe render's summary line.
-probe="$("$glint" render "$scene" --spp 1 -o "$out/probe.png" 2>&1 | tail -n 1)"
+if ! probe="$("$glint" render "$scene" --spp 1 -o "$out/probe.png" 2>&1)"; then
+    echo "work-scaling.sh: error: $scene does not render: $(tail -n 1 <<<"$probe")" >&2
+    exit 2
+fi
+probe="$(tail -n 1 <<<"$probe")"
 read -r width height < <(sed -E 's/.*: ([0-9]+)x([0-9]+),.*/\1 \2/' <<<"$probe")
 spp="$(sed -nE 's/^spp *= *([0-9]+).*/\1/p' "$scene" | head -n 1)"
 light="$(sed -nE 's/^light_samples *= *([0-9]+).*/\1/p' "$scene" | head -n 1)"

@@ -81,6 +81,28 @@ impl TriangleMesh {
         })
     }
 
+    /// A generated mesh for benchmarks and tests: `n × n` quads (two triangles
+    /// each) over [−1, 1]² in x, z, displaced to the bumpy height
+    /// `y = 0.1·sin(7x)·cos(5z) + 0.05·sin(23x + 17z)`.
+    pub fn displaced_grid(n: u32) -> TriangleMesh {
+        let n = n.max(1);
+        let height = |x: f32, z: f32| {
+            0.1 * (7.0 * x).sin() * (5.0 * z).cos() + 0.05 * (23.0 * x + 17.0 * z).sin()
+        };
+        let mut positions = Vec::with_capacity(((n + 1) * (n + 1)) as usize);
+        for j in 0..=n {
+            for i in 0..=n {
+                let (x, z) = (
+                    2.0 * i as f32 / n as f32 - 1.0,
+                    2.0 * j as f32 / n as f32 - 1.0,
+                );
+                positions.push(Vec3::new(x, height(x, z), z));
+            }
+        }
+        TriangleMesh::new(positions, Self::grid_indices(n, n), vec![], vec![])
+            .expect("a grid's triangles are valid")
+    }
+
     /// The triangles of a grid of `columns × rows` quads whose `(columns + 1) ×
     /// (rows + 1)` vertices are stored row by row: two triangles per quad, wound
     /// counter-clockwise seen from the side where rows grow towards the viewer

@@ -34,6 +34,16 @@ impl Vec3x8 {
         }
     }
 
+    /// The eight vectors `v`, lane k holding `v[k]`.
+    #[inline]
+    pub fn from_lanes(v: [Vec3; LANES]) -> Self {
+        Self {
+            x: f32x8::new(v.map(|v| v.x)),
+            y: f32x8::new(v.map(|v| v.y)),
+            z: f32x8::new(v.map(|v| v.z)),
+        }
+    }
+
     /// Lane `lane` as a scalar vector.
     #[inline]
     pub fn lane(&self, lane: usize) -> Vec3 {
@@ -156,6 +166,18 @@ impl std::ops::Sub for Vec3x8 {
     }
 }
 
+impl std::ops::Neg for Vec3x8 {
+    type Output = Self;
+    #[inline]
+    fn neg(self) -> Self {
+        Self {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+        }
+    }
+}
+
 impl std::ops::Add for Vec3x8 {
     type Output = Self;
     #[inline]
@@ -192,6 +214,15 @@ pub fn bits(mask: f32x8) -> u32 {
     mask.to_bitmask()
 }
 
+/// The mask of the lanes whose bit is set in `bits` (lane k as bit k): the
+/// inverse of [`bits`].
+#[inline]
+pub fn from_bits(bits: u32) -> f32x8 {
+    const BIT: wide::u32x8 = wide::u32x8::new([1, 2, 4, 8, 16, 32, 64, 128]);
+    let set = (wide::u32x8::splat(bits) & BIT).simd_eq(BIT);
+    bytemuck::cast(set)
+}
+
 /// The mask of the first `n` lanes.
 #[inline]
 pub fn first_lanes(n: usize) -> f32x8 {
@@ -204,11 +235,18 @@ mod tests {
     use super::*;
 
     fn lanes(f: impl Fn(usize) -> Vec3) -> Vec3x8 {
-        let v: [Vec3; LANES] = std::array::from_fn(f);
-        Vec3x8 {
-            x: f32x8::new(v.map(|v| v.x)),
-            y: f32x8::new(v.map(|v| v.y)),
-            z: f32x8::new(v.map(|v| v.z)),
+        Vec3x8::from_lanes(std::array::from_fn(f))
+    }
+
+    #[test]
+    fn masks_from_bits_give_back_their_bits() {
+        for bits in 0..=255u32 {
+            let mask = from_bits(bits);
+            assert_eq!(super::bits(mask), bits);
+            let picked = mask.select(f32x8::ONE, f32x8::ZERO).to_array();
+            for (k, &p) in picked.iter().enumerate() {
+                assert_eq!(p, (bits >> k & 1) as f32, "bits {bits:#b}, lane {k}");
+            }
         }
     }
 

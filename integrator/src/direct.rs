@@ -295,7 +295,16 @@ pub(crate) struct ShadingPoint<'a> {
 impl<'a> ShadingPoint<'a> {
     /// The point `hit` of `material`, seen along `ray`, with its texture lookup `tc`.
     pub(crate) fn new(hit: &'a Hit, material: &'a PhongMaterial, ray: &Ray, tc: &TexCoord) -> Self {
-        let (kd, ks) = material.reflectances(tc);
+        Self::with_reflectances(hit, material, ray, material.reflectances(tc))
+    }
+
+    /// [`Self::new`] with the reflectances `(kd, ks)` already looked up.
+    pub(crate) fn with_reflectances(
+        hit: &'a Hit,
+        material: &'a PhongMaterial,
+        ray: &Ray,
+        (kd, ks): (Vec3, Vec3),
+    ) -> Self {
         let n = hit.facing_normal(ray.direction);
         let ng = if hit.geometric_normal.dot(n) < 0.0 {
             -hit.geometric_normal
@@ -384,13 +393,13 @@ impl ShadingPoint<'_> {
 /// box's floor: about half the relative MSE at 256 samples, and a steeper
 /// convergence slope, than independent pairs). Every other sample keeps its own
 /// sequence.
-struct PairAllocation {
+pub(crate) struct PairAllocation {
     depth: u32,
     next_joint: u32,
 }
 
 impl PairAllocation {
-    fn new(depth: u32) -> Self {
+    pub(crate) fn new(depth: u32) -> Self {
         Self {
             depth,
             next_joint: 1,
@@ -400,7 +409,7 @@ impl PairAllocation {
     /// The pair for a sample that would otherwise read `own`, taking
     /// `per_sample` points per camera sample.
     #[inline]
-    fn take(&mut self, own: DimensionPair, per_sample: u32) -> DimensionPair {
+    pub(crate) fn take(&mut self, own: DimensionPair, per_sample: u32) -> DimensionPair {
         if self.depth == 0 && per_sample == 1 && self.next_joint <= MAX_JOINT {
             self.next_joint += 1;
             DimensionPair::Joint {

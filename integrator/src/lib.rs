@@ -27,6 +27,7 @@
 //!   [`Aov`]: buffers other than radiance.
 
 mod aov;
+mod camera_lanes;
 pub mod counters;
 mod direct;
 mod light_samples;

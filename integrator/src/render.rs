@@ -1,6 +1,6 @@
 use crate::counters::{ShadingCounters, TextureCounters};
 use crate::direct::SampleContext;
-use crate::sampling::{pixel_rng, SamplePattern, SobolPoints, PIXEL_STREAM};
+use crate::sampling::{pixel_rng, PixelSample, SamplePattern, SobolPoints, PIXEL_STREAM};
 use crate::{Aov, DirectIntegrator, Scene};
 use glam::{Vec2, Vec3};
 use glint_camera::{Camera, Film};
@@ -285,6 +285,7 @@ fn render_rows(
     // differentials the same way, never below 1/8).
     let footprint_scale = (1.0 / (settings.spp as f32).sqrt()).max(0.125);
     let differentials = scene.needs_differentials();
+    let first_hits_in_lanes = integrator.shades_first_hits_in_lanes(scene);
     for (offset, radiance) in pixels.iter_mut().enumerate() {
         let (x, y) = (offset as u32 % width, first_row + offset as u32 / width);
         let pixel = y as u64 * width as u64 + x as u64;
@@ -315,6 +316,24 @@ fn render_rows(
                     )
                 })
                 .flatten();
+            if let (true, Some(hits)) = (first_hits_in_lanes, &hits) {
+                let first = PixelSample {
+                    seed: settings.seed,
+                    pixel,
+                    sample: (chunk * LANES) as u64,
+                };
+                let rays = rays.map(|(ray, _)| ray);
+                let values =
+                    integrator.li_first_hits(scene, &rays, hits, jitters.len(), first, &mut ctx);
+                for value in values.into_iter().take(jitters.len()) {
+                    if value.is_finite() {
+                        sum += value;
+                    } else {
+                        ctx.counters.nonfinite_samples += 1;
+                    }
+                }
+                continue;
+            }
             for (k, (ray, diff)) in rays.iter().take(jitters.len()).enumerate() {
                 ctx.begin_sample(settings.seed, pixel, (chunk * LANES + k) as u64);
                 let value = match (settings.aov, &hits) {

@@ -13,7 +13,8 @@
 //! - [`PhongMaterial::new`] (or [`PhongMaterial::mirror`]); per shading point,
 //!   [`PhongMaterial::reflectances`] gives `(kd, ks)` from the textures, then
 //!   [`PhongMaterial::reflect`] the reflection of one light and
-//!   [`PhongMaterial::brdf_cos`] the energy-normalised BRDF for the environment.
+//!   [`PhongMaterial::brdf_cos`] the energy-normalised BRDF for the environment;
+//!   [`PhongLanes`] reflects one light sample at each of eight points at once.
 //! - [`PointLight`], [`AreaLight::new`] (sampled with [`AreaLight::sample_point`]),
 //!   both wrapped in [`Light`].
 //! - [`EnvironmentLight::new`], with [`EnvironmentLight::radiance`],
@@ -26,11 +27,13 @@ mod area_light;
 pub mod distribution;
 mod environment_light;
 mod material;
+mod phong_lanes;
 mod point_light;
 
 pub use area_light::AreaLight;
 pub use environment_light::{EnvironmentLight, EnvironmentSample};
 pub use material::{PhongMaterial, SpecularLobe, UvTransform};
+pub use phong_lanes::PhongLanes;
 pub use point_light::PointLight;
 
 /// Every kind of light, as one enum (no virtual calls in the shading loop).

@@ -134,6 +134,20 @@ impl PhongMaterial {
         (kd, ks)
     }
 
+    /// [`Self::reflectances`] at the point `uv`, for a material whose textures
+    /// use no footprint ([`Self::uses_footprint`] is false): the same values,
+    /// without carrying the derivatives through the uv transform.
+    #[inline]
+    pub fn reflectances_at(&self, uv: Vec2) -> (Vec3, Vec3) {
+        let uv = uv * self.uv_transform.scale + self.uv_transform.offset;
+        let kd = self.diffuse.evaluate_at(uv);
+        let ks = match &self.specular {
+            Some(t) => t.evaluate_at(uv),
+            None => kd,
+        };
+        (kd, ks)
+    }
+
     /// Whether any of the material's textures filter over a footprint, so the
     /// integrator only computes ray differentials at hits that need them.
     pub fn uses_footprint(&self) -> bool {
@@ -191,7 +205,7 @@ impl PhongMaterial {
     /// Whether the exponent is taken by [`powi`] (integral, up to 1024) rather
     /// than `powf`.
     #[inline]
-    fn integral_exponent(&self) -> bool {
+    pub(crate) fn integral_exponent(&self) -> bool {
         self.shininess.fract() == 0.0 && self.shininess <= 1024.0
     }
 
@@ -242,7 +256,7 @@ impl PhongMaterial {
 /// an exponent unknown at compile time) in the same order, so the same bits. For
 /// `f32` or for lanes of them (`one` is 1 in the type).
 #[inline]
-fn powi<T>(mut base: T, exponent: i32, one: T) -> T
+pub(crate) fn powi<T>(mut base: T, exponent: i32, one: T) -> T
 where
     T: Copy + std::ops::Mul<Output = T> + std::ops::Div<Output = T>,
 {
@@ -408,6 +422,17 @@ mod tests {
         };
         assert_eq!(shifted.reflectances(&at(0.1, 0.1)).0, Vec3::Y);
         assert!(!shifted.uses_footprint());
+        // Looked up at a point without a footprint: the same values.
+        for m in [&tiled, &shifted, &m2] {
+            for k in 0..400 {
+                let uv = Vec2::new((k % 20) as f32 * 0.071 - 0.3, (k / 20) as f32 * 0.063 - 0.2);
+                assert_eq!(
+                    m.reflectances_at(uv),
+                    m.reflectances(&TexCoord::point(uv)),
+                    "{uv}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -48,7 +48,7 @@ pub use texcoord::TexCoord;
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// A color that may vary over a surface.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,6 +69,18 @@ impl Texture {
             Texture::Constant(c) => *c,
             Texture::Checkerboard(c) => c.evaluate_filtered(tc),
             Texture::Image(t) => t.evaluate(tc),
+        }
+    }
+
+    /// [`Self::evaluate`] at the point `uv` (a footprint of zero size), without
+    /// building a [`TexCoord`]: constants and unfiltered checkerboards read
+    /// nothing else.
+    #[inline]
+    pub fn evaluate_at(&self, uv: Vec2) -> Vec3 {
+        match self {
+            Texture::Constant(c) => *c,
+            Texture::Checkerboard(c) if !c.analytic => c.evaluate(uv),
+            _ => self.evaluate(&TexCoord::point(uv)),
         }
     }
 

@@ -62,6 +62,24 @@ impl ShapeList {
         })
     }
 
+    /// [`ShapeList::surface_record`] without the derivatives of the point and
+    /// normal where they cost extra (a sphere's: left zero, see
+    /// [`Sphere::surface_point`](crate::Sphere::surface_point)), for shading
+    /// that reads no texture footprint. Every other field is the same.
+    pub fn surface_point(&self, ray: &Ray, found: PrimitiveHit) -> Option<Hit> {
+        match self.objects[found.object as usize] {
+            Object::Shape(s) => match &self.shapes[s as usize] {
+                Shape::Sphere(sphere) => Some(Hit {
+                    shape: found.object,
+                    primitive: found.primitive,
+                    ..sphere.surface_point(ray, found.t)
+                }),
+                _ => self.surface_record(ray, found),
+            },
+            Object::Mesh(_) => self.surface_record(ray, found),
+        }
+    }
+
     /// The nearest hit with `0 < t < t_max` as [`ShapeList::closest_hit`] finds
     /// it, without its surface record: which primitive, and where along the ray.
     pub fn closest_primitive(&self, ray: &Ray, t_max: f32) -> Option<PrimitiveHit> {

@@ -413,3 +413,41 @@ mod lanes {
         assert!(list.closest_primitives_lanes(&rays, 8).is_none());
     }
 }
+
+/// `surface_point` is `surface_record` with a sphere's derivatives left zero:
+/// every other field the same bits, on spheres and a plane.
+#[test]
+fn surface_points_are_surface_records_without_sphere_derivatives() {
+    let list = scene();
+    let mut compared = 0;
+    for k in 0..400 {
+        let a = k as f32 * 0.37;
+        let ray = Ray::new(
+            Vec3::new(0.5 * a.sin(), 0.4 * a.cos(), 0.0),
+            Vec3::new(0.1 * (1.3 * a).sin(), 0.1 * (0.7 * a).cos(), -1.0),
+        );
+        let Some(found) = list.closest_primitive(&ray, f32::INFINITY) else {
+            continue;
+        };
+        let record = list.surface_record(&ray, found).unwrap();
+        let point = list.surface_point(&ray, found).unwrap();
+        let is_sphere = matches!(
+            list.object(found.object),
+            ObjectRef::Shape(Shape::Sphere(_))
+        );
+        let expected = if is_sphere {
+            crate::Hit {
+                dpdu: Vec3::ZERO,
+                dpdv: Vec3::ZERO,
+                dndu: Vec3::ZERO,
+                dndv: Vec3::ZERO,
+                ..record
+            }
+        } else {
+            record
+        };
+        assert_eq!(format!("{point:?}"), format!("{expected:?}"), "ray {ray:?}");
+        compared += 1;
+    }
+    assert!(compared > 300, "{compared} hits");
+}

@@ -68,13 +68,7 @@ impl Sphere {
     /// The surface record at ray parameter `t`, found by [`Self::hit_distance`].
     /// The hit point is projected back onto the sphere to remove the error of `o + t·d`.
     pub fn surface_at(&self, ray: &Ray, t: f32) -> Hit {
-        let n = (ray.at(t) - self.center).normalize();
-        let point = self.center + self.radius * n;
-        let theta = n.y.clamp(-1.0, 1.0).acos();
-        let mut phi = (-n.z).atan2(n.x);
-        if phi < 0.0 {
-            phi += TAU;
-        }
+        let (hit, theta, phi) = self.surface_frame(ray, t);
         let (sin_phi, cos_phi) = phi.sin_cos();
         let (sin_theta, cos_theta) = theta.sin_cos();
         let r = self.radius;
@@ -82,19 +76,47 @@ impl Sphere {
         let dpdu = TAU * r * Vec3::new(-sin_theta * sin_phi, 0.0, -sin_theta * cos_phi);
         let dpdv = -PI * r * Vec3::new(cos_theta * cos_phi, -sin_theta, -cos_theta * sin_phi);
         Hit {
-            t,
-            point,
-            geometric_normal: n,
-            shading_normal: n,
-            uv: Vec2::new(phi / TAU, 1.0 - theta / PI),
             dpdu,
             dpdv,
             // n = (p − c)/r, so ∂n/∂u = (∂p/∂u)/r (Weingarten, for a sphere).
             dndu: dpdu / r,
             dndv: dpdv / r,
+            ..hit
+        }
+    }
+
+    /// [`Self::surface_at`] without the derivatives `dpdu`, `dpdv`, `dndu` and
+    /// `dndv` (left zero), for shading that reads no texture footprint: the
+    /// other fields bit for bit, without the two `sin_cos` the derivatives take.
+    pub fn surface_point(&self, ray: &Ray, t: f32) -> Hit {
+        self.surface_frame(ray, t).0
+    }
+
+    /// The surface record at `t` without derivatives, and the hit's polar angle
+    /// θ (from +y) and azimuth φ (from +x towards −z, in [0, 2π)).
+    #[inline]
+    fn surface_frame(&self, ray: &Ray, t: f32) -> (Hit, f32, f32) {
+        let n = (ray.at(t) - self.center).normalize();
+        let point = self.center + self.radius * n;
+        let theta = n.y.clamp(-1.0, 1.0).acos();
+        let mut phi = (-n.z).atan2(n.x);
+        if phi < 0.0 {
+            phi += TAU;
+        }
+        let hit = Hit {
+            t,
+            point,
+            geometric_normal: n,
+            shading_normal: n,
+            uv: Vec2::new(phi / TAU, 1.0 - theta / PI),
+            dpdu: Vec3::ZERO,
+            dpdv: Vec3::ZERO,
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
             front_face: n.dot(ray.direction) < 0.0,
             shape: 0,
             primitive: 0,
-        }
+        };
+        (hit, theta, phi)
     }
 }

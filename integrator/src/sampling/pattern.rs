@@ -63,13 +63,17 @@ impl SamplePattern {
     #[inline]
     pub fn fill(self, rng: &mut Pcg32, sobol: SobolPoints, out: &mut [Vec2]) {
         let n = out.len() as u32;
-        match (self, exact_sqrt(n)) {
-            (Self::Grid, Some(k)) => fill_grid(k, out, |_| Vec2::splat(0.5)),
-            (Self::Grid, None) => panic!("grid pattern needs a square count, got {n}"),
-            (Self::Random, _) => out.iter_mut().for_each(|p| *p = uniform2(rng)),
-            (Self::Stratified, Some(k)) => fill_grid(k, out, |_| uniform2(rng)),
-            (Self::Stratified, None) => fill_latin_hypercube(rng, out),
-            (Self::Sobol, _) => sobol.fill(out),
+        match self {
+            Self::Random => out.iter_mut().for_each(|p| *p = uniform2(rng)),
+            Self::Sobol => sobol.fill(out),
+            Self::Grid => match exact_sqrt(n) {
+                Some(k) => fill_grid(k, out, |_| Vec2::splat(0.5)),
+                None => panic!("grid pattern needs a square count, got {n}"),
+            },
+            Self::Stratified => match exact_sqrt(n) {
+                Some(k) => fill_grid(k, out, |_| uniform2(rng)),
+                None => fill_latin_hypercube(rng, out),
+            },
         }
     }
 }

@@ -1,0 +1,462 @@
+//! The first hits of eight camera samples shaded at once.
+//!
+//! With one sample per area light per camera sample (`--light-samples 1`, the
+//! way Mitsuba's `direct` integrator is usually run), a shading point has no
+//! light samples for [`crate::light_samples`]' lanes to batch. The lanes are
+//! then the camera samples: the eight samples of a pixel that
+//! [`glint_geometry::ShapeList::closest_primitives_lanes`] found the hits of
+//! together are shaded together too. Their light points, directions, Phong
+//! reflections ([`PhongLanes`], each lane with its own material) and
+//! horizon tests run in SIMD lanes, and their shadow rays, from eight origins,
+//! are traced as one batch.
+//!
+//! This is only done where a scene needs nothing else at a first hit
+//! ([`DirectIntegrator::shades_first_hits_in_lanes`]): area lights only, no
+//! environment, no mirrors, no texture footprints. Every lane repeats the
+//! scalar path's operations in its order, and its random numbers come from its
+//! own camera sample's stream, so each sample's radiance and the shading counts
+//! are those of [`DirectIntegrator::li_at`], bit for bit (the tests compare).
+
+use crate::direct::{PairAllocation, SampleContext, ShadingPoint};
+use crate::sampling::{DimensionPair, PixelSample, SamplePattern};
+use crate::{DirectIntegrator, Scene, SurfaceKind};
+use glam::{Vec2, Vec3};
+use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
+use glint_geometry::{offset_ray_origin, Occluders, PrimitiveHit, Ray, RayLanes, SHADOW_EPSILON};
+use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial};
+use glint_texture::TexCoord;
+
+impl DirectIntegrator {
+    /// Whether the first hits of `scene`'s camera samples can be shaded eight at
+    /// a time ([`Self::li_first_hits`]): one sample per area light, only area
+    /// lights, no environment, and materials without mirrors or texture
+    /// footprints.
+    pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
+        self.light_samples == 1
+            && scene.environment.is_none()
+            && scene.lights.iter().all(|l| matches!(l, Light::Area(_)))
+            && scene
+                .materials
+                .iter()
+                .all(|m| m.reflectivity == 0.0 && !m.uses_footprint())
+    }
+
+    /// The radiance of the first `used` of eight camera samples of one pixel,
+    /// samples `first.sample..first.sample + used`, whose camera rays `rays`
+    /// have the closest hits `hits`: for each, what [`Self::li_at`] gives it
+    /// alone (with [`SampleContext::begin_sample`] for that sample), bit for bit.
+    /// Only for scenes where [`Self::shades_first_hits_in_lanes`] holds.
+    pub(crate) fn li_first_hits(
+        &self,
+        scene: &Scene,
+        rays: &[Ray; LANES],
+        hits: &[Option<PrimitiveHit>; LANES],
+        used: usize,
+        first: PixelSample,
+        ctx: &mut SampleContext,
+    ) -> [Vec3; LANES] {
+        debug_assert!(self.shades_first_hits_in_lanes(scene));
+        let mut radiance = [Vec3::ZERO; LANES];
+        let mut shaded = ShadedLanes::default();
+        for (k, (ray, found)) in rays.iter().zip(hits).take(used).enumerate() {
+            let Some(hit) = found.and_then(|found| scene.shapes.surface_point(ray, found)) else {
+                continue;
+            };
+            match scene.surface_of(&hit) {
+                SurfaceKind::Emitter(Light::Area(area)) => radiance[k] = area.color,
+                SurfaceKind::Emitter(_) => {}
+                SurfaceKind::Material(material) => {
+                    if ctx.detailed {
+                        ctx.textures.record(material, &TexCoord::point(hit.uv));
+                    }
+                    let reflectances = material.reflectances_at(hit.uv);
+                    let point = ShadingPoint::with_reflectances(&hit, material, ray, reflectances);
+                    radiance[k] = scene.ambient * point.kd;
+                    shaded.set(k, &point, material);
+                }
+            }
+        }
+        if shaded.lanes == 0 {
+            return radiance;
+        }
+        let shaded = shaded.transposed();
+        // Each lane's own stream, as `SampleContext::begin_sample` makes it (only
+        // patterns other than Sobol draw from it).
+        let mut rngs: [Option<rand_pcg::Pcg32>; LANES] = std::array::from_fn(|k| {
+            let sample = PixelSample {
+                sample: first.sample + k as u64,
+                ..first
+            };
+            (shaded.lanes >> k & 1 == 1 && self.light_pattern != SamplePattern::Sobol)
+                .then(|| sample.rng())
+        });
+        let mut pairs = PairAllocation::new(0);
+        for (index, light) in scene.lights.iter().enumerate() {
+            let Light::Area(area) = light else {
+                unreachable!("shades_first_hits_in_lanes admits area lights only")
+            };
+            let own = DimensionPair::Light {
+                light: index as u32,
+                depth: 0,
+            };
+            let pair = pairs.take(own, self.light_samples);
+            let u: [Vec2; LANES] = std::array::from_fn(|k| {
+                let mut u = [Vec2::ZERO];
+                if shaded.lanes >> k & 1 == 1 {
+                    let sample = PixelSample {
+                        sample: first.sample + k as u64,
+                        ..first
+                    };
+                    let sobol = sample.sobol_points(pair, 1);
+                    match &mut rngs[k] {
+                        Some(rng) => self.light_pattern.fill(rng, sobol, &mut u),
+                        None => self.light_pattern.fill(&mut ctx.rng, sobol, &mut u),
+                    }
+                }
+                u[0]
+            });
+            ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
+            let reflected = shaded.area_light(scene, area, &u, ctx);
+            for (k, radiance) in radiance.iter_mut().enumerate() {
+                if shaded.lanes >> k & 1 == 1 {
+                    let sum = Vec3::ZERO + reflected[k];
+                    *radiance += area.color * sum / self.light_samples as f32;
+                }
+            }
+        }
+        for (k, radiance) in radiance.iter_mut().enumerate() {
+            if shaded.lanes >> k & 1 == 1 {
+                if self.environment_samples > 0 {
+                    // What `shade` adds for an environment the scene lacks.
+                    *radiance += Vec3::ZERO;
+                }
+                // `li_at`'s blend with the (absent) mirror term: r = 0.
+                let r = 0.0;
+                *radiance = (1.0 - r) * *radiance + r * Vec3::ZERO;
+            }
+        }
+        radiance
+    }
+}
+
+/// The shading points of up to eight lanes, gathered one by one
+/// ([`ShadedLanes::set`]), then in SIMD form ([`ShadedLanes::transposed`]).
+#[derive(Default)]
+struct ShadedLanes<'a> {
+    /// The lanes holding a point (bit k for lane k).
+    lanes: u32,
+    points: [Vec3; LANES],
+    geometric_normals: [Vec3; LANES],
+    /// The geometric normals on the viewer's side.
+    ngs: [Vec3; LANES],
+    point: Vec3x8,
+    geometric_normal: Vec3x8,
+    ng: Vec3x8,
+    phong: PhongLanes<'a>,
+}
+
+impl<'a> ShadedLanes<'a> {
+    /// Puts `p`, of `material`, in lane `k`.
+    fn set(&mut self, k: usize, p: &ShadingPoint, material: &'a PhongMaterial) {
+        self.phong
+            .set(k, material, p.kd, p.ks, p.n, p.v, p.has_specular);
+        self.lanes |= 1 << k;
+        self.points[k] = p.hit.point;
+        self.geometric_normals[k] = p.hit.geometric_normal;
+        self.ngs[k] = p.ng;
+    }
+
+    /// With the points gathered, their lanes.
+    fn transposed(self) -> Self {
+        Self {
+            point: Vec3x8::from_lanes(self.points),
+            geometric_normal: Vec3x8::from_lanes(self.geometric_normals),
+            ng: Vec3x8::from_lanes(self.ngs),
+            ..self
+        }
+    }
+
+    /// Per lane, the Phong reflection of the light point at `u` on `light`, or
+    /// zero where it is behind the light, below the surface, reflects nothing or
+    /// is blocked: `unoccluded_reflection` of the scalar path, with its counts.
+    fn area_light(
+        &self,
+        scene: &Scene,
+        light: &AreaLight,
+        u: &[Vec2; LANES],
+        ctx: &mut SampleContext,
+    ) -> [Vec3; LANES] {
+        let (ux, uy) = (f32x8::new(u.map(|u| u.x)), f32x8::new(u.map(|u| u.y)));
+        let position = light.sample_points(ux, uy);
+        let towards = position - self.point;
+        let (l, normalized) = towards.try_normalize();
+        let reflected = self.phong.reflect(&l);
+        let normal = light.surface().normal();
+        let lit = self.lanes
+            & lanes::bits(lanes::gt(
+                (self.point - position).dot_splat(normal),
+                f32x8::ZERO,
+            ));
+        let normalized = lanes::bits(normalized);
+        let above = lanes::bits(lanes::gt(l.dot(&self.ng), f32x8::ZERO));
+        let shaded = lit & normalized & above;
+        let traced = shaded & !lanes::bits(reflected.is_zero());
+        let counters = &mut ctx.counters;
+        let ones = |bits: u32| u64::from(bits.count_ones());
+        counters.skipped_behind_light += ones(self.lanes & !lit);
+        counters.skipped_behind_surface += ones(lit & normalized & !shaded);
+        counters.specular_lobes += ones(shaded & self.phong.specular_lanes());
+        counters.skipped_zero_brdf += ones(shaded & !traced);
+        counters.light_shadow_rays += ones(traced);
+        let visible = traced & !self.blocked(scene, &position, &towards, traced);
+        std::array::from_fn(|k| {
+            if visible >> k & 1 == 1 {
+                reflected.lane(k)
+            } else {
+                Vec3::ZERO
+            }
+        })
+    }
+
+    /// The `traced` lanes whose shadow ray, from the point (offset to the side
+    /// `towards` leaves on) to `position`, is blocked.
+    fn blocked(&self, scene: &Scene, position: &Vec3x8, towards: &Vec3x8, traced: u32) -> u32 {
+        let from_back = lanes::lt(towards.dot(&self.geometric_normal), f32x8::ZERO);
+        let outgoing = Vec3x8::select(from_back, &-self.geometric_normal, &self.geometric_normal);
+        let origin = Vec3x8::from_lanes(std::array::from_fn(|k| {
+            if traced >> k & 1 == 1 {
+                offset_ray_origin(self.point.lane(k), outgoing.lane(k))
+            } else {
+                Vec3::ZERO
+            }
+        }));
+        let rays = RayLanes {
+            origin,
+            direction: *position - origin,
+        };
+        scene
+            .shapes
+            .any_hits_among(&Occluders::ALL, &rays, 1.0 - SHADOW_EPSILON, traced)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{SceneBuilder, ShadingCounters};
+    use glam::UVec2;
+    use glint_camera::Camera;
+    use glint_geometry::{Parallelogram, RayDifferential, Sphere};
+    use glint_lighting::SpecularLobe;
+    use glint_texture::{Checkerboard, Texture};
+
+    /// A room (floor, back wall, one-sided ceiling) with four spheres in
+    /// materials that take every path of the Phong lanes, lit by two area
+    /// lights: one facing down into the room, one facing the back wall from
+    /// in front of the camera's view, so that each is behind some points.
+    fn room() -> Scene {
+        let mut b = SceneBuilder::new();
+        let checks = b.material(PhongMaterial::new(
+            Checkerboard::new(Vec3::new(0.9, 0.2, 0.1), Vec3::new(0.1, 0.3, 0.8), 4),
+            22.0,
+        ));
+        let gray = b.material(PhongMaterial::new(Vec3::splat(0.7), 16.0));
+        let blinn = b.material(PhongMaterial {
+            lobe: SpecularLobe::BlinnPhong,
+            ..PhongMaterial::new(Vec3::new(0.2, 0.4, 0.9), 40.0)
+        });
+        let fractional = b.material(PhongMaterial::new(Vec3::new(0.6, 0.6, 0.1), 7.5));
+        let matte = b.material(PhongMaterial {
+            specular: Some(Texture::Constant(Vec3::ZERO)),
+            ..PhongMaterial::new(Vec3::new(0.3, 0.8, 0.3), 1.0)
+        });
+        // Reflects nothing: no shadow ray is traced.
+        let black = b.material(PhongMaterial {
+            specular: Some(Texture::Constant(Vec3::ZERO)),
+            ..PhongMaterial::new(Vec3::ZERO, 1.0)
+        });
+        let wall = |origin: Vec3, e1: Vec3, e2: Vec3, facing: Vec3| {
+            Parallelogram::new(origin, e1, e2, false)
+                .unwrap()
+                .facing(facing)
+        };
+        b.shape(
+            wall(
+                Vec3::new(-5.0, -2.0, -9.0),
+                Vec3::X * 10.0,
+                Vec3::Z * 12.0,
+                Vec3::Y,
+            ),
+            gray,
+        )
+        .shape(
+            wall(
+                Vec3::new(-5.0, -2.0, -9.0),
+                Vec3::X * 10.0,
+                Vec3::Y * 8.0,
+                Vec3::Z,
+            ),
+            checks,
+        )
+        .shape(
+            wall(
+                Vec3::new(-5.0, 4.0, -9.0),
+                Vec3::X * 10.0,
+                Vec3::Z * 12.0,
+                -Vec3::Y,
+            ),
+            matte,
+        )
+        .shape(
+            Sphere::new(Vec3::new(-2.0, -1.0, -5.0), 1.0).unwrap(),
+            checks,
+        )
+        .shape(Sphere::new(Vec3::new(0.5, 0.0, -6.0), 1.2).unwrap(), blinn)
+        .shape(
+            Sphere::new(Vec3::new(2.5, -1.2, -4.0), 0.8).unwrap(),
+            fractional,
+        )
+        .shape(Sphere::new(Vec3::new(0.0, 2.5, -7.0), 0.6).unwrap(), black);
+        let down = AreaLight::new(Vec3::new(0.0, 3.9, -5.0), Vec3::X, Vec3::Z, Vec3::ONE)
+            .unwrap()
+            .facing(-Vec3::Y);
+        let back = AreaLight::new(
+            Vec3::new(1.0, 1.0, -1.0),
+            Vec3::X * 0.5,
+            Vec3::Y * 0.5,
+            Vec3::new(0.8, 0.6, 0.3),
+        )
+        .unwrap()
+        .facing(-Vec3::Z);
+        b.area_light(down).area_light(back);
+        b.ambient(Vec3::splat(0.05));
+        let camera = Camera::new(
+            Vec3::new(0.0, 1.0, 3.0),
+            Vec3::new(0.0, 0.0, -5.0),
+            Vec3::Y,
+            70.0,
+            1.0,
+            UVec2::new(12, 10),
+        )
+        .unwrap();
+        b.build(camera).unwrap()
+    }
+
+    /// Every camera sample of every pixel, in chunks of eight (and of three
+    /// and one, partly filled): the lanes give each sample's `li_at` radiance
+    /// and the shading counts bit for bit, for every light pattern.
+    #[test]
+    fn lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
+        let scene = room();
+        let mut total = ShadingCounters::default();
+        for pattern in [
+            SamplePattern::Random,
+            SamplePattern::Stratified,
+            SamplePattern::Sobol,
+            SamplePattern::Grid,
+        ] {
+            let integrator = DirectIntegrator {
+                light_samples: 1,
+                light_pattern: pattern,
+                environment_samples: 4,
+                environment_pattern: SamplePattern::Sobol,
+                max_depth: 4,
+            };
+            assert!(integrator.shades_first_hits_in_lanes(&scene));
+            let resolution = scene.camera.resolution();
+            let mut compared = 0;
+            for pixel in 0..(resolution.x * resolution.y) as u64 {
+                let (x, y) = (pixel % resolution.x as u64, pixel / resolution.x as u64);
+                for (chunk, used) in [(0u64, 8usize), (1, 3), (2, 1)] {
+                    let rays: [Ray; LANES] = std::array::from_fn(|k| {
+                        let jitter = ((k as f32 + 0.5) / 8.0, ((k * 5 % 8) as f32 + 0.5) / 8.0);
+                        let c = scene
+                            .camera
+                            .generate_ray(x as f32 + jitter.0, y as f32 + jitter.1);
+                        Ray::new(c.origin, c.direction)
+                    });
+                    let hits = scene
+                        .shapes
+                        .closest_primitives_lanes(&RayLanes::new(rays), used)
+                        .expect("spheres and parallelograms: hits in lanes");
+                    let first = PixelSample {
+                        seed: 11,
+                        pixel,
+                        sample: chunk * LANES as u64,
+                    };
+                    let mut lanes = SampleContext::new(1, 4);
+                    let values =
+                        integrator.li_first_hits(&scene, &rays, &hits, used, first, &mut lanes);
+                    let mut scalar = SampleContext::new(1, 4);
+                    for (k, ray) in rays.iter().enumerate().take(used) {
+                        scalar.begin_sample(first.seed, pixel, first.sample + k as u64);
+                        let hit = scene.shapes.closest_hit(ray, f32::INFINITY);
+                        let expected = integrator.li_at(
+                            &scene,
+                            ray,
+                            &RayDifferential::none(ray),
+                            hit,
+                            0,
+                            &mut scalar,
+                        );
+                        assert_eq!(
+                            values[k].to_array().map(f32::to_bits),
+                            expected.to_array().map(f32::to_bits),
+                            "{pattern:?}, pixel ({x}, {y}), sample {}: {} against {expected}",
+                            first.sample + k as u64,
+                            values[k]
+                        );
+                        compared += 1;
+                    }
+                    assert_eq!(
+                        lanes.counters, scalar.counters,
+                        "{pattern:?} pixel ({x}, {y})"
+                    );
+                    total += scalar.counters;
+                }
+            }
+            assert_eq!(compared, 12 * 10 * 12);
+        }
+        // Every branch was taken: lanes behind a light, below the horizon, with
+        // zero reflection, traced, and the specular lobe evaluated.
+        assert!(total.light_samples > 0, "{total:?}");
+        assert!(total.skipped_behind_light > 0, "{total:?}");
+        assert!(total.skipped_behind_surface > 0, "{total:?}");
+        assert!(total.skipped_zero_brdf > 0, "{total:?}");
+        assert!(total.light_shadow_rays > 0, "{total:?}");
+        assert!(total.specular_lobes > 0, "{total:?}");
+    }
+
+    #[test]
+    fn scenes_that_need_more_at_a_hit_are_shaded_one_by_one() {
+        let scene = room();
+        let integrator = |light_samples| DirectIntegrator {
+            light_samples,
+            light_pattern: SamplePattern::Random,
+            environment_samples: 0,
+            environment_pattern: SamplePattern::Sobol,
+            max_depth: 4,
+        };
+        assert!(integrator(1).shades_first_hits_in_lanes(&scene));
+        // Several light samples: those are the lanes (`light_samples`).
+        assert!(!integrator(2).shades_first_hits_in_lanes(&scene));
+        let with = |change: fn(&mut Scene)| {
+            let mut scene = room();
+            change(&mut scene);
+            integrator(1).shades_first_hits_in_lanes(&scene)
+        };
+        assert!(!with(|s| s.materials[1].reflectivity = 0.5));
+        assert!(!with(|s| {
+            s.materials[0].diffuse = Texture::Checkerboard(Checkerboard {
+                analytic: true,
+                ..Checkerboard::new(Vec3::ZERO, Vec3::ONE, 4)
+            })
+        }));
+        assert!(!with(|s| s.lights.push(Light::Point(
+            glint_lighting::PointLight {
+                position: Vec3::Y,
+                color: Vec3::ONE
+            }
+        ))));
+    }
+}

@@ -1,0 +1,223 @@
+//! The Phong reflection of eight shading points at once, each with its own
+//! material, reflectances, normal and viewer: one light direction per lane.
+//!
+//! [`PhongMaterial::reflect_lanes`] shades eight light samples of *one* point;
+//! [`PhongLanes`] shades one light sample of each of eight points (eight camera
+//! samples' hits). Each lane is bit for bit what [`PhongMaterial::reflect`]
+//! (or [`PhongMaterial::reflect_diffuse`] where the lane has no specular term)
+//! gives for that point: the same operations in the same order, nothing fused.
+//! The lobe's power `cos^s` is taken by the repeated squaring of
+//! [`f32::powi`] with each lane's own exponent; lanes whose lobe is Blinn–Phong
+//! or whose exponent is not an integer are computed one by one.
+
+use crate::{PhongMaterial, SpecularLobe};
+use glam::Vec3;
+use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
+
+/// Eight shading points' Phong parameters, one per lane; lanes never set
+/// reflect nothing.
+#[derive(Clone, Debug, Default)]
+pub struct PhongLanes<'a> {
+    materials: [Option<&'a PhongMaterial>; LANES],
+    kd: [Vec3; LANES],
+    ks: [Vec3; LANES],
+    n: [Vec3; LANES],
+    v: [Vec3; LANES],
+    /// Lanes with a specular term (bit k for lane k).
+    specular: u32,
+    /// Lanes whose lobe is a Phong lobe with an integral exponent, taken in lanes.
+    lane_lobes: u32,
+    /// Each lane's exponent, where its lobe is taken in lanes.
+    exponents: [u32; LANES],
+}
+
+impl<'a> PhongLanes<'a> {
+    /// Sets lane `lane` to the point with `material`, reflectances `kd` and
+    /// `ks`, unit normal `n` and unit direction to the viewer `v`; `specular`
+    /// says whether its specular term is evaluated (as the scalar path's choice
+    /// between [`PhongMaterial::reflect`] and [`PhongMaterial::reflect_diffuse`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn set(
+        &mut self,
+        lane: usize,
+        material: &'a PhongMaterial,
+        kd: Vec3,
+        ks: Vec3,
+        n: Vec3,
+        v: Vec3,
+        specular: bool,
+    ) {
+        self.materials[lane] = Some(material);
+        (self.kd[lane], self.ks[lane]) = (kd, ks);
+        (self.n[lane], self.v[lane]) = (n, v);
+        let bit = 1 << lane;
+        self.specular = (self.specular & !bit) | if specular { bit } else { 0 };
+        let in_lanes = material.lobe == SpecularLobe::Phong
+            && material.integral_exponent()
+            && material.shininess >= 0.0;
+        self.lane_lobes = (self.lane_lobes & !bit) | if in_lanes { bit } else { 0 };
+        self.exponents[lane] = if in_lanes {
+            material.shininess as u32
+        } else {
+            0
+        };
+    }
+
+    /// The lanes that were set (bit k for lane k).
+    pub fn lanes(&self) -> u32 {
+        (0..LANES).fold(0, |bits, k| {
+            bits | u32::from(self.materials[k].is_some()) << k
+        })
+    }
+
+    /// The lanes with a specular term.
+    pub fn specular_lanes(&self) -> u32 {
+        self.specular
+    }
+
+    /// Per lane, the fraction of a unit light from direction `l` reflected
+    /// towards the lane's viewer: `kd · n·l + ks · lobe`, zero where `n·l ≤ 0`.
+    #[inline]
+    pub fn reflect(&self, l: &Vec3x8) -> Vec3x8 {
+        let n = Vec3x8::from_lanes(self.n);
+        let n_dot_l = n.dot(l);
+        let diffuse = Vec3x8::from_lanes(self.kd).scale(n_dot_l);
+        let reflected = if self.specular == 0 {
+            diffuse
+        } else {
+            let lobe = self.specular_lobe(&n, l, n_dot_l);
+            let specular = diffuse + Vec3x8::from_lanes(self.ks).scale(lobe);
+            Vec3x8::select(lanes::from_bits(self.specular), &specular, &diffuse)
+        };
+        // `n·l ≤ 0` gives zero (a NaN goes on, as in the scalar test).
+        let behind = lanes::le(n_dot_l, f32x8::ZERO);
+        Vec3x8::select(behind, &Vec3x8::default(), &reflected)
+    }
+
+    /// [`PhongMaterial::specular_lobe`] per lane.
+    #[inline]
+    fn specular_lobe(&self, n: &Vec3x8, l: &Vec3x8, n_dot_l: f32x8) -> f32x8 {
+        // (2·(n·l))·n − l, then its dot product with v.
+        let mirror = n.scale(f32x8::splat(2.0) * n_dot_l) - *l;
+        let cosine = mirror.dot(&Vec3x8::from_lanes(self.v));
+        let lobe = lanes::le(cosine, f32x8::ZERO).select(f32x8::ZERO, self.powers(cosine));
+        let one_by_one = self.specular & !self.lane_lobes;
+        if one_by_one == 0 {
+            return lobe;
+        }
+        let n_dot_l = n_dot_l.to_array();
+        let mut lobe = lobe.to_array();
+        for (k, lobe) in lobe.iter_mut().enumerate() {
+            if let Some(m) = self.materials[k].filter(|_| one_by_one >> k & 1 == 1) {
+                *lobe = m.specular_lobe(self.n[k], l.lane(k), self.v[k], n_dot_l[k]);
+            }
+        }
+        f32x8::new(lobe)
+    }
+
+    /// `base^exponent` per lane by the binary exponentiation of [`powi`]: bit
+    /// `b` of a lane's exponent multiplies its result by `base^(2^b)`, in the
+    /// scalar loop's order; the squarings past a lane's top bit leave its
+    /// result alone.
+    #[inline]
+    fn powers(&self, mut base: f32x8) -> f32x8 {
+        let top = self.exponents.iter().copied().max().unwrap_or(0);
+        let bit = |b: u32| {
+            lanes::from_bits((0..LANES).fold(0, |bits, k| bits | (self.exponents[k] >> b & 1) << k))
+        };
+        let mut result = bit(0).select(base, f32x8::ONE);
+        let mut b = 1;
+        while top >> b != 0 {
+            base = base * base;
+            result = bit(b).select(result * base, result);
+            b += 1;
+        }
+        result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::powi;
+
+    #[test]
+    fn powers_give_the_bits_of_powi_for_each_lanes_exponent() {
+        let material = PhongMaterial::new(Vec3::ONE, 1.0);
+        let mut lanes = PhongLanes::default();
+        let exponents = [0u32, 1, 2, 3, 16, 22, 120, 1024];
+        for (k, &e) in exponents.iter().enumerate() {
+            lanes.set(k, &material, Vec3::ONE, Vec3::ONE, Vec3::Y, Vec3::Y, true);
+            lanes.exponents[k] = e;
+        }
+        for base in [0.0f32, 0.3, 0.5, 0.9, 0.99999, 1.0] {
+            let out = lanes.powers(f32x8::splat(base)).to_array();
+            for (k, &e) in exponents.iter().enumerate() {
+                let expected = powi(base, e as i32, 1.0);
+                assert_eq!(out[k].to_bits(), expected.to_bits(), "{base}^{e}");
+            }
+        }
+    }
+
+    #[test]
+    fn eight_points_reflect_the_scalar_bits() {
+        let materials: Vec<PhongMaterial> = [1.0, 16.0, 22.0, 120.0, 7.5, 2000.0, 0.0, 40.0]
+            .iter()
+            .enumerate()
+            .map(|(k, &s)| PhongMaterial {
+                lobe: if k == 7 {
+                    SpecularLobe::BlinnPhong
+                } else {
+                    SpecularLobe::Phong
+                },
+                ..PhongMaterial::new(Vec3::new(0.7, 0.5, 0.2), s)
+            })
+            .collect();
+        let unit = |a: f32, b: f32| Vec3::new(a.sin() * b.cos(), a.cos(), a.sin() * b.sin());
+        for batch in 0..40 {
+            let f = batch as f32;
+            let mut lanes = PhongLanes::default();
+            let mut points = Vec::new();
+            for k in 0..LANES {
+                let (m, g) = (&materials[(k + batch) % LANES], k as f32);
+                let kd = Vec3::new(0.1 * g, 0.9 - 0.1 * g, 0.5);
+                let ks = if batch % 3 == 0 {
+                    Vec3::ZERO
+                } else {
+                    Vec3::splat(0.3)
+                };
+                let n = unit(0.2 * f + g, 0.7 * g);
+                let v = unit(0.3 * f - g, 1.1 * g + f);
+                let specular = (batch + k) % 4 != 0;
+                if (batch + 2 * k) % 7 != 0 {
+                    lanes.set(k, m, kd, ks, n, v, specular);
+                    points.push((k, m, kd, ks, n, v, specular));
+                }
+            }
+            // Directions around each lane's horizon and mirror peak, a zero and a NaN.
+            let l: [Vec3; LANES] = std::array::from_fn(|k| match (batch, k) {
+                (0, 0) => Vec3::ZERO,
+                (1, 1) => Vec3::new(f32::NAN, 1.0, 0.0),
+                _ => unit(0.37 * (k + 8 * batch) as f32 - 1.5, 0.4 * f),
+            });
+            let out = lanes.reflect(&Vec3x8::from_lanes(l));
+            assert_eq!(lanes.lanes().count_ones() as usize, points.len());
+            for (k, m, kd, ks, n, v, specular) in points {
+                let scalar = if specular {
+                    m.reflect(kd, ks, n, l[k], v)
+                } else {
+                    m.reflect_diffuse(kd, n, l[k])
+                };
+                let lane = out.lane(k);
+                for axis in 0..3 {
+                    assert!(
+                        lane[axis].to_bits() == scalar[axis].to_bits()
+                            || (lane[axis].is_nan() && scalar[axis].is_nan()),
+                        "batch {batch} lane {k} s={}: {lane} against {scalar}",
+                        m.shininess
+                    );
+                }
+            }
+        }
+    }
+}

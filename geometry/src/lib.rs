@@ -64,7 +64,7 @@ mod shapes;
 pub use counters::{take_counters, CountingGuard, QueryCounters};
 pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceDifferentials};
 pub use hit::Hit;
-pub use offset::{offset_ray_origin, spawn_ray, spawn_ray_to, SHADOW_EPSILON};
+pub use offset::{offset_ray_origin, offset_ray_origins, spawn_ray, spawn_ray_to, SHADOW_EPSILON};
 pub use ray::Ray;
 pub use shape_list::{ObjectRef, Occluders, PrimitiveHit, ShapeList};
 pub use shapes::{triangle, triangle_packet};

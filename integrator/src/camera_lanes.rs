@@ -22,7 +22,7 @@ use crate::sampling::{DimensionPair, PixelSample, SamplePattern};
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
-use glint_geometry::{offset_ray_origin, Occluders, PrimitiveHit, Ray, RayLanes, SHADOW_EPSILON};
+use glint_geometry::{offset_ray_origins, Occluders, PrimitiveHit, Ray, RayLanes, SHADOW_EPSILON};
 use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial};
 use glint_texture::TexCoord;
 
@@ -79,7 +79,7 @@ impl DirectIntegrator {
         if shaded.lanes == 0 {
             return radiance;
         }
-        let shaded = shaded.transposed();
+        shaded.transpose();
         // Each lane's own stream, as `SampleContext::begin_sample` makes it (only
         // patterns other than Sobol draw from it).
         let mut rngs: [Option<rand_pcg::Pcg32>; LANES] = std::array::from_fn(|k| {
@@ -140,7 +140,7 @@ impl DirectIntegrator {
 }
 
 /// The shading points of up to eight lanes, gathered one by one
-/// ([`ShadedLanes::set`]), then in SIMD form ([`ShadedLanes::transposed`]).
+/// ([`ShadedLanes::set`]), then in SIMD form ([`ShadedLanes::transpose`]).
 #[derive(Default)]
 struct ShadedLanes<'a> {
     /// The lanes holding a point (bit k for lane k).
@@ -166,14 +166,12 @@ impl<'a> ShadedLanes<'a> {
         self.ngs[k] = p.ng;
     }
 
-    /// With the points gathered, their lanes.
-    fn transposed(self) -> Self {
-        Self {
-            point: Vec3x8::from_lanes(self.points),
-            geometric_normal: Vec3x8::from_lanes(self.geometric_normals),
-            ng: Vec3x8::from_lanes(self.ngs),
-            ..self
-        }
+    /// With the points gathered, sets their lanes (in place: the struct is
+    /// large, and moving it costs a copy).
+    fn transpose(&mut self) {
+        self.point = Vec3x8::from_lanes(self.points);
+        self.geometric_normal = Vec3x8::from_lanes(self.geometric_normals);
+        self.ng = Vec3x8::from_lanes(self.ngs);
     }
 
     /// Per lane, the Phong reflection of the light point at `u` on `light`, or
@@ -223,13 +221,7 @@ impl<'a> ShadedLanes<'a> {
     fn blocked(&self, scene: &Scene, position: &Vec3x8, towards: &Vec3x8, traced: u32) -> u32 {
         let from_back = lanes::lt(towards.dot(&self.geometric_normal), f32x8::ZERO);
         let outgoing = Vec3x8::select(from_back, &-self.geometric_normal, &self.geometric_normal);
-        let origin = Vec3x8::from_lanes(std::array::from_fn(|k| {
-            if traced >> k & 1 == 1 {
-                offset_ray_origin(self.point.lane(k), outgoing.lane(k))
-            } else {
-                Vec3::ZERO
-            }
-        }));
+        let origin = offset_ray_origins(&self.point, &outgoing);
         let rays = RayLanes {
             origin,
             direction: *position - origin,

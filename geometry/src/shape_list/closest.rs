@@ -6,13 +6,14 @@
 use super::{LinearShapes, Object, ObjectRef, Primitive, ShapeList};
 use crate::bvh::RayStream;
 use crate::counters::count;
-use crate::lanes::LANES;
+use crate::lanes::{self, f32x8, LANES};
 use crate::prefetch::prefetch;
 use crate::triangle::WatertightRay;
 use crate::{Hit, Ray};
 use crate::{RayLanes, Shape};
 use glam::{Vec3, Vec4};
 use std::ops::ControlFlow;
+use wide::i32x8;
 
 /// A candidate for the closest hit: a primitive, or a position in the BVH's leaf
 /// order, looked up only when needed.
@@ -66,18 +67,24 @@ impl ShapeList {
     /// normal where they cost extra (a sphere's: left zero, see
     /// [`Sphere::surface_point`](crate::Sphere::surface_point)), for shading
     /// that reads no texture footprint. Every other field is the same.
+    #[inline(always)]
     pub fn surface_point(&self, ray: &Ray, found: PrimitiveHit) -> Option<Hit> {
-        match self.objects[found.object as usize] {
+        // Inlined, with the two common shapes spelled out: the record then stays
+        // in registers instead of being stored and reloaded (a stall on every
+        // hit when the stores and the loads differ in width).
+        let hit = match self.objects[found.object as usize] {
             Object::Shape(s) => match &self.shapes[s as usize] {
-                Shape::Sphere(sphere) => Some(Hit {
-                    shape: found.object,
-                    primitive: found.primitive,
-                    ..sphere.surface_point(ray, found.t)
-                }),
-                _ => self.surface_record(ray, found),
+                Shape::Sphere(sphere) => sphere.surface_point(ray, found.t),
+                Shape::Parallelogram(p) => p.surface_at(ray, found.t),
+                _ => return self.surface_record(ray, found),
             },
-            Object::Mesh(_) => self.surface_record(ray, found),
-        }
+            Object::Mesh(_) => return self.surface_record(ray, found),
+        };
+        Some(Hit {
+            shape: found.object,
+            primitive: found.primitive,
+            ..hit
+        })
     }
 
     /// The nearest hit with `0 < t < t_max` as [`ShapeList::closest_hit`] finds
@@ -115,8 +122,9 @@ impl ShapeList {
             .linear
             .as_ref()
             .filter(|linear| linear.others.is_empty() && self.bvh.is_none())?;
-        let mut best_t = [f32::INFINITY; LANES];
-        let mut best_object = [u32::MAX; LANES];
+        // The nearest so far per lane, and its object (i32::MAX: none yet).
+        let mut best_t = f32x8::splat(f32::INFINITY);
+        let mut best_object = i32x8::splat(i32::MAX);
         let spheres = linear.spheres.iter().map(|(_, objects)| objects);
         let parallelograms = linear.parallelograms.iter().map(|(_, objects)| objects);
         let used = spheres
@@ -124,7 +132,7 @@ impl ShapeList {
             .flatten()
             .filter(|&&o| o != u32::MAX);
         for &object in used {
-            let (mut hits, t) = match self.object(object) {
+            let (hits, t) = match self.object(object) {
                 ObjectRef::Shape(Shape::Sphere(s)) => {
                     count(|c| c.sphere_tests += tested);
                     s.hit_distance_lanes(rays, f32::INFINITY)
@@ -135,22 +143,22 @@ impl ShapeList {
                 }
                 _ => unreachable!("packets hold spheres and parallelograms"),
             };
-            let t = t.to_array();
-            while hits != 0 {
-                let lane = hits.trailing_zeros() as usize;
-                hits &= hits - 1;
-                // The rule of `ClosestSearch::consider`: nearer, or as near and lower.
-                let (bt, bo) = (best_t[lane], best_object[lane]);
-                if t[lane] < bt || (t[lane] == bt && object < bo) {
-                    best_t[lane] = t[lane];
-                    best_object[lane] = object;
-                }
+            if hits == 0 {
+                continue;
             }
+            // The rule of `ClosestSearch::consider`: nearer, or as near and lower.
+            let o = i32x8::splat(object as i32);
+            let lower: f32x8 = bytemuck::cast(o.simd_lt(best_object));
+            let nearer = lanes::lt(t, best_t) | (t.simd_eq(best_t) & lower);
+            let take = lanes::from_bits(hits) & nearer;
+            best_t = take.select(t, best_t);
+            best_object = bytemuck::cast::<f32x8, i32x8>(take).select(o, best_object);
         }
+        let (best_t, best_object) = (best_t.to_array(), best_object.to_array());
         Some(std::array::from_fn(|lane| {
-            (best_object[lane] != u32::MAX).then(|| PrimitiveHit {
+            (best_object[lane] != i32::MAX).then(|| PrimitiveHit {
                 t: best_t[lane],
-                object: best_object[lane],
+                object: best_object[lane] as u32,
                 primitive: 0,
             })
         }))

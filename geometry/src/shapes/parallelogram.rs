@@ -97,6 +97,7 @@ impl Parallelogram {
         inside.then_some(t)
     }
 
+    #[inline]
     pub fn surface_at(&self, ray: &Ray, t: f32) -> Hit {
         let uv = self.coordinates(ray.at(t)).clamp(Vec2::ZERO, Vec2::ONE);
         Hit {

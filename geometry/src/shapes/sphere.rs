@@ -88,6 +88,7 @@ impl Sphere {
     /// [`Self::surface_at`] without the derivatives `dpdu`, `dpdv`, `dndu` and
     /// `dndv` (left zero), for shading that reads no texture footprint: the
     /// other fields bit for bit, without the two `sin_cos` the derivatives take.
+    #[inline]
     pub fn surface_point(&self, ray: &Ray, t: f32) -> Hit {
         self.surface_frame(ray, t).0
     }

@@ -18,6 +18,7 @@
 //! are those of [`DirectIntegrator::li_at`], bit for bit (the tests compare).
 
 use crate::direct::{PairAllocation, SampleContext, ShadingPoint};
+use crate::light_samples::count_lanes;
 use crate::sampling::{DimensionPair, PixelSample, SamplePattern};
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
@@ -199,13 +200,16 @@ impl<'a> ShadedLanes<'a> {
         let above = lanes::bits(lanes::gt(l.dot(&self.ng), f32x8::ZERO));
         let shaded = lit & normalized & above;
         let traced = shaded & !lanes::bits(reflected.is_zero());
-        let counters = &mut ctx.counters;
-        let ones = |bits: u32| u64::from(bits.count_ones());
-        counters.skipped_behind_light += ones(self.lanes & !lit);
-        counters.skipped_behind_surface += ones(lit & normalized & !shaded);
-        counters.specular_lobes += ones(shaded & self.phong.specular_lanes());
-        counters.skipped_zero_brdf += ones(shaded & !traced);
-        counters.light_shadow_rays += ones(traced);
+        let specular = self.phong.specular_lanes();
+        count_lanes(
+            &mut ctx.counters,
+            self.lanes,
+            lit,
+            normalized,
+            shaded,
+            traced,
+            specular,
+        );
         let visible = traced & !self.blocked(scene, &position, &towards, traced);
         std::array::from_fn(|k| {
             if visible >> k & 1 == 1 {

@@ -14,7 +14,7 @@
 //! lanes, a shape counts one test per ray in the batch.
 
 use crate::direct::{SampleContext, ShadingPoint};
-use crate::Scene;
+use crate::{Scene, ShadingCounters};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
 use glint_geometry::{offset_ray_origin, Occluders, RayLanes, SHADOW_EPSILON};
@@ -91,8 +91,7 @@ impl ShadingPoint<'_> {
         sum
     }
 
-    /// Adds one chunk's lanes to the counts, as the scalar path counts them
-    /// (each argument a set of lanes, bit k for lane k).
+    /// Adds one chunk's lanes to the counts ([`count_lanes`]).
     fn count(
         &self,
         ctx: &mut SampleContext,
@@ -102,15 +101,16 @@ impl ShadingPoint<'_> {
         shaded: u32,
         traced: u32,
     ) {
-        let counters = &mut ctx.counters;
-        let ones = |bits: u32| bits.count_ones() as u64;
-        counters.skipped_behind_light += ones(used & !lit);
-        counters.skipped_behind_surface += ones(lit & normalized & !shaded);
-        if self.has_specular {
-            counters.specular_lobes += ones(shaded);
-        }
-        counters.skipped_zero_brdf += ones(shaded & !traced);
-        counters.light_shadow_rays += ones(traced);
+        let specular = if self.has_specular { u32::MAX } else { 0 };
+        count_lanes(
+            &mut ctx.counters,
+            used,
+            lit,
+            normalized,
+            shaded,
+            traced,
+            specular,
+        );
     }
 
     /// [`Self::area_light_sum`] one sample at a time.
@@ -133,6 +133,29 @@ impl ShadingPoint<'_> {
         }
         sum
     }
+}
+
+/// Adds one chunk of light samples in lanes to the counts, as the scalar path
+/// counts them one by one. Each argument is a set of lanes (bit k for lane k):
+/// the lanes `used`, those whose light point shines on the point (`lit`), whose
+/// direction could be normalised, which are above the horizon and so shaded
+/// (`shaded`), whose shadow ray is traced, and those that evaluate a specular
+/// lobe when shaded.
+pub(crate) fn count_lanes(
+    counters: &mut ShadingCounters,
+    used: u32,
+    lit: u32,
+    normalized: u32,
+    shaded: u32,
+    traced: u32,
+    specular: u32,
+) {
+    let ones = |bits: u32| u64::from(bits.count_ones());
+    counters.skipped_behind_light += ones(used & !lit);
+    counters.skipped_behind_surface += ones(lit & normalized & !shaded);
+    counters.specular_lobes += ones(shaded & specular);
+    counters.skipped_zero_brdf += ones(shaded & !traced);
+    counters.light_shadow_rays += ones(traced);
 }
 
 /// Up to eight sample coordinates as x and y lanes (unused lanes 0).

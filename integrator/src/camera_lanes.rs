@@ -81,15 +81,15 @@ impl DirectIntegrator {
             return radiance;
         }
         shaded.transpose();
+        let samples: [PixelSample; LANES] = std::array::from_fn(|k| PixelSample {
+            sample: first.sample + k as u64,
+            ..first
+        });
         // Each lane's own stream, as `SampleContext::begin_sample` makes it (only
         // patterns other than Sobol draw from it).
         let mut rngs: [Option<rand_pcg::Pcg32>; LANES] = std::array::from_fn(|k| {
-            let sample = PixelSample {
-                sample: first.sample + k as u64,
-                ..first
-            };
             (shaded.lanes >> k & 1 == 1 && self.light_pattern != SamplePattern::Sobol)
-                .then(|| sample.rng())
+                .then(|| samples[k].rng())
         });
         let mut pairs = PairAllocation::new(0);
         for (index, light) in scene.lights.iter().enumerate() {
@@ -104,11 +104,7 @@ impl DirectIntegrator {
             let u: [Vec2; LANES] = std::array::from_fn(|k| {
                 let mut u = [Vec2::ZERO];
                 if shaded.lanes >> k & 1 == 1 {
-                    let sample = PixelSample {
-                        sample: first.sample + k as u64,
-                        ..first
-                    };
-                    let sobol = sample.sobol_points(pair, 1);
+                    let sobol = samples[k].sobol_points(pair, 1);
                     match &mut rngs[k] {
                         Some(rng) => self.light_pattern.fill(rng, sobol, &mut u),
                         None => self.light_pattern.fill(&mut ctx.rng, sobol, &mut u),
@@ -127,13 +123,9 @@ impl DirectIntegrator {
         }
         for (k, radiance) in radiance.iter_mut().enumerate() {
             if shaded.lanes >> k & 1 == 1 {
-                if self.environment_samples > 0 {
-                    // What `shade` adds for an environment the scene lacks.
-                    *radiance += Vec3::ZERO;
-                }
-                // `li_at`'s blend with the (absent) mirror term: r = 0.
-                let r = 0.0;
-                *radiance = (1.0 - r) * *radiance + r * Vec3::ZERO;
+                // `li_at` adds the absent environment and mirror terms, zeros: a
+                // −0 component becomes +0 there, so it must here too.
+                *radiance += Vec3::ZERO;
             }
         }
         radiance

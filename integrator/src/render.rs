@@ -316,34 +316,35 @@ fn render_rows(
                     )
                 })
                 .flatten();
-            if let (true, Some(hits)) = (first_hits_in_lanes, &hits) {
-                let first = PixelSample {
-                    seed: settings.seed,
-                    pixel,
-                    sample: (chunk * LANES) as u64,
-                };
-                let rays = rays.map(|(ray, _)| ray);
-                let values =
-                    integrator.li_first_hits(scene, &rays, hits, jitters.len(), first, &mut ctx);
-                for value in values.into_iter().take(jitters.len()) {
-                    if value.is_finite() {
-                        sum += value;
-                    } else {
-                        ctx.counters.nonfinite_samples += 1;
-                    }
+            let used = jitters.len();
+            let values: [Vec3; LANES] = match (first_hits_in_lanes, &hits) {
+                // One sample per light: the eight samples shaded together.
+                (true, Some(hits)) => {
+                    let first = PixelSample {
+                        seed: settings.seed,
+                        pixel,
+                        sample: (chunk * LANES) as u64,
+                    };
+                    let rays = rays.map(|(ray, _)| ray);
+                    integrator.li_first_hits(scene, &rays, hits, used, first, &mut ctx)
                 }
-                continue;
-            }
-            for (k, (ray, diff)) in rays.iter().take(jitters.len()).enumerate() {
-                ctx.begin_sample(settings.seed, pixel, (chunk * LANES + k) as u64);
-                let value = match (settings.aov, &hits) {
-                    (None, Some(hits)) => {
-                        let hit = hits[k].and_then(|found| scene.shapes.surface_record(ray, found));
-                        integrator.li_at(scene, ray, diff, hit, 0, &mut ctx)
+                _ => std::array::from_fn(|k| {
+                    let Some((ray, diff)) = rays.get(k).filter(|_| k < used) else {
+                        return Vec3::ZERO;
+                    };
+                    ctx.begin_sample(settings.seed, pixel, (chunk * LANES + k) as u64);
+                    match (settings.aov, &hits) {
+                        (None, Some(hits)) => {
+                            let hit =
+                                hits[k].and_then(|found| scene.shapes.surface_record(ray, found));
+                            integrator.li_at(scene, ray, diff, hit, 0, &mut ctx)
+                        }
+                        (None, None) => integrator.li(scene, ray, diff, 0, &mut ctx),
+                        (Some(aov), _) => aov.evaluate(scene, ray, diff, settings.max_depth),
                     }
-                    (None, None) => integrator.li(scene, ray, diff, 0, &mut ctx),
-                    (Some(aov), _) => aov.evaluate(scene, ray, diff, settings.max_depth),
-                };
+                }),
+            };
+            for value in values.into_iter().take(used) {
                 if value.is_finite() {
                     sum += value;
                 } else {

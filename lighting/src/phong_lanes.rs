@@ -63,13 +63,6 @@ impl<'a> PhongLanes<'a> {
         };
     }
 
-    /// The lanes that were set (bit k for lane k).
-    pub fn lanes(&self) -> u32 {
-        (0..LANES).fold(0, |bits, k| {
-            bits | u32::from(self.materials[k].is_some()) << k
-        })
-    }
-
     /// The lanes with a specular term.
     pub fn specular_lanes(&self) -> u32 {
         self.specular
@@ -201,7 +194,6 @@ mod tests {
                 _ => unit(0.37 * (k + 8 * batch) as f32 - 1.5, 0.4 * f),
             });
             let out = lanes.reflect(&Vec3x8::from_lanes(l));
-            assert_eq!(lanes.lanes().count_ones() as usize, points.len());
             for (k, m, kd, ks, n, v, specular) in points {
                 let scalar = if specular {
                     m.reflect(kd, ks, n, l[k], v)

@@ -86,6 +86,16 @@ impl Vec3x8 {
         }
     }
 
+    /// `v * other` per component for the same `v` in every lane, as `Vec3 * Vec3`.
+    #[inline]
+    pub fn scaled_splat_lanes(v: Vec3, other: &Self) -> Self {
+        Self {
+            x: f32x8::splat(v.x) * other.x,
+            y: f32x8::splat(v.y) * other.y,
+            z: f32x8::splat(v.z) * other.z,
+        }
+    }
+
     /// `self − v` for the same `v` in every lane.
     #[inline]
     pub fn sub_splat(&self, v: Vec3) -> Self {
@@ -145,6 +155,30 @@ impl Vec3x8 {
         let rcp = f32x8::ONE / self.dot(self).sqrt();
         let ok = rcp.is_finite() & rcp.simd_gt(f32x8::ZERO);
         (self.scale(rcp), ok)
+    }
+
+    /// [`Vec3::normalize`] per lane: `self · (1/length)`, rounded as glam rounds it.
+    #[inline]
+    pub fn normalize(&self) -> Self {
+        self.scale(f32x8::ONE / self.dot(self).sqrt())
+    }
+
+    /// Sets lane `lane` to `v`.
+    #[inline]
+    pub fn set_lane(&mut self, lane: usize, v: Vec3) {
+        self.x.as_mut_array()[lane] = v.x;
+        self.y.as_mut_array()[lane] = v.y;
+        self.z.as_mut_array()[lane] = v.z;
+    }
+
+    /// `v + self` for the same `v` in every lane.
+    #[inline]
+    pub fn splat_add(v: Vec3, other: &Self) -> Self {
+        Self {
+            x: f32x8::splat(v.x) + other.x,
+            y: f32x8::splat(v.y) + other.y,
+            z: f32x8::splat(v.z) + other.z,
+        }
     }
 
     /// The lanes equal to zero in every component (as `Vec3 == Vec3::ZERO`).
@@ -291,6 +325,21 @@ mod tests {
                     assert_eq!(unit.lane(k), n);
                 }
                 None => assert!(ok.as_array()[k] == 0.0, "normalize fails, lane {k}"),
+            }
+            if sa.length_squared() > 0.0 && sa.is_finite() {
+                assert_eq!(a.normalize().lane(k), sa.normalize(), "normalize, lane {k}");
+            }
+            let mut set = Vec3x8::default();
+            set.set_lane(k, sb);
+            assert_eq!(
+                set.lane(k).to_array().map(f32::to_bits),
+                sb.to_array().map(f32::to_bits)
+            );
+            for axis in 0..3 {
+                assert!(same(
+                    Vec3x8::splat_add(sb, &a).lane(k)[axis],
+                    (sb + sa)[axis]
+                ));
             }
             assert_eq!(bits(zero) >> k & 1 == 1, (sa - sa) == Vec3::ZERO);
         }

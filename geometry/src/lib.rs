@@ -66,11 +66,11 @@ pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceD
 pub use hit::Hit;
 pub use offset::{offset_ray_origin, offset_ray_origins, spawn_ray, spawn_ray_to, SHADOW_EPSILON};
 pub use ray::Ray;
-pub use shape_list::{ObjectRef, Occluders, PrimitiveHit, ShapeList};
+pub use shape_list::{ClosestLanes, ObjectRef, Occluders, PrimitiveHit, ShapeList};
 pub use shapes::{triangle, triangle_packet};
 pub use shapes::{
     AaBox, MeshError, Parallelogram, ParallelogramPacket, Plane, RayLanes, Shape, Sphere,
-    SpherePacket, TriangleMesh, TrianglePacket,
+    SpherePacket, SurfaceLanes, TriangleMesh, TrianglePacket,
 };
 
 #[cfg(doctest)]

@@ -23,9 +23,12 @@ use crate::sampling::{DimensionPair, PixelSample, SamplePattern};
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
-use glint_geometry::{offset_ray_origins, Occluders, PrimitiveHit, Ray, RayLanes, SHADOW_EPSILON};
+use glint_geometry::{
+    offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayLanes, Shape, SurfaceLanes,
+    SHADOW_EPSILON,
+};
 use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial};
-use glint_texture::TexCoord;
+use glint_texture::{TexCoord, Texture};
 
 impl DirectIntegrator {
     /// Whether the first hits of `scene`'s camera samples can be shaded eight at
@@ -44,14 +47,14 @@ impl DirectIntegrator {
 
     /// The radiance of the first `used` of eight camera samples of one pixel,
     /// samples `first.sample..first.sample + used`, whose camera rays `rays`
-    /// have the closest hits `hits`: for each, what [`Self::li_at`] gives it
+    /// have the closest hits `closest`: for each, what [`Self::li_at`] gives it
     /// alone (with [`SampleContext::begin_sample`] for that sample), bit for bit.
     /// Only for scenes where [`Self::shades_first_hits_in_lanes`] holds.
     pub(crate) fn li_first_hits(
         &self,
         scene: &Scene,
-        rays: &[Ray; LANES],
-        hits: &[Option<PrimitiveHit>; LANES],
+        rays: &RayLanes,
+        closest: &ClosestLanes,
         used: usize,
         first: PixelSample,
         ctx: &mut SampleContext,
@@ -59,28 +62,33 @@ impl DirectIntegrator {
         debug_assert!(self.shades_first_hits_in_lanes(scene));
         let mut radiance = [Vec3::ZERO; LANES];
         let mut shaded = ShadedLanes::default();
-        for (k, (ray, found)) in rays.iter().zip(hits).take(used).enumerate() {
-            let Some(hit) = found.and_then(|found| scene.shapes.surface_point(ray, found)) else {
-                continue;
-            };
-            match scene.surface_of(&hit) {
-                SurfaceKind::Emitter(Light::Area(area)) => radiance[k] = area.color,
-                SurfaceKind::Emitter(_) => {}
-                SurfaceKind::Material(material) => {
-                    if ctx.detailed {
-                        ctx.textures.record(material, &TexCoord::point(hit.uv));
+        let hit_lanes = closest.hits & ((1 << used) - 1);
+        if !shaded.set_common(scene, rays, closest, hit_lanes, &mut radiance, ctx) {
+            for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
+                let ray = rays.lane(k);
+                let found = closest.hit(k).expect("a hit lane");
+                let Some(hit) = scene.shapes.surface_point(&ray, found) else {
+                    continue;
+                };
+                match scene.surface_of(&hit) {
+                    SurfaceKind::Emitter(Light::Area(area)) => radiance[k] = area.color,
+                    SurfaceKind::Emitter(_) => {}
+                    SurfaceKind::Material(material) => {
+                        if ctx.detailed {
+                            ctx.textures.record(material, &TexCoord::point(hit.uv));
+                        }
+                        let reflectances = material.reflectances_at(hit.uv);
+                        let point =
+                            ShadingPoint::with_reflectances(&hit, material, &ray, reflectances);
+                        radiance[k] = scene.ambient * point.kd;
+                        shaded.set(k, &point, material);
                     }
-                    let reflectances = material.reflectances_at(hit.uv);
-                    let point = ShadingPoint::with_reflectances(&hit, material, ray, reflectances);
-                    radiance[k] = scene.ambient * point.kd;
-                    shaded.set(k, &point, material);
                 }
             }
         }
         if shaded.lanes == 0 {
             return radiance;
         }
-        shaded.transpose();
         let samples: [PixelSample; LANES] = std::array::from_fn(|k| PixelSample {
             sample: first.sample + k as u64,
             ..first
@@ -132,18 +140,15 @@ impl DirectIntegrator {
     }
 }
 
-/// The shading points of up to eight lanes, gathered one by one
-/// ([`ShadedLanes::set`]), then in SIMD form ([`ShadedLanes::transpose`]).
+/// The shading points of up to eight lanes: all at once where the lanes hit
+/// one shape ([`ShadedLanes::set_common`]), else one by one ([`ShadedLanes::set`]).
 #[derive(Default)]
 struct ShadedLanes<'a> {
     /// The lanes holding a point (bit k for lane k).
     lanes: u32,
-    points: [Vec3; LANES],
-    geometric_normals: [Vec3; LANES],
-    /// The geometric normals on the viewer's side.
-    ngs: [Vec3; LANES],
     point: Vec3x8,
     geometric_normal: Vec3x8,
+    /// The geometric normals on the viewer's side.
     ng: Vec3x8,
     phong: PhongLanes<'a>,
 }
@@ -154,17 +159,66 @@ impl<'a> ShadedLanes<'a> {
         self.phong
             .set(k, material, p.kd, p.ks, p.n, p.v, p.has_specular);
         self.lanes |= 1 << k;
-        self.points[k] = p.hit.point;
-        self.geometric_normals[k] = p.hit.geometric_normal;
-        self.ngs[k] = p.ng;
+        self.point.set_lane(k, p.hit.point);
+        self.geometric_normal.set_lane(k, p.hit.geometric_normal);
+        self.ng.set_lane(k, p.ng);
     }
 
-    /// With the points gathered, sets their lanes (in place: the struct is
-    /// large, and moving it costs a copy).
-    fn transpose(&mut self) {
-        self.point = Vec3x8::from_lanes(self.points);
-        self.geometric_normal = Vec3x8::from_lanes(self.geometric_normals);
-        self.ng = Vec3x8::from_lanes(self.ngs);
+    /// Where every lane of `hit_lanes` hits the same sphere or parallelogram
+    /// (most of a pixel's samples), sets them all at once and returns true:
+    /// each lane what [`Self::set`] gives it from its [`ShadingPoint`], and
+    /// `radiance` its ambient or emitted part. Returns false, setting nothing,
+    /// for lanes on several objects (or none) or on other shapes.
+    fn set_common(
+        &mut self,
+        scene: &'a Scene,
+        rays: &RayLanes,
+        closest: &ClosestLanes,
+        hit_lanes: u32,
+        radiance: &mut [Vec3; LANES],
+        ctx: &mut SampleContext,
+    ) -> bool {
+        let Some(object) = closest.common_object(hit_lanes) else {
+            return false;
+        };
+        let surface = match scene.shapes.object(object) {
+            ObjectRef::Shape(Shape::Sphere(s)) => {
+                s.surface_points_lanes(rays, closest.t, hit_lanes)
+            }
+            ObjectRef::Shape(Shape::Parallelogram(p)) => p.surface_points_lanes(rays, closest.t),
+            _ => return false,
+        };
+        let material = match scene.surface_of_primitive(object, 0) {
+            SurfaceKind::Material(material) => material,
+            SurfaceKind::Emitter(light) => {
+                if let Light::Area(area) = light {
+                    for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
+                        radiance[k] = area.color;
+                    }
+                }
+                return true;
+            }
+        };
+        let (kd, ks) = reflectances_lanes(material, &surface, hit_lanes, ctx);
+        // `ShadingPoint::with_reflectances`: the normal turned to the viewer, the
+        // geometric normal to its side, and the unit direction to the viewer.
+        let d = &rays.direction;
+        let g = &surface.normal;
+        let n = Vec3x8::select(lanes::gt(g.dot(d), f32x8::ZERO), &-*g, g);
+        let ng = Vec3x8::select(lanes::lt(g.dot(&n), f32x8::ZERO), &-*g, g);
+        let v = -d.normalize();
+        let specular = hit_lanes & !lanes::bits(ks.is_zero());
+        self.phong
+            .set_lanes(hit_lanes, material, &kd, &ks, &n, &v, specular);
+        let ambient = Vec3x8::scaled_splat_lanes(scene.ambient, &kd);
+        for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
+            radiance[k] = ambient.lane(k);
+        }
+        self.lanes = hit_lanes;
+        self.point = surface.point;
+        self.geometric_normal = surface.normal;
+        self.ng = ng;
+        true
     }
 
     /// Per lane, the Phong reflection of the light point at `u` on `light`, or
@@ -228,13 +282,45 @@ impl<'a> ShadedLanes<'a> {
     }
 }
 
+/// `material`'s reflectances `(kd, ks)` at each lane's uv (the lanes of
+/// `hit_lanes`; the others zero), as [`PhongMaterial::reflectances_at`] gives
+/// them: constants in every lane at once, textures lane by lane.
+fn reflectances_lanes(
+    material: &PhongMaterial,
+    surface: &SurfaceLanes,
+    hit_lanes: u32,
+    ctx: &mut SampleContext,
+) -> (Vec3x8, Vec3x8) {
+    let (u, v) = (surface.u.to_array(), surface.v.to_array());
+    let uv = |k: usize| Vec2::new(u[k], v[k]);
+    if ctx.detailed {
+        for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
+            ctx.textures.record(material, &TexCoord::point(uv(k)));
+        }
+    }
+    let specular = material.specular.as_ref().map(Texture::as_constant);
+    match (material.diffuse.as_constant(), specular) {
+        (Some(kd), None) => (Vec3x8::splat(kd), Vec3x8::splat(kd)),
+        (Some(kd), Some(Some(ks))) => (Vec3x8::splat(kd), Vec3x8::splat(ks)),
+        _ => {
+            let (mut kd, mut ks) = (Vec3x8::default(), Vec3x8::default());
+            for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
+                let (d, s) = material.reflectances_at(uv(k));
+                kd.set_lane(k, d);
+                ks.set_lane(k, s);
+            }
+            (kd, ks)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::{SceneBuilder, ShadingCounters};
     use glam::UVec2;
     use glint_camera::Camera;
-    use glint_geometry::{Parallelogram, RayDifferential, Sphere};
+    use glint_geometry::{Parallelogram, Ray, RayDifferential, Sphere};
     use glint_lighting::SpecularLobe;
     use glint_texture::{Checkerboard, Texture};
 
@@ -305,9 +391,15 @@ mod tests {
             fractional,
         )
         .shape(Sphere::new(Vec3::new(0.0, 2.5, -7.0), 0.6).unwrap(), black);
-        let down = AreaLight::new(Vec3::new(0.0, 3.9, -5.0), Vec3::X, Vec3::Z, Vec3::ONE)
-            .unwrap()
-            .facing(-Vec3::Y);
+        // Large enough that some pixels see nothing else.
+        let down = AreaLight::new(
+            Vec3::new(0.0, 3.9, -5.0),
+            Vec3::X * 3.0,
+            Vec3::Z * 3.0,
+            Vec3::ONE,
+        )
+        .unwrap()
+        .facing(-Vec3::Y);
         let back = AreaLight::new(
             Vec3::new(1.0, 1.0, -1.0),
             Vec3::X * 0.5,
@@ -337,6 +429,8 @@ mod tests {
     fn lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
         let scene = room();
         let mut total = ShadingCounters::default();
+        // Chunks whose lanes hit several objects, one shape, one light.
+        let mut common = [0; 3];
         for pattern in [
             SamplePattern::Random,
             SamplePattern::Stratified,
@@ -363,18 +457,25 @@ mod tests {
                             .generate_ray(x as f32 + jitter.0, y as f32 + jitter.1);
                         Ray::new(c.origin, c.direction)
                     });
-                    let hits = scene
+                    let ray_lanes = RayLanes::new(rays);
+                    let closest = scene
                         .shapes
-                        .closest_primitives_lanes(&RayLanes::new(rays), used)
+                        .closest_lanes(&ray_lanes, used)
                         .expect("spheres and parallelograms: hits in lanes");
+                    let hit_lanes = closest.hits & ((1 << used) - 1);
+                    match closest.common_object(hit_lanes) {
+                        Some(object) if scene.light_objects.contains(&object) => common[2] += 1,
+                        Some(_) => common[1] += 1,
+                        None => common[0] += 1,
+                    }
                     let first = PixelSample {
                         seed: 11,
                         pixel,
                         sample: chunk * LANES as u64,
                     };
                     let mut lanes = SampleContext::new(1, 4);
-                    let values =
-                        integrator.li_first_hits(&scene, &rays, &hits, used, first, &mut lanes);
+                    let values = integrator
+                        .li_first_hits(&scene, &ray_lanes, &closest, used, first, &mut lanes);
                     let mut scalar = SampleContext::new(1, 4);
                     for (k, ray) in rays.iter().enumerate().take(used) {
                         scalar.begin_sample(first.seed, pixel, first.sample + k as u64);
@@ -405,6 +506,8 @@ mod tests {
             }
             assert_eq!(compared, 12 * 10 * 12);
         }
+        // Both ways of gathering the points were taken, and lanes that all see a light.
+        assert!(common.iter().all(|&n| n > 0), "{common:?}");
         // Every branch was taken: lanes behind a light, below the horizon, with
         // zero reflection, traced, and the specular lobe evaluated.
         assert!(total.light_samples > 0, "{total:?}");

@@ -308,35 +308,31 @@ fn render_rows(
             });
             // Several camera rays at once: their closest hits one shape against
             // all of them, where the scene's layout allows it (the same hits).
-            let hits = (settings.aov.is_none() && jitters.len() > 1)
-                .then(|| {
-                    scene.shapes.closest_primitives_lanes(
-                        &RayLanes::new(rays.map(|(ray, _)| ray)),
-                        jitters.len(),
-                    )
-                })
-                .flatten();
             let used = jitters.len();
-            let values: [Vec3; LANES] = match (first_hits_in_lanes, &hits) {
+            let ray_lanes = RayLanes::new(rays.map(|(ray, _)| ray));
+            let closest = (settings.aov.is_none() && used > 1)
+                .then(|| scene.shapes.closest_lanes(&ray_lanes, used))
+                .flatten();
+            let values: [Vec3; LANES] = match &closest {
                 // One sample per light: the eight samples shaded together.
-                (true, Some(hits)) => {
+                Some(closest) if first_hits_in_lanes => {
                     let first = PixelSample {
                         seed: settings.seed,
                         pixel,
                         sample: (chunk * LANES) as u64,
                     };
-                    let rays = rays.map(|(ray, _)| ray);
-                    integrator.li_first_hits(scene, &rays, hits, used, first, &mut ctx)
+                    integrator.li_first_hits(scene, &ray_lanes, closest, used, first, &mut ctx)
                 }
                 _ => std::array::from_fn(|k| {
                     let Some((ray, diff)) = rays.get(k).filter(|_| k < used) else {
                         return Vec3::ZERO;
                     };
                     ctx.begin_sample(settings.seed, pixel, (chunk * LANES + k) as u64);
-                    match (settings.aov, &hits) {
-                        (None, Some(hits)) => {
-                            let hit =
-                                hits[k].and_then(|found| scene.shapes.surface_record(ray, found));
+                    match (settings.aov, &closest) {
+                        (None, Some(closest)) => {
+                            let hit = closest
+                                .hit(k)
+                                .and_then(|found| scene.shapes.surface_record(ray, found));
                             integrator.li_at(scene, ray, diff, hit, 0, &mut ctx)
                         }
                         (None, None) => integrator.li(scene, ray, diff, 0, &mut ctx),

@@ -54,11 +54,18 @@ impl Scene {
     /// The material or light at `hit`.
     #[inline]
     pub fn surface_of(&self, hit: &Hit) -> SurfaceKind<'_> {
-        match self.surfaces[hit.shape as usize] {
+        self.surface_of_primitive(hit.shape, hit.primitive)
+    }
+
+    /// The material or light of triangle `primitive` of object `object` (0 for
+    /// a shape), as [`Self::surface_of`] a hit on it.
+    #[inline]
+    pub fn surface_of_primitive(&self, object: u32, primitive: u32) -> SurfaceKind<'_> {
+        match self.surfaces[object as usize] {
             Surface::Material(m) => SurfaceKind::Material(&self.materials[m as usize]),
             Surface::Emitter(l) => SurfaceKind::Emitter(&self.lights[l as usize]),
             Surface::Mesh(k) => {
-                let m = self.mesh_materials[k as usize][hit.primitive as usize];
+                let m = self.mesh_materials[k as usize][primitive as usize];
                 SurfaceKind::Material(&self.materials[m as usize])
             }
         }

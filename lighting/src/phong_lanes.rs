@@ -19,10 +19,10 @@ use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
 #[derive(Clone, Debug, Default)]
 pub struct PhongLanes<'a> {
     materials: [Option<&'a PhongMaterial>; LANES],
-    kd: [Vec3; LANES],
-    ks: [Vec3; LANES],
-    n: [Vec3; LANES],
-    v: [Vec3; LANES],
+    kd: Vec3x8,
+    ks: Vec3x8,
+    n: Vec3x8,
+    v: Vec3x8,
     /// Lanes with a specular term (bit k for lane k).
     specular: u32,
     /// Lanes whose lobe is a Phong lobe with an integral exponent, taken in lanes.
@@ -47,20 +47,51 @@ impl<'a> PhongLanes<'a> {
         v: Vec3,
         specular: bool,
     ) {
-        self.materials[lane] = Some(material);
-        (self.kd[lane], self.ks[lane]) = (kd, ks);
-        (self.n[lane], self.v[lane]) = (n, v);
-        let bit = 1 << lane;
-        self.specular = (self.specular & !bit) | if specular { bit } else { 0 };
+        self.kd.set_lane(lane, kd);
+        self.ks.set_lane(lane, ks);
+        self.n.set_lane(lane, n);
+        self.v.set_lane(lane, v);
+        self.set_material(1 << lane, material, if specular { 1 << lane } else { 0 });
+    }
+
+    /// Sets the lanes `lanes` (bit k for lane k) to points of one `material`,
+    /// with the reflectances, normals and viewer directions of [`Self::set`] in
+    /// lanes; `specular` holds the lanes whose specular term is evaluated.
+    #[allow(clippy::too_many_arguments)]
+    pub fn set_lanes(
+        &mut self,
+        lanes: u32,
+        material: &'a PhongMaterial,
+        kd: &Vec3x8,
+        ks: &Vec3x8,
+        n: &Vec3x8,
+        v: &Vec3x8,
+        specular: u32,
+    ) {
+        let mask = lanes::from_bits(lanes);
+        self.kd = Vec3x8::select(mask, kd, &self.kd);
+        self.ks = Vec3x8::select(mask, ks, &self.ks);
+        self.n = Vec3x8::select(mask, n, &self.n);
+        self.v = Vec3x8::select(mask, v, &self.v);
+        self.set_material(lanes, material, specular & lanes);
+    }
+
+    /// Gives the lanes `lanes` `material`, with specular terms in `specular`.
+    fn set_material(&mut self, lanes: u32, material: &'a PhongMaterial, specular: u32) {
+        self.specular = (self.specular & !lanes) | specular;
         let in_lanes = material.lobe == SpecularLobe::Phong
             && material.integral_exponent()
             && material.shininess >= 0.0;
-        self.lane_lobes = (self.lane_lobes & !bit) | if in_lanes { bit } else { 0 };
-        self.exponents[lane] = if in_lanes {
+        self.lane_lobes = (self.lane_lobes & !lanes) | if in_lanes { lanes } else { 0 };
+        let exponent = if in_lanes {
             material.shininess as u32
         } else {
             0
         };
+        for k in (0..LANES).filter(|k| lanes >> k & 1 == 1) {
+            self.materials[k] = Some(material);
+            self.exponents[k] = exponent;
+        }
     }
 
     /// The lanes with a specular term.
@@ -72,14 +103,14 @@ impl<'a> PhongLanes<'a> {
     /// towards the lane's viewer: `kd · n·l + ks · lobe`, zero where `n·l ≤ 0`.
     #[inline]
     pub fn reflect(&self, l: &Vec3x8) -> Vec3x8 {
-        let n = Vec3x8::from_lanes(self.n);
+        let n = self.n;
         let n_dot_l = n.dot(l);
-        let diffuse = Vec3x8::from_lanes(self.kd).scale(n_dot_l);
+        let diffuse = self.kd.scale(n_dot_l);
         let reflected = if self.specular == 0 {
             diffuse
         } else {
             let lobe = self.specular_lobe(&n, l, n_dot_l);
-            let specular = diffuse + Vec3x8::from_lanes(self.ks).scale(lobe);
+            let specular = diffuse + self.ks.scale(lobe);
             Vec3x8::select(lanes::from_bits(self.specular), &specular, &diffuse)
         };
         // `n·l ≤ 0` gives zero (a NaN goes on, as in the scalar test).
@@ -92,7 +123,7 @@ impl<'a> PhongLanes<'a> {
     fn specular_lobe(&self, n: &Vec3x8, l: &Vec3x8, n_dot_l: f32x8) -> f32x8 {
         // (2·(n·l))·n − l, then its dot product with v.
         let mirror = n.scale(f32x8::splat(2.0) * n_dot_l) - *l;
-        let cosine = mirror.dot(&Vec3x8::from_lanes(self.v));
+        let cosine = mirror.dot(&self.v);
         let lobe = lanes::le(cosine, f32x8::ZERO).select(f32x8::ZERO, self.powers(cosine));
         let one_by_one = self.specular & !self.lane_lobes;
         if one_by_one == 0 {
@@ -102,7 +133,7 @@ impl<'a> PhongLanes<'a> {
         let mut lobe = lobe.to_array();
         for (k, lobe) in lobe.iter_mut().enumerate() {
             if let Some(m) = self.materials[k].filter(|_| one_by_one >> k & 1 == 1) {
-                *lobe = m.specular_lobe(self.n[k], l.lane(k), self.v[k], n_dot_l[k]);
+                *lobe = m.specular_lobe(self.n.lane(k), l.lane(k), self.v.lane(k), n_dot_l[k]);
             }
         }
         f32x8::new(lobe)
@@ -211,5 +242,38 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Lanes set together with one material reflect what lanes set one by one do.
+    #[test]
+    fn lanes_set_together_are_lanes_set_one_by_one() {
+        let unit = |a: f32| Vec3::new(a.sin(), a.cos(), 0.3 * a).normalize();
+        let shiny = PhongMaterial::new(Vec3::new(0.7, 0.5, 0.2), 22.0);
+        let other = PhongMaterial::new(Vec3::ONE, 3.0);
+        let kd: [Vec3; LANES] = std::array::from_fn(|k| Vec3::new(0.1 * k as f32, 0.5, 0.9));
+        let ks: [Vec3; LANES] = std::array::from_fn(|k| Vec3::splat(0.05 * k as f32));
+        let n: [Vec3; LANES] = std::array::from_fn(|k| unit(0.1 * k as f32));
+        let v: [Vec3; LANES] = std::array::from_fn(|k| unit(0.2 - 0.05 * k as f32));
+        let (lanes, specular) = (0b1011_0110, 0b0011_0100);
+        let mut together = PhongLanes::default();
+        together.set(0, &other, Vec3::ONE, Vec3::ONE, Vec3::Y, Vec3::Y, true);
+        let x = |a: [Vec3; LANES]| Vec3x8::from_lanes(a);
+        together.set_lanes(lanes, &shiny, &x(kd), &x(ks), &x(n), &x(v), specular | 1);
+        let mut one_by_one = PhongLanes::default();
+        one_by_one.set(0, &other, Vec3::ONE, Vec3::ONE, Vec3::Y, Vec3::Y, true);
+        for k in (0..LANES).filter(|k| lanes >> k & 1 == 1) {
+            one_by_one.set(k, &shiny, kd[k], ks[k], n[k], v[k], specular >> k & 1 == 1);
+        }
+        assert_eq!(together.specular_lanes(), one_by_one.specular_lanes());
+        assert_eq!(together.specular_lanes(), 0b0011_0101);
+        let l = x(std::array::from_fn(|k| unit(0.15 * k as f32 + 0.02)));
+        let (a, b) = (together.reflect(&l), one_by_one.reflect(&l));
+        for k in 0..LANES {
+            assert_eq!(
+                a.lane(k).to_array().map(f32::to_bits),
+                b.lane(k).to_array().map(f32::to_bits)
+            );
+        }
+        assert!(a.lane(2) != Vec3::ZERO, "lit lanes reflect something");
     }
 }

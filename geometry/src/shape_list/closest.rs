@@ -34,6 +34,41 @@ pub struct PrimitiveHit {
     pub primitive: u32,
 }
 
+/// The closest hits of eight rays, in lanes ([`ShapeList::closest_lanes`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ClosestLanes {
+    /// The lanes whose ray hits something (bit k for lane k).
+    pub hits: u32,
+    /// Each hit lane's distance, as [`PrimitiveHit::t`].
+    pub t: f32x8,
+    /// Each hit lane's object, as [`PrimitiveHit::object`] (shapes only: the
+    /// primitive is 0).
+    pub object: [u32; LANES],
+}
+
+impl ClosestLanes {
+    /// The answer of lane `lane`.
+    #[inline]
+    pub fn hit(&self, lane: usize) -> Option<PrimitiveHit> {
+        (self.hits >> lane & 1 == 1).then(|| PrimitiveHit {
+            t: self.t.as_array()[lane],
+            object: self.object[lane],
+            primitive: 0,
+        })
+    }
+
+    /// The one object every lane of `lanes` hits, if they all hit the same.
+    #[inline]
+    pub fn common_object(&self, lanes: u32) -> Option<u32> {
+        if lanes == 0 {
+            return None;
+        }
+        let first = self.object[lanes.trailing_zeros() as usize];
+        let same = (0..LANES).all(|k| lanes >> k & 1 == 0 || self.object[k] == first);
+        (same && lanes & !self.hits == 0).then_some(first)
+    }
+}
+
 impl ShapeList {
     /// The nearest hit with `0 < t < t_max`, if any, with its surface record.
     /// Hits at exactly the same distance (a ray through an edge where two surfaces
@@ -109,14 +144,21 @@ impl ShapeList {
     /// [`ShapeList::closest_primitive`] without an upper limit for each of the
     /// eight rays of `rays`, one shape against the eight rays at a time: the same
     /// answers. The first `used` lanes hold real rays (the others are counted
-    /// by no `--stats` test, and their answers are to be ignored). `None` unless the list is the linear loop with every object in
-    /// its packets (spheres and parallelograms: the course's scenes), where this
-    /// pays; ask the rays one by one then.
+    /// by no `--stats` test, and their answers are to be ignored). `None` unless
+    /// the list is the linear loop with every object in its packets (spheres and
+    /// parallelograms: the course's scenes), where this pays; ask the rays one
+    /// by one then.
     pub fn closest_primitives_lanes(
         &self,
         rays: &RayLanes,
         used: usize,
     ) -> Option<[Option<PrimitiveHit>; LANES]> {
+        let closest = self.closest_lanes(rays, used)?;
+        Some(std::array::from_fn(|lane| closest.hit(lane)))
+    }
+
+    /// [`ShapeList::closest_primitives_lanes`] with the answers left in lanes.
+    pub fn closest_lanes(&self, rays: &RayLanes, used: usize) -> Option<ClosestLanes> {
         let tested = used.min(LANES) as u64;
         let linear = self
             .linear
@@ -154,14 +196,12 @@ impl ShapeList {
             best_t = take.select(t, best_t);
             best_object = bytemuck::cast::<f32x8, i32x8>(take).select(o, best_object);
         }
-        let (best_t, best_object) = (best_t.to_array(), best_object.to_array());
-        Some(std::array::from_fn(|lane| {
-            (best_object[lane] != i32::MAX).then(|| PrimitiveHit {
-                t: best_t[lane],
-                object: best_object[lane] as u32,
-                primitive: 0,
-            })
-        }))
+        let none: f32x8 = bytemuck::cast(best_object.simd_eq(i32x8::splat(i32::MAX)));
+        Some(ClosestLanes {
+            hits: !lanes::bits(none) & 0xff,
+            t: best_t,
+            object: bytemuck::cast(best_object),
+        })
     }
 
     /// [`ShapeList::closest_primitive`] for each of `rays`, with its own

@@ -15,7 +15,7 @@ mod closest;
 mod linear;
 mod occluders;
 
-pub use closest::PrimitiveHit;
+pub use closest::{ClosestLanes, PrimitiveHit};
 pub use occluders::Occluders;
 
 use crate::bvh::Bvh;

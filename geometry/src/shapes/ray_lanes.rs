@@ -113,16 +113,97 @@ impl Parallelogram {
     }
 }
 
+/// The surface points of eight rays' hits on one shape, in lanes: what
+/// [`Sphere::surface_point`] and [`Parallelogram::surface_at`] give each lane,
+/// bit for bit, without the derivatives.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SurfaceLanes {
+    pub point: Vec3x8,
+    /// The geometric normal, which is also the shading normal on these shapes.
+    pub normal: Vec3x8,
+    pub u: f32x8,
+    pub v: f32x8,
+}
+
+impl RayLanes {
+    /// Each lane's point at its own parameter `t`, as [`Ray::at`] rounds it.
+    #[inline]
+    pub fn at(&self, t: f32x8) -> Vec3x8 {
+        self.origin + self.direction.scale(t)
+    }
+}
+
+impl Sphere {
+    /// [`Self::surface_point`] of each lane of `lanes` (bit k for lane k) at its
+    /// distance `t`; the other lanes are left undefined. The polar angles are
+    /// taken one lane at a time, by the same `acos` and `atan2` as the scalar path.
+    #[inline]
+    pub fn surface_points_lanes(&self, rays: &RayLanes, t: f32x8, lanes: u32) -> SurfaceLanes {
+        let n = rays.at(t).sub_splat(self.center).normalize();
+        let point = Vec3x8::splat_add(self.center, &n.scale(f32x8::splat(self.radius)));
+        let (ny, nz, nx) = (n.y.to_array(), n.z.to_array(), n.x.to_array());
+        let mut u = [0.0; LANES];
+        let mut v = [0.0; LANES];
+        for k in (0..LANES).filter(|k| lanes >> k & 1 == 1) {
+            let theta = ny[k].clamp(-1.0, 1.0).acos();
+            let mut phi = (-nz[k]).atan2(nx[k]);
+            if phi < 0.0 {
+                phi += std::f32::consts::TAU;
+            }
+            (u[k], v[k]) = (
+                phi / std::f32::consts::TAU,
+                1.0 - theta / std::f32::consts::PI,
+            );
+        }
+        SurfaceLanes {
+            point,
+            normal: n,
+            u: f32x8::new(u),
+            v: f32x8::new(v),
+        }
+    }
+}
+
+impl Parallelogram {
+    /// [`Self::surface_at`] of each lane at its distance `t`, without the
+    /// derivatives (the edges, the same in every lane).
+    #[inline]
+    pub fn surface_points_lanes(&self, rays: &RayLanes, t: f32x8) -> SurfaceLanes {
+        let local = rays.at(t).sub_splat(self.origin);
+        let (zero, one) = (f32x8::ZERO, f32x8::ONE);
+        // Vec2::clamp: max with the lower bound, then min with the upper.
+        let u = local
+            .cross_splat(self.edge2)
+            .dot_splat(self.w)
+            .max(zero)
+            .min(one);
+        let v = Vec3x8::splat_cross(self.edge1, &local)
+            .dot_splat(self.w)
+            .max(zero)
+            .min(one);
+        // origin + α·edge1 + β·edge2, as `point_at` rounds it.
+        let point = Vec3x8::splat_add(self.origin, &Vec3x8::scaled_splat(self.edge1, u))
+            + Vec3x8::scaled_splat(self.edge2, v);
+        SurfaceLanes {
+            point,
+            normal: Vec3x8::splat(self.normal),
+            u,
+            v,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::bvh::test_support::XorShift;
+    use crate::Hit;
 
     fn rays_from(origin: Vec3, targets: [Vec3; 8]) -> RayLanes {
         RayLanes::new(targets.map(|t| Ray::new(origin, t - origin)))
     }
 
-    /// Every lane agrees with the scalar test, on random rays (origins inside
+    /// Every lane agrees with the scalar test and surface record, on random rays (origins inside
     /// and outside, grazing and tangent ones included by volume).
     #[test]
     fn lanes_agree_with_the_scalar_tests() {
@@ -158,6 +239,31 @@ mod tests {
                     scalar(sphere.hit_distance(&ray, t_max))
                 );
                 assert_eq!(lane(walls, wall_t), scalar(wall.hit_distance(&ray, t_max)));
+            }
+            let sphere_points = sphere.surface_points_lanes(&rays, sphere_t, spheres);
+            let wall_points = wall.surface_points_lanes(&rays, wall_t);
+            for k in 0..8 {
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                let lane = |s: &SurfaceLanes| {
+                    let uv = [s.u.as_array()[k], s.v.as_array()[k]].map(f32::to_bits);
+                    (bits(s.point.lane(k)), bits(s.normal.lane(k)), uv)
+                };
+                let scalar = |h: Hit| {
+                    (
+                        bits(h.point),
+                        bits(h.geometric_normal),
+                        h.uv.to_array().map(f32::to_bits),
+                    )
+                };
+                let ray = rays.lane(k);
+                if spheres >> k & 1 == 1 {
+                    let t = sphere_t.as_array()[k];
+                    assert_eq!(lane(&sphere_points), scalar(sphere.surface_point(&ray, t)));
+                }
+                if walls >> k & 1 == 1 {
+                    let t = wall_t.as_array()[k];
+                    assert_eq!(lane(&wall_points), scalar(wall.surface_at(&ray, t)));
+                }
             }
             hits += spheres.count_ones() + walls.count_ones();
         }

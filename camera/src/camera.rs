@@ -1,12 +1,21 @@
 //! The pinhole camera of the course report (sections 2.1 and 2.2).
 
 use glam::{UVec2, Vec3};
+use wide::f32x8;
 
 /// A ray leaving the camera: origin at the pinhole, unit-length direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraRay {
     pub origin: Vec3,
     pub direction: Vec3,
+}
+
+/// Eight camera rays in SIMD lanes: the pinhole they share, and each lane's
+/// unit direction by component (`direction[0]` the x components, and so on).
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRayLanes {
+    pub origin: Vec3,
+    pub direction: [f32x8; 3],
 }
 
 /// A camera ray with the directions of the rays one pixel to the right (`dx`) and
@@ -118,6 +127,31 @@ impl Camera {
         CameraRay {
             origin: self.position,
             direction: on_film.normalize(),
+        }
+    }
+
+    /// [`Self::generate_ray`] for eight raster positions `(x[k], y[k])` at
+    /// once, each lane's direction bit for bit the scalar one: the same
+    /// operations in the same order, nothing fused.
+    #[inline]
+    pub fn generate_rays_lanes(&self, x: f32x8, y: f32x8) -> CameraRayLanes {
+        let two = f32x8::splat(2.0);
+        let ndc_x = two * x / f32x8::splat(self.resolution.x as f32) - f32x8::ONE;
+        let ndc_y = f32x8::ONE - two * y / f32x8::splat(self.resolution.y as f32);
+        let (a, b) = (
+            ndc_x * f32x8::splat(self.half_width),
+            ndc_y * f32x8::splat(self.half_height),
+        );
+        let on_film = |axis: usize| {
+            let f = self.focal_length * self.forward[axis];
+            f32x8::splat(f) + a * f32x8::splat(self.right[axis]) + b * f32x8::splat(self.up[axis])
+        };
+        let (dx, dy, dz) = (on_film(0), on_film(1), on_film(2));
+        // Vec3::normalize: times 1/length, the length of (x·x + y·y) + z·z.
+        let rcp = f32x8::ONE / (dx * dx + dy * dy + dz * dz).sqrt();
+        CameraRayLanes {
+            origin: self.position,
+            direction: [dx * rcp, dy * rcp, dz * rcp],
         }
     }
 
@@ -292,5 +326,42 @@ mod tests {
         assert_eq!(wide.film_half_extent().1, cam.film_half_extent().1);
         assert_eq!(wide.generate_ray(8.0, 4.0), cam.generate_ray(4.0, 4.0));
         assert!(cam.with_resolution(UVec2::new(0, 3)).is_err());
+    }
+
+    #[test]
+    fn rays_in_lanes_are_the_scalar_rays_bit_for_bit() {
+        let camera = Camera::new(
+            Vec3::new(1.5, -2.0, 7.0),
+            Vec3::new(0.2, 0.1, -3.0),
+            Vec3::new(0.1, 1.0, 0.0),
+            47.0,
+            1.3,
+            UVec2::new(640, 360),
+        )
+        .unwrap();
+        let mut seed = 0x2545_f491_u32;
+        let mut next = move |scale: f32| {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            (seed >> 8) as f32 / (1 << 24) as f32 * scale
+        };
+        for _ in 0..500 {
+            let x: [f32; 8] = std::array::from_fn(|_| next(640.0));
+            let y: [f32; 8] = std::array::from_fn(|_| next(360.0));
+            let lanes = camera.generate_rays_lanes(f32x8::new(x), f32x8::new(y));
+            for k in 0..8 {
+                let scalar = camera.generate_ray(x[k], y[k]);
+                assert_eq!(lanes.origin, scalar.origin);
+                let d = lanes.direction.map(|c| c.to_array()[k].to_bits());
+                assert_eq!(
+                    d,
+                    scalar.direction.to_array().map(f32::to_bits),
+                    "({}, {})",
+                    x[k],
+                    y[k]
+                );
+            }
+        }
     }
 }

@@ -19,7 +19,7 @@
 
 use crate::direct::{PairAllocation, SampleContext, ShadingPoint};
 use crate::light_samples::count_lanes;
-use crate::sampling::{DimensionPair, PixelSample, SamplePattern};
+use crate::sampling::{stream_seed, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern};
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
@@ -93,12 +93,15 @@ impl DirectIntegrator {
             sample: first.sample + k as u64,
             ..first
         });
-        // Each lane's own stream, as `SampleContext::begin_sample` makes it (only
-        // patterns other than Sobol draw from it).
-        let mut rngs: [Option<rand_pcg::Pcg32>; LANES] = std::array::from_fn(|k| {
-            (shaded.lanes >> k & 1 == 1 && self.light_pattern != SamplePattern::Sobol)
-                .then(|| samples[k].rng())
-        });
+        // Each lane's own stream, as `SampleContext::begin_sample` makes it. The
+        // random pattern draws a point as two uniforms; so does the stratified
+        // one for a single point (its one cell is the whole square, and
+        // `(0 + u)·1` is `u`). Grid and Sobol points draw nothing.
+        let mut rngs = matches!(
+            self.light_pattern,
+            SamplePattern::Random | SamplePattern::Stratified
+        )
+        .then(|| Pcg32Lanes::new(samples.map(|s| stream_seed(s.seed, s.pixel, s.sample))));
         let mut pairs = PairAllocation::new(0);
         for (index, light) in scene.lights.iter().enumerate() {
             let Light::Area(area) = light else {
@@ -109,19 +112,25 @@ impl DirectIntegrator {
                 depth: 0,
             };
             let pair = pairs.take(own, self.light_samples);
-            let u: [Vec2; LANES] = std::array::from_fn(|k| {
-                let mut u = [Vec2::ZERO];
-                if shaded.lanes >> k & 1 == 1 {
-                    let sobol = samples[k].sobol_points(pair, 1);
-                    match &mut rngs[k] {
-                        Some(rng) => self.light_pattern.fill(rng, sobol, &mut u),
-                        None => self.light_pattern.fill(&mut ctx.rng, sobol, &mut u),
-                    }
+            let u = match &mut rngs {
+                Some(rngs) => {
+                    let x = rngs.uniform();
+                    (x, rngs.uniform())
                 }
-                u[0]
-            });
+                None => {
+                    let u: [Vec2; LANES] = std::array::from_fn(|k| {
+                        let mut u = [Vec2::ZERO];
+                        if shaded.lanes >> k & 1 == 1 {
+                            let sobol = samples[k].sobol_points(pair, 1);
+                            self.light_pattern.fill(&mut ctx.rng, sobol, &mut u);
+                        }
+                        u[0]
+                    });
+                    (f32x8::new(u.map(|u| u.x)), f32x8::new(u.map(|u| u.y)))
+                }
+            };
             ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
-            let reflected = shaded.area_light(scene, area, &u, ctx);
+            let reflected = shaded.area_light(scene, area, u, ctx);
             for (k, radiance) in radiance.iter_mut().enumerate() {
                 if shaded.lanes >> k & 1 == 1 {
                     let sum = Vec3::ZERO + reflected[k];
@@ -221,17 +230,16 @@ impl<'a> ShadedLanes<'a> {
         true
     }
 
-    /// Per lane, the Phong reflection of the light point at `u` on `light`, or
+    /// Per lane, the Phong reflection of the light point at `(ux, uy)` on `light`, or
     /// zero where it is behind the light, below the surface, reflects nothing or
     /// is blocked: `unoccluded_reflection` of the scalar path, with its counts.
     fn area_light(
         &self,
         scene: &Scene,
         light: &AreaLight,
-        u: &[Vec2; LANES],
+        (ux, uy): (f32x8, f32x8),
         ctx: &mut SampleContext,
     ) -> [Vec3; LANES] {
-        let (ux, uy) = (f32x8::new(u.map(|u| u.x)), f32x8::new(u.map(|u| u.y)));
         let position = light.sample_points(ux, uy);
         let towards = position - self.point;
         let (l, normalized) = towards.try_normalize();

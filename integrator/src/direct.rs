@@ -1,4 +1,5 @@
 use crate::counters::{ShadingCounters, TextureCounters};
+use crate::sampling::Pcg32;
 use crate::sampling::{DimensionPair, PixelSample, SamplePattern, MAX_JOINT};
 use crate::{Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
@@ -7,7 +8,6 @@ use glint_geometry::{
 };
 use glint_lighting::{AreaLight, Light, PhongMaterial};
 use glint_texture::TexCoord;
-use rand_pcg::Pcg32;
 
 /// From this many samples per area light on, each shading point first culls the
 /// shapes that cannot block its shadow rays to the light

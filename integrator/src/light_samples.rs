@@ -178,7 +178,6 @@ mod tests {
     use glint_geometry::{Parallelogram, Ray, Sphere};
     use glint_lighting::{Light, PhongMaterial, SpecularLobe};
     use glint_texture::{TexCoord, Texture};
-    use rand_core::RngCore;
 
     /// A floor, a ceiling above the light (behind its one emitting side), a
     /// sphere between them and a one-sided light, in materials `material`.

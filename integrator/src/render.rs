@@ -4,7 +4,7 @@ use crate::sampling::{pixel_rng, PixelSample, SamplePattern, SobolPoints, PIXEL_
 use crate::{Aov, DirectIntegrator, Scene};
 use glam::{Vec2, Vec3};
 use glint_camera::{Camera, Film};
-use glint_geometry::lanes::LANES;
+use glint_geometry::lanes::{f32x8, Vec3x8, LANES};
 use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential, RayLanes};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -286,6 +286,11 @@ fn render_rows(
     let footprint_scale = (1.0 / (settings.spp as f32).sqrt()).max(0.125);
     let differentials = scene.needs_differentials();
     let first_hits_in_lanes = integrator.shades_first_hits_in_lanes(scene);
+    // The whole of a camera sample in lanes, from its ray to its radiance.
+    let all_in_lanes = first_hits_in_lanes
+        && settings.aov.is_none()
+        && !differentials
+        && scene.shapes.has_closest_lanes();
     for (offset, radiance) in pixels.iter_mut().enumerate() {
         let (x, y) = (offset as u32 % width, first_row + offset as u32 / width);
         let pixel = y as u64 * width as u64 + x as u64;
@@ -296,6 +301,37 @@ fn render_rows(
             .fill(&mut rng, sobol, &mut pixel_samples);
         let mut sum = Vec3::ZERO;
         for (chunk, jitters) in pixel_samples.chunks(LANES).enumerate() {
+            let used = jitters.len();
+            let first = PixelSample {
+                seed: settings.seed,
+                pixel,
+                sample: (chunk * LANES) as u64,
+            };
+            if all_in_lanes && used > 1 {
+                // Camera rays, closest hits and shading, eight samples at a time.
+                let jitter = |axis: usize| {
+                    f32x8::new(std::array::from_fn(|k| jitters[k.min(used - 1)][axis]))
+                };
+                let c = scene.camera.generate_rays_lanes(
+                    f32x8::splat(x as f32) + jitter(0),
+                    f32x8::splat(y as f32) + jitter(1),
+                );
+                let [dx, dy, dz] = c.direction;
+                let rays = RayLanes {
+                    origin: Vec3x8::splat(c.origin),
+                    direction: Vec3x8 {
+                        x: dx,
+                        y: dy,
+                        z: dz,
+                    },
+                };
+                let closest = scene.shapes.closest_lanes(&rays, used);
+                let closest = closest.expect("has_closest_lanes");
+                let values =
+                    integrator.li_first_hits(scene, &rays, &closest, used, first, &mut ctx);
+                accumulate(&mut sum, values, used, &mut ctx);
+                continue;
+            }
             let rays: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
                 let raster = Vec2::new(x as f32, y as f32) + jitters[k.min(jitters.len() - 1)];
                 if differentials {
@@ -308,7 +344,6 @@ fn render_rows(
             });
             // Several camera rays at once: their closest hits one shape against
             // all of them, where the scene's layout allows it (the same hits).
-            let used = jitters.len();
             let ray_lanes = RayLanes::new(rays.map(|(ray, _)| ray));
             let closest = (settings.aov.is_none() && used > 1)
                 .then(|| scene.shapes.closest_lanes(&ray_lanes, used))
@@ -316,11 +351,6 @@ fn render_rows(
             let values: [Vec3; LANES] = match &closest {
                 // One sample per light: the eight samples shaded together.
                 Some(closest) if first_hits_in_lanes => {
-                    let first = PixelSample {
-                        seed: settings.seed,
-                        pixel,
-                        sample: (chunk * LANES) as u64,
-                    };
                     integrator.li_first_hits(scene, &ray_lanes, closest, used, first, &mut ctx)
                 }
                 _ => std::array::from_fn(|k| {
@@ -340,13 +370,7 @@ fn render_rows(
                     }
                 }),
             };
-            for value in values.into_iter().take(used) {
-                if value.is_finite() {
-                    sum += value;
-                } else {
-                    ctx.counters.nonfinite_samples += 1;
-                }
-            }
+            accumulate(&mut sum, values, used, &mut ctx);
         }
         *radiance = sum / settings.spp as f32;
     }
@@ -358,6 +382,19 @@ fn render_rows(
             QueryCounters::default()
         },
         textures: ctx.textures,
+    }
+}
+
+/// Adds the first `used` of a chunk's radiance `values` to `sum`, leaving out
+/// (and counting) those that are NaN or infinite.
+#[inline]
+fn accumulate(sum: &mut Vec3, values: [Vec3; LANES], used: usize, ctx: &mut SampleContext) {
+    for value in values.into_iter().take(used) {
+        if value.is_finite() {
+            *sum += value;
+        } else {
+            ctx.counters.nonfinite_samples += 1;
+        }
     }
 }
 

@@ -157,13 +157,22 @@ impl ShapeList {
         Some(std::array::from_fn(|lane| closest.hit(lane)))
     }
 
+    /// Whether [`ShapeList::closest_lanes`] answers (the linear loop holds every
+    /// object in its packets).
+    pub fn has_closest_lanes(&self) -> bool {
+        self.lanes_layout().is_some()
+    }
+
+    fn lanes_layout(&self) -> Option<&LinearShapes> {
+        self.linear
+            .as_ref()
+            .filter(|linear| linear.others.is_empty() && self.bvh.is_none())
+    }
+
     /// [`ShapeList::closest_primitives_lanes`] with the answers left in lanes.
     pub fn closest_lanes(&self, rays: &RayLanes, used: usize) -> Option<ClosestLanes> {
         let tested = used.min(LANES) as u64;
-        let linear = self
-            .linear
-            .as_ref()
-            .filter(|linear| linear.others.is_empty() && self.bvh.is_none())?;
+        let linear = self.lanes_layout()?;
         // The nearest so far per lane, and its object (i32::MAX: none yet).
         let mut best_t = f32x8::splat(f32::INFINITY);
         let mut best_object = i32x8::splat(i32::MAX);

@@ -68,17 +68,21 @@
 //! # Files
 //! - `pattern`: [`SamplePattern`] and how each fills N points.
 //! - `sobol`: [`DimensionPair`], [`SobolSequence`] and [`SobolPoints`].
+//! - `pcg`: the PCG32 generator ([`Pcg32`]), and eight of them in lanes
+//!   ([`Pcg32Lanes`]).
 //! - `streams`: [`pixel_rng`], [`uniform`] and [`PixelSample`], which names a
 //!   camera sample's stream and its Sobol points.
 //! - `sobol_tests`: the published points, elementary intervals, convergence and
 //!   correlation of the Sobol sequences.
 
 mod pattern;
+mod pcg;
 mod sobol;
 #[cfg(test)]
 mod sobol_tests;
 mod streams;
 
 pub use pattern::SamplePattern;
+pub use pcg::{Pcg32, Pcg32Lanes, STREAM};
 pub use sobol::{DimensionPair, SobolPoints, SobolSequence, MAX_JOINT};
-pub use streams::{mix64, pixel_rng, uniform, PixelSample, PIXEL_STREAM};
+pub use streams::{mix64, pixel_rng, stream_seed, uniform, PixelSample, PIXEL_STREAM};

@@ -1,10 +1,9 @@
 //! The sample patterns: where N points fall in [0, 1)².
 
+use super::pcg::{fill_uniform_pairs, Pcg32};
 use super::sobol::SobolPoints;
 use super::streams::uniform;
 use glam::Vec2;
-use rand_core::RngCore;
-use rand_pcg::Pcg32;
 
 /// How N points are placed in [0, 1)².
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -64,7 +63,7 @@ impl SamplePattern {
     pub fn fill(self, rng: &mut Pcg32, sobol: SobolPoints, out: &mut [Vec2]) {
         let n = out.len() as u32;
         match self {
-            Self::Random => out.iter_mut().for_each(|p| *p = uniform2(rng)),
+            Self::Random => fill_uniform_pairs(rng, out),
             Self::Sobol => sobol.fill(out),
             Self::Grid => match exact_sqrt(n) {
                 Some(k) => fill_grid(k, out, |_| Vec2::splat(0.5)),

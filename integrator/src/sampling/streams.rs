@@ -1,9 +1,8 @@
 //! The per-pixel random streams: every number a pixel uses is a function of
 //! `(seed, pixel index, sample index)`, never of a shared generator.
 
+use super::pcg::Pcg32;
 use super::sobol::{DimensionPair, SobolPoints};
-use rand_core::RngCore;
-use rand_pcg::Pcg32;
 
 /// SplitMix64's finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix.
 #[inline]
@@ -19,15 +18,21 @@ pub const PIXEL_STREAM: u64 = u64::MAX;
 
 /// The generator for `(seed, pixel, sample)`: independent of every other triple
 /// and of the order in which pixels are rendered.
+#[inline]
 pub fn pixel_rng(seed: u64, pixel: u64, sample: u64) -> Pcg32 {
-    let state = mix64(mix64(mix64(seed) ^ pixel) ^ sample);
-    Pcg32::new(state, 0x0a02_bdbf_7bb3_c0a7)
+    Pcg32::new(stream_seed(seed, pixel, sample))
+}
+
+/// The seed of [`pixel_rng`]`(seed, pixel, sample)`.
+#[inline]
+pub fn stream_seed(seed: u64, pixel: u64, sample: u64) -> u64 {
+    mix64(mix64(mix64(seed) ^ pixel) ^ sample)
 }
 
 /// A uniform f32 in [0, 1) from the top 24 bits of one 32-bit draw.
 #[inline]
 pub fn uniform(rng: &mut Pcg32) -> f32 {
-    (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+    rng.uniform()
 }
 
 /// One camera sample of one pixel: it names the sample's PCG stream

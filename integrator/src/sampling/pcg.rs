@@ -1,0 +1,234 @@
+//! PCG32 (O'Neill, "PCG: A Family of Simple Fast Space-Efficient Statistically
+//! Good Algorithms for Random Number Generation", 2014): the 64-bit LCG
+//! `s ← a·s + c` with the XSH-RR output permutation, on Glint's one stream
+//! [`INCREMENT`]. One generator ([`Pcg32`]) or eight stepping in lanes
+//! ([`Pcg32Lanes`]), each lane the scalar generator's numbers bit for bit.
+//!
+//! The numbers are those of `rand_pcg::Pcg32` (`Lcg64Xsh32`) seeded with
+//! `Pcg32::new(state, STREAM)` (the tests compare), Glint's generator before
+//! it had lanes; having the state at hand lets a stream jump ahead by any
+//! number of draws in one multiply-add (Brown, "Random Number Generation with
+//! Arbitrary Strides", 1994), which is how eight lanes take consecutive draws
+//! of one stream.
+
+use glint_geometry::lanes::{f32x8, LANES};
+
+/// The LCG's multiplier (Knuth's MMIX constant, PCG's default).
+const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
+
+/// The stream every Glint generator runs on.
+pub const STREAM: u64 = 0x0a02_bdbf_7bb3_c0a7;
+
+/// The LCG's increment for [`STREAM`] (odd, as the full period needs).
+const INCREMENT: u64 = (STREAM << 1) | 1;
+
+/// `(A, C)` with `A·s + C` the state `delta` steps after `s`: the square-and-
+/// multiply composition of the affine map `s ↦ a·s + c` with itself (Brown 1994).
+const fn jump(delta: u64) -> (u64, u64) {
+    let (mut acc_mult, mut acc_plus) = (1u64, 0u64);
+    let (mut mult, mut plus) = (MULTIPLIER, INCREMENT);
+    let mut d = delta;
+    while d > 0 {
+        if d & 1 == 1 {
+            acc_mult = acc_mult.wrapping_mul(mult);
+            acc_plus = acc_plus.wrapping_mul(mult).wrapping_add(plus);
+        }
+        plus = mult.wrapping_add(1).wrapping_mul(plus);
+        mult = mult.wrapping_mul(mult);
+        d /= 2;
+    }
+    (acc_mult, acc_plus)
+}
+
+/// XSH-RR: the top bits xor-shifted down, rotated by the top five bits.
+#[inline(always)]
+fn output(state: u64) -> u32 {
+    let rot = (state >> 59) as u32;
+    let xsh = (((state >> 18) ^ state) >> 27) as u32;
+    xsh.rotate_right(rot)
+}
+
+#[inline(always)]
+fn step(state: u64) -> u64 {
+    state.wrapping_mul(MULTIPLIER).wrapping_add(INCREMENT)
+}
+
+/// A uniform f32 in [0, 1) from the top 24 bits of a 32-bit draw.
+#[inline(always)]
+fn unit(draw: u32) -> f32 {
+    (draw >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
+/// One PCG32 generator on [`STREAM`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pcg32 {
+    state: u64,
+}
+
+impl Pcg32 {
+    /// The generator seeded with `seed`, as `rand_pcg::Pcg32::new(seed, STREAM)`.
+    #[inline]
+    pub fn new(seed: u64) -> Self {
+        Self {
+            state: step(seed.wrapping_add(INCREMENT)),
+        }
+    }
+
+    /// The next 32 random bits.
+    #[inline]
+    pub fn next_u32(&mut self) -> u32 {
+        let state = self.state;
+        self.state = step(state);
+        output(state)
+    }
+
+    /// A uniform f32 in [0, 1) from the top 24 bits of the next draw.
+    #[inline]
+    pub fn uniform(&mut self) -> f32 {
+        unit(self.next_u32())
+    }
+
+    /// Skips the next `delta` draws.
+    #[inline]
+    pub fn advance(&mut self, delta: u64) {
+        let (a, c) = jump(delta);
+        self.state = a.wrapping_mul(self.state).wrapping_add(c);
+    }
+}
+
+/// The jumps by 0, 2, 4, … 14 draws: lane k of a stream's pairs of draws.
+const PAIR_LANES: [(u64, u64); LANES] = {
+    let mut jumps = [(0, 0); LANES];
+    let mut k = 0;
+    while k < LANES {
+        jumps[k] = jump(2 * k as u64);
+        k += 1;
+    }
+    jumps
+};
+
+/// From a lane's state after its two draws of a chunk to its first draw of the
+/// next: the lanes take `2·LANES` draws a chunk.
+const NEXT_PAIRS: (u64, u64) = jump(2 * LANES as u64 - 2);
+
+/// Eight PCG32 generators on [`STREAM`], stepped together.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pcg32Lanes {
+    state: [u64; LANES],
+}
+
+impl Pcg32Lanes {
+    /// Lane k seeded with `seeds[k]`, as [`Pcg32::new`].
+    #[inline]
+    pub fn new(seeds: [u64; LANES]) -> Self {
+        Self {
+            state: seeds.map(|s| step(s.wrapping_add(INCREMENT))),
+        }
+    }
+
+    /// Each lane's next 32 random bits.
+    #[inline]
+    pub fn next_u32(&mut self) -> [u32; LANES] {
+        let out = self.state.map(output);
+        self.state = self.state.map(step);
+        out
+    }
+
+    /// Each lane's next uniform f32 in [0, 1), as [`Pcg32::uniform`].
+    #[inline]
+    pub fn uniform(&mut self) -> f32x8 {
+        f32x8::new(self.next_u32().map(unit))
+    }
+}
+
+/// Fills `out` with uniform points of `rng`, point i from draws 2i and 2i + 1
+/// (x, then y), and leaves `rng` past them: the same points and state as
+/// drawing them one by one, eight points at a time in lanes.
+pub fn fill_uniform_pairs(rng: &mut Pcg32, out: &mut [glam::Vec2]) {
+    let mut chunks = out.chunks_exact_mut(LANES);
+    let mut lanes = Pcg32Lanes {
+        state: PAIR_LANES.map(|(a, c)| a.wrapping_mul(rng.state).wrapping_add(c)),
+    };
+    let (next_a, next_c) = NEXT_PAIRS;
+    for chunk in &mut chunks {
+        let x = lanes.uniform().to_array();
+        let y = lanes.uniform().to_array();
+        for (k, p) in chunk.iter_mut().enumerate() {
+            *p = glam::Vec2::new(x[k], y[k]);
+        }
+        lanes.state = lanes
+            .state
+            .map(|s| next_a.wrapping_mul(s).wrapping_add(next_c));
+    }
+    let done = out.len() / LANES * LANES;
+    rng.advance(2 * done as u64);
+    for p in &mut out[done..] {
+        let x = rng.uniform();
+        *p = glam::Vec2::new(x, rng.uniform());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand_core::RngCore;
+
+    #[test]
+    fn draws_are_those_of_rand_pcg_on_the_same_stream() {
+        for seed in [0, 1, 0xdead_beef, u64::MAX, 0x0123_4567_89ab_cdef] {
+            let mut ours = Pcg32::new(seed);
+            let mut theirs = rand_pcg::Pcg32::new(seed, STREAM);
+            for _ in 0..1000 {
+                assert_eq!(ours.next_u32(), theirs.next_u32(), "seed {seed:#x}");
+            }
+        }
+    }
+
+    #[test]
+    fn advancing_skips_exactly_that_many_draws() {
+        for delta in [0, 1, 2, 7, 15, 16, 1000, 123_456] {
+            let mut jumped = Pcg32::new(42);
+            jumped.advance(delta);
+            let mut stepped = Pcg32::new(42);
+            for _ in 0..delta {
+                stepped.next_u32();
+            }
+            assert_eq!(jumped, stepped, "delta {delta}");
+        }
+    }
+
+    #[test]
+    fn lanes_are_the_scalar_generators() {
+        let seeds: [u64; LANES] = std::array::from_fn(|k| 0x9e37_79b9 * k as u64 + 5);
+        let mut lanes = Pcg32Lanes::new(seeds);
+        let mut scalars = seeds.map(Pcg32::new);
+        for _ in 0..100 {
+            let u = lanes.uniform().to_array();
+            for (k, rng) in scalars.iter_mut().enumerate() {
+                assert_eq!(u[k].to_bits(), rng.uniform().to_bits());
+            }
+        }
+    }
+
+    /// Every length, including partial chunks, gives the one-by-one points and
+    /// the one-by-one state after them.
+    #[test]
+    fn pairs_filled_in_lanes_are_the_pairs_drawn_one_by_one() {
+        for n in [0, 1, 7, 8, 9, 16, 61, 64, 256] {
+            let mut lanes_rng = Pcg32::new(n as u64 * 31 + 7);
+            let mut scalar_rng = lanes_rng;
+            let mut filled = vec![glam::Vec2::NAN; n];
+            fill_uniform_pairs(&mut lanes_rng, &mut filled);
+            for (i, p) in filled.iter().enumerate() {
+                let x = scalar_rng.uniform();
+                let expected = glam::Vec2::new(x, scalar_rng.uniform());
+                assert_eq!(
+                    p.to_array().map(f32::to_bits),
+                    expected.to_array().map(f32::to_bits),
+                    "n {n}, point {i}"
+                );
+            }
+            assert_eq!(lanes_rng, scalar_rng, "n {n}: the state after");
+        }
+    }
+}

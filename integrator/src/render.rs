@@ -300,6 +300,11 @@ fn render_rows(
             .pixel_pattern
             .fill(&mut rng, sobol, &mut pixel_samples);
         let mut sum = Vec3::ZERO;
+        let candidates = if all_in_lanes {
+            objects_seen_by_pixel(scene, x, y)
+        } else {
+            u64::MAX
+        };
         for (chunk, jitters) in pixel_samples.chunks(LANES).enumerate() {
             let used = jitters.len();
             let first = PixelSample {
@@ -325,7 +330,7 @@ fn render_rows(
                         z: dz,
                     },
                 };
-                let closest = scene.shapes.closest_lanes(&rays, used);
+                let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
                 let closest = closest.expect("has_closest_lanes");
                 let values =
                     integrator.li_first_hits(scene, &rays, &closest, used, first, &mut ctx);
@@ -383,6 +388,23 @@ fn render_rows(
         },
         textures: ctx.textures,
     }
+}
+
+/// The objects a camera ray through pixel `(x, y)` may hit
+/// ([`ShapeList::objects_in_cone`](glint_geometry::ShapeList::objects_in_cone)):
+/// those meeting the cone around the pixel's central ray through its four corners.
+fn objects_seen_by_pixel(scene: &Scene, x: u32, y: u32) -> u64 {
+    let camera = &scene.camera;
+    let (x, y) = (x as f32, y as f32);
+    let axis = camera.generate_ray(x + 0.5, y + 0.5);
+    let half_angle = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+        .map(|(dx, dy)| camera.generate_ray(x + dx, y + dy).direction)
+        .map(|corner| axis.direction.dot(corner).clamp(-1.0, 1.0).acos())
+        .into_iter()
+        .fold(0.0, f32::max);
+    scene
+        .shapes
+        .objects_in_cone(axis.origin, axis.direction, half_angle)
 }
 
 /// Adds the first `used` of a chunk's radiance `values` to `sum`, leaving out

@@ -6,8 +6,9 @@
 //! rule (nearest, ties to the lowest object).
 
 use super::{Object, ShapeList};
+use crate::bvh::Bounds3;
 use crate::{ParallelogramPacket, Shape, SpherePacket};
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 
 /// A scene's objects laid out for the linear loop.
 #[derive(Clone, Debug, Default)]
@@ -25,6 +26,9 @@ pub(super) struct LinearShapes {
     /// Per object, the bit [`Occluders`](super::Occluders) names a flat shape by
     /// (a parallelogram's packet and lane), or `None`.
     pub(super) flat_bits: Vec<Option<u8>>,
+    /// Per object, its bounds and bounding sphere (centre, radius), for culling
+    /// whole batches of rays; empty bounds for objects outside the packets.
+    pub(super) object_bounds: Vec<(Bounds3, Vec3, f32)>,
 }
 
 impl LinearShapes {
@@ -53,7 +57,21 @@ impl LinearShapes {
         for (k, (object, _)) in parallelograms.iter().enumerate() {
             flat_bits[*object as usize] = u8::try_from(first_flat + k).ok();
         }
+        let mut object_bounds = vec![(Bounds3::EMPTY, Vec3::ZERO, 0.0); list.objects.len()];
+        for (object, sphere) in &spheres {
+            let bounds = Shape::Sphere(*sphere)
+                .bounds()
+                .expect("a sphere is bounded");
+            object_bounds[*object as usize] = (bounds, sphere.center(), sphere.radius());
+        }
+        for (object, p) in &parallelograms {
+            let bounds = Shape::Parallelogram(*p).bounds().expect("bounded");
+            let (e1, e2) = p.edges();
+            let radius = 0.5 * (e1 + e2).length().max((e1 - e2).length());
+            object_bounds[*object as usize] = (bounds, p.center(), radius);
+        }
         Self {
+            object_bounds,
             sphere_bounds: lanes_of(&spheres, |s| {
                 let (c, r) = (s.center(), s.radius());
                 ([c.x, c.y, c.z].map(Vec4::splat), Vec4::splat(r))

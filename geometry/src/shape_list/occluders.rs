@@ -12,8 +12,9 @@
 //! then test one or two spheres instead of ten shapes.)
 
 use super::{ObjectRef, ShapeList};
+use crate::bvh::Bounds3;
 use crate::counters::count;
-use crate::lanes::LANES;
+use crate::lanes::{self, f32x8, LANES};
 use crate::triangle::WatertightRay;
 use crate::{Ray, RayLanes, Shape};
 use glam::{Vec3, Vec4};
@@ -159,12 +160,17 @@ impl ShapeList {
         };
         let tested = u64::from(active.count_ones());
         let mut blocked = 0;
+        let reach = segments_bounds(rays, t_max, active);
         let spheres = linear.spheres.iter().map(|(_, objects)| objects);
         let parallelograms = linear.parallelograms.iter().map(|(_, objects)| objects);
         for (k, objects) in spheres.chain(parallelograms).enumerate() {
             let kept = occluders.packet(k);
             for (lane, &object) in objects.iter().enumerate() {
                 if kept >> lane & 1 == 0 || object == u32::MAX {
+                    continue;
+                }
+                let bounds = &linear.object_bounds[object as usize].0;
+                if !overlap(&reach, bounds) {
                     continue;
                 }
                 blocked |= active
@@ -216,6 +222,50 @@ impl ShapeList {
             .filter(|&lane| active >> lane & 1 == 1 && blocked(lane))
             .fold(0, |bits, lane| bits | 1 << lane)
     }
+}
+
+/// The box around the segments `origin` to `origin + t_max·direction` of the
+/// lanes of `active`, widened by 10⁻⁴ of its coordinates' size: every point
+/// where one of those rays can hit a shape with `0 < t < t_max`, with room
+/// to spare for rounding.
+fn segments_bounds(rays: &RayLanes, t_max: f32, active: u32) -> Bounds3 {
+    let ends = rays.origin + rays.direction.scale(f32x8::splat(t_max));
+    let mask = lanes::from_bits(active);
+    let axis = |o: f32x8, e: f32x8| {
+        // 0·∞ = NaN: with t_max infinite, a ray keeps a coordinate its
+        // direction does not change.
+        let e = e.is_nan().select(o, e);
+        let (lo, hi) = (o.min(e), o.max(e));
+        let lo = mask.select(lo, f32x8::splat(f32::INFINITY)).to_array();
+        let hi = mask.select(hi, f32x8::splat(f32::NEG_INFINITY)).to_array();
+        // f32::min and max pass over NaN: a ray with a NaN coordinate hits
+        // nothing (every test compares false), so it needs no room.
+        let min = lo.iter().fold(f32::INFINITY, |m, &v| m.min(v));
+        let max = hi.iter().fold(f32::NEG_INFINITY, |m, &v| m.max(v));
+        (min, max)
+    };
+    let (x, y, z) = (
+        axis(rays.origin.x, ends.x),
+        axis(rays.origin.y, ends.y),
+        axis(rays.origin.z, ends.z),
+    );
+    let (min, max) = (Vec3::new(x.0, y.0, z.0), Vec3::new(x.1, y.1, z.1));
+    let margin = 1e-4 * min.abs().max(max.abs()).max_element();
+    Bounds3 {
+        min: min - margin,
+        max: max + margin,
+    }
+}
+
+/// Whether two boxes share a point (NaN bounds count as sharing).
+#[inline]
+fn overlap(a: &Bounds3, b: &Bounds3) -> bool {
+    !(a.min.x > b.max.x
+        || a.min.y > b.max.y
+        || a.min.z > b.max.z
+        || b.min.x > a.max.x
+        || b.min.y > a.max.y
+        || b.min.z > a.max.z)
 }
 
 /// A face of the pyramid: a point `x` is outside when `normal · x − offset > margin`.

@@ -160,7 +160,10 @@ impl ShapeList {
         };
         let tested = u64::from(active.count_ones());
         let mut blocked = 0;
-        let reach = segments_bounds(rays, t_max, active);
+        // Rays from eight points, not culled for one point (`Occluders::ALL`):
+        // only the shapes near their segments. After a point's own culling
+        // this would cost more than it saves.
+        let reach = (occluders.lanes == u64::MAX).then(|| segments_bounds(rays, t_max, active));
         let spheres = linear.spheres.iter().map(|(_, objects)| objects);
         let parallelograms = linear.parallelograms.iter().map(|(_, objects)| objects);
         for (k, objects) in spheres.chain(parallelograms).enumerate() {
@@ -170,7 +173,7 @@ impl ShapeList {
                     continue;
                 }
                 let bounds = &linear.object_bounds[object as usize].0;
-                if !overlap(&reach, bounds) {
+                if reach.as_ref().is_some_and(|reach| !overlap(reach, bounds)) {
                     continue;
                 }
                 blocked |= active

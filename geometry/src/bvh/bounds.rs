@@ -53,6 +53,12 @@ impl Bounds3 {
 
     /// `(min + max)/2`, evaluated as `min/2 + max/2` so that it cannot overflow.
     /// NaN for [`Bounds3::EMPTY`].
+    /// Whether the two boxes share a point (NaN bounds count as sharing).
+    #[inline]
+    pub fn overlaps(&self, other: &Bounds3) -> bool {
+        !(self.min.cmpgt(other.max).any() || other.min.cmpgt(self.max).any())
+    }
+
     pub fn centroid(&self) -> Vec3 {
         0.5 * self.min + 0.5 * self.max
     }

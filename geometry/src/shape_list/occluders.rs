@@ -173,7 +173,7 @@ impl ShapeList {
                     continue;
                 }
                 let bounds = &linear.object_bounds[object as usize].0;
-                if reach.as_ref().is_some_and(|reach| !overlap(reach, bounds)) {
+                if reach.as_ref().is_some_and(|reach| !reach.overlaps(bounds)) {
                     continue;
                 }
                 blocked |= active
@@ -232,7 +232,7 @@ impl ShapeList {
 /// where one of those rays can hit a shape with `0 < t < t_max`, with room
 /// to spare for rounding.
 fn segments_bounds(rays: &RayLanes, t_max: f32, active: u32) -> Bounds3 {
-    let ends = rays.origin + rays.direction.scale(f32x8::splat(t_max));
+    let ends = rays.at(f32x8::splat(t_max));
     let mask = lanes::from_bits(active);
     let axis = |o: f32x8, e: f32x8| {
         // 0·∞ = NaN: with t_max infinite, a ray keeps a coordinate its
@@ -258,17 +258,6 @@ fn segments_bounds(rays: &RayLanes, t_max: f32, active: u32) -> Bounds3 {
         min: min - margin,
         max: max + margin,
     }
-}
-
-/// Whether two boxes share a point (NaN bounds count as sharing).
-#[inline]
-fn overlap(a: &Bounds3, b: &Bounds3) -> bool {
-    !(a.min.x > b.max.x
-        || a.min.y > b.max.y
-        || a.min.z > b.max.z
-        || b.min.x > a.max.x
-        || b.min.y > a.max.y
-        || b.min.z > a.max.z)
 }
 
 /// A face of the pyramid: a point `x` is outside when `normal · x − offset > margin`.

@@ -84,6 +84,16 @@ impl Sphere {
 }
 
 impl Parallelogram {
+    /// The edge coordinates (α, β) of each lane's point `p`, as `coordinates`
+    /// rounds them.
+    #[inline]
+    fn coordinates_lanes(&self, p: &Vec3x8) -> (f32x8, f32x8) {
+        let local = p.sub_splat(self.origin);
+        let alpha = local.cross_splat(self.edge2).dot_splat(self.w);
+        let beta = Vec3x8::splat_cross(self.edge1, &local).dot_splat(self.w);
+        (alpha, beta)
+    }
+
     /// The lanes whose ray [`Self::hit_distance`] finds a hit in (0, `t_max`),
     /// as [`Sphere::hits_lanes`] for spheres.
     #[inline]
@@ -103,10 +113,7 @@ impl Parallelogram {
             facing_away |= lanes::gt(denom, zero);
         }
         let t = Vec3x8::splat_sub(self.origin, &rays.origin).dot_splat(self.normal) / denom;
-        // ray.at(t) = o + t·d, then its edge coordinates α, β.
-        let local = (rays.origin + rays.direction.scale(t)).sub_splat(self.origin);
-        let alpha = local.cross_splat(self.edge2).dot_splat(self.w);
-        let beta = Vec3x8::splat_cross(self.edge1, &local).dot_splat(self.w);
+        let (alpha, beta) = self.coordinates_lanes(&rays.at(t));
         let within = |x: f32x8| x.simd_ge(zero) & x.simd_le(one);
         let hit = in_range(t, f32x8::splat(t_max)) & within(alpha) & within(beta) & !facing_away;
         (lanes::bits(hit), t)
@@ -145,15 +152,8 @@ impl Sphere {
         let mut u = [0.0; LANES];
         let mut v = [0.0; LANES];
         for k in (0..LANES).filter(|k| lanes >> k & 1 == 1) {
-            let theta = ny[k].clamp(-1.0, 1.0).acos();
-            let mut phi = (-nz[k]).atan2(nx[k]);
-            if phi < 0.0 {
-                phi += std::f32::consts::TAU;
-            }
-            (u[k], v[k]) = (
-                phi / std::f32::consts::TAU,
-                1.0 - theta / std::f32::consts::PI,
-            );
+            let (uv, _, _) = Sphere::uv_of_normal(Vec3::new(nx[k], ny[k], nz[k]));
+            (u[k], v[k]) = (uv.x, uv.y);
         }
         SurfaceLanes {
             point,
@@ -169,18 +169,10 @@ impl Parallelogram {
     /// derivatives (the edges, the same in every lane).
     #[inline]
     pub fn surface_points_lanes(&self, rays: &RayLanes, t: f32x8) -> SurfaceLanes {
-        let local = rays.at(t).sub_splat(self.origin);
-        let (zero, one) = (f32x8::ZERO, f32x8::ONE);
+        let (alpha, beta) = self.coordinates_lanes(&rays.at(t));
         // Vec2::clamp: max with the lower bound, then min with the upper.
-        let u = local
-            .cross_splat(self.edge2)
-            .dot_splat(self.w)
-            .max(zero)
-            .min(one);
-        let v = Vec3x8::splat_cross(self.edge1, &local)
-            .dot_splat(self.w)
-            .max(zero)
-            .min(one);
+        let (zero, one) = (f32x8::ZERO, f32x8::ONE);
+        let (u, v) = (alpha.max(zero).min(one), beta.max(zero).min(one));
         // origin + α·edge1 + β·edge2, as `point_at` rounds it.
         let point = Vec3x8::splat_add(self.origin, &Vec3x8::scaled_splat(self.edge1, u))
             + Vec3x8::scaled_splat(self.edge2, v);

@@ -93,23 +93,31 @@ impl Sphere {
         self.surface_frame(ray, t).0
     }
 
+    /// The uv of the point with unit normal `n`, with its polar angle θ (from
+    /// +y) and azimuth φ (from +x towards −z, in [0, 2π)).
+    #[inline]
+    pub(crate) fn uv_of_normal(n: Vec3) -> (Vec2, f32, f32) {
+        let theta = n.y.clamp(-1.0, 1.0).acos();
+        let mut phi = (-n.z).atan2(n.x);
+        if phi < 0.0 {
+            phi += TAU;
+        }
+        (Vec2::new(phi / TAU, 1.0 - theta / PI), theta, phi)
+    }
+
     /// The surface record at `t` without derivatives, and the hit's polar angle
     /// θ (from +y) and azimuth φ (from +x towards −z, in [0, 2π)).
     #[inline]
     fn surface_frame(&self, ray: &Ray, t: f32) -> (Hit, f32, f32) {
         let n = (ray.at(t) - self.center).normalize();
         let point = self.center + self.radius * n;
-        let theta = n.y.clamp(-1.0, 1.0).acos();
-        let mut phi = (-n.z).atan2(n.x);
-        if phi < 0.0 {
-            phi += TAU;
-        }
+        let (uv, theta, phi) = Self::uv_of_normal(n);
         let hit = Hit {
             t,
             point,
             geometric_normal: n,
             shading_normal: n,
-            uv: Vec2::new(phi / TAU, 1.0 - theta / PI),
+            uv,
             dpdu: Vec3::ZERO,
             dpdv: Vec3::ZERO,
             dndu: Vec3::ZERO,

@@ -2,7 +2,6 @@
 
 use super::pcg::{fill_uniform_pairs, Pcg32};
 use super::sobol::SobolPoints;
-use super::streams::uniform;
 use glam::Vec2;
 
 /// How N points are placed in [0, 1)².
@@ -70,7 +69,7 @@ impl SamplePattern {
                 None => panic!("grid pattern needs a square count, got {n}"),
             },
             Self::Stratified => match exact_sqrt(n) {
-                Some(k) => fill_grid(k, out, |_| uniform2(rng)),
+                Some(k) => fill_grid(k, out, |_| rng.uniform2()),
                 None => fill_latin_hypercube(rng, out),
             },
         }
@@ -95,7 +94,7 @@ fn fill_latin_hypercube(rng: &mut Pcg32, out: &mut [Vec2]) {
     let n = out.len();
     let scale = 1.0 / n as f32;
     for (i, p) in out.iter_mut().enumerate() {
-        let jitter = uniform2(rng);
+        let jitter = rng.uniform2();
         *p = ((Vec2::splat(i as f32) + jitter) * scale).min(Vec2::splat(ONE_MINUS_EPSILON));
     }
     // Fisher–Yates on the y coordinates pairs the columns with random rows.
@@ -109,12 +108,6 @@ fn fill_latin_hypercube(rng: &mut Pcg32, out: &mut [Vec2]) {
 
 /// The largest f32 below 1.
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
-
-#[inline]
-fn uniform2(rng: &mut Pcg32) -> Vec2 {
-    let x = uniform(rng);
-    Vec2::new(x, uniform(rng))
-}
 
 #[cfg(test)]
 mod tests {

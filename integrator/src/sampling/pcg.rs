@@ -1,7 +1,7 @@
 //! PCG32 (O'Neill, "PCG: A Family of Simple Fast Space-Efficient Statistically
 //! Good Algorithms for Random Number Generation", 2014): the 64-bit LCG
 //! `s ← a·s + c` with the XSH-RR output permutation, on Glint's one stream
-//! [`INCREMENT`]. One generator ([`Pcg32`]) or eight stepping in lanes
+//! [`STREAM`]. One generator ([`Pcg32`]) or eight stepping in lanes
 //! ([`Pcg32Lanes`]), each lane the scalar generator's numbers bit for bit.
 //!
 //! The numbers are those of `rand_pcg::Pcg32` (`Lcg64Xsh32`) seeded with
@@ -48,6 +48,18 @@ fn output(state: u64) -> u32 {
     xsh.rotate_right(rot)
 }
 
+/// The state `jump` (from [`jump`]) steps after `state`.
+#[inline(always)]
+fn jumped((a, c): (u64, u64), state: u64) -> u64 {
+    a.wrapping_mul(state).wrapping_add(c)
+}
+
+/// The first state of the generator seeded with `seed` (as `rand_pcg` seeds).
+#[inline(always)]
+fn seeded(seed: u64) -> u64 {
+    step(seed.wrapping_add(INCREMENT))
+}
+
 #[inline(always)]
 fn step(state: u64) -> u64 {
     state.wrapping_mul(MULTIPLIER).wrapping_add(INCREMENT)
@@ -70,7 +82,7 @@ impl Pcg32 {
     #[inline]
     pub fn new(seed: u64) -> Self {
         Self {
-            state: step(seed.wrapping_add(INCREMENT)),
+            state: seeded(seed),
         }
     }
 
@@ -88,11 +100,17 @@ impl Pcg32 {
         unit(self.next_u32())
     }
 
+    /// A point uniform in [0, 1)²: x from the next draw, then y.
+    #[inline]
+    pub fn uniform2(&mut self) -> glam::Vec2 {
+        let x = self.uniform();
+        glam::Vec2::new(x, self.uniform())
+    }
+
     /// Skips the next `delta` draws.
     #[inline]
     pub fn advance(&mut self, delta: u64) {
-        let (a, c) = jump(delta);
-        self.state = a.wrapping_mul(self.state).wrapping_add(c);
+        self.state = jumped(jump(delta), self.state);
     }
 }
 
@@ -122,7 +140,7 @@ impl Pcg32Lanes {
     #[inline]
     pub fn new(seeds: [u64; LANES]) -> Self {
         Self {
-            state: seeds.map(|s| step(s.wrapping_add(INCREMENT))),
+            state: seeds.map(seeded),
         }
     }
 
@@ -147,25 +165,19 @@ impl Pcg32Lanes {
 pub fn fill_uniform_pairs(rng: &mut Pcg32, out: &mut [glam::Vec2]) {
     let mut chunks = out.chunks_exact_mut(LANES);
     let mut lanes = Pcg32Lanes {
-        state: PAIR_LANES.map(|(a, c)| a.wrapping_mul(rng.state).wrapping_add(c)),
+        state: PAIR_LANES.map(|jump| jumped(jump, rng.state)),
     };
-    let (next_a, next_c) = NEXT_PAIRS;
     for chunk in &mut chunks {
         let x = lanes.uniform().to_array();
         let y = lanes.uniform().to_array();
         for (k, p) in chunk.iter_mut().enumerate() {
             *p = glam::Vec2::new(x[k], y[k]);
         }
-        lanes.state = lanes
-            .state
-            .map(|s| next_a.wrapping_mul(s).wrapping_add(next_c));
+        lanes.state = lanes.state.map(|s| jumped(NEXT_PAIRS, s));
     }
     let done = out.len() / LANES * LANES;
     rng.advance(2 * done as u64);
-    for p in &mut out[done..] {
-        let x = rng.uniform();
-        *p = glam::Vec2::new(x, rng.uniform());
-    }
+    out[done..].iter_mut().for_each(|p| *p = rng.uniform2());
 }
 
 #[cfg(test)]

@@ -19,7 +19,7 @@
 
 use crate::direct::{PairAllocation, SampleContext, ShadingPoint};
 use crate::light_samples::count_lanes;
-use crate::sampling::{stream_seed, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern};
+use crate::sampling::{pixel_key, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern};
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
@@ -101,7 +101,7 @@ impl DirectIntegrator {
             self.light_pattern,
             SamplePattern::Random | SamplePattern::Stratified
         )
-        .then(|| Pcg32Lanes::new(samples.map(|s| stream_seed(s.seed, s.pixel, s.sample))));
+        .then(|| Pcg32Lanes::for_streams(pixel_key(first.seed, first.pixel), first.sample));
         let mut pairs = PairAllocation::new(0);
         for (index, light) in scene.lights.iter().enumerate() {
             let Light::Area(area) = light else {
@@ -113,10 +113,7 @@ impl DirectIntegrator {
             };
             let pair = pairs.take(own, self.light_samples);
             let u = match &mut rngs {
-                Some(rngs) => {
-                    let x = rngs.uniform();
-                    (x, rngs.uniform())
-                }
+                Some(rngs) => rngs.uniform2(),
                 None => {
                     let u: [Vec2; LANES] = std::array::from_fn(|k| {
                         let mut u = [Vec2::ZERO];

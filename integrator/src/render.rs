@@ -391,20 +391,21 @@ fn render_rows(
 }
 
 /// The objects a camera ray through pixel `(x, y)` may hit
-/// ([`ShapeList::objects_in_cone`](glint_geometry::ShapeList::objects_in_cone)):
-/// those meeting the cone around the pixel's central ray through its four corners.
+/// ([`ShapeList::objects_in_frustum`](glint_geometry::ShapeList::objects_in_frustum)):
+/// those meeting the frustum of the rays through the pixel's four corners.
 fn objects_seen_by_pixel(scene: &Scene, x: u32, y: u32) -> u64 {
     let camera = &scene.camera;
     let (x, y) = (x as f32, y as f32);
-    let axis = camera.generate_ray(x + 0.5, y + 0.5);
-    let half_angle = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
-        .map(|(dx, dy)| camera.generate_ray(x + dx, y + dy).direction)
-        .map(|corner| axis.direction.dot(corner).clamp(-1.0, 1.0).acos())
-        .into_iter()
-        .fold(0.0, f32::max);
+    let corner = |dx: f32, dy: f32| camera.generate_ray(x + dx, y + dy);
+    let corners = [
+        corner(0.0, 0.0),
+        corner(1.0, 0.0),
+        corner(1.0, 1.0),
+        corner(0.0, 1.0),
+    ];
     scene
         .shapes
-        .objects_in_cone(axis.origin, axis.direction, half_angle)
+        .objects_in_frustum(corners[0].origin, corners.map(|c| c.direction))
 }
 
 /// Adds the first `used` of a chunk's radiance `values` to `sum`, leaving out

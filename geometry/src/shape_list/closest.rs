@@ -163,40 +163,10 @@ impl ShapeList {
         self.lanes_layout().is_some()
     }
 
-    fn lanes_layout(&self) -> Option<&LinearShapes> {
+    pub(super) fn lanes_layout(&self) -> Option<&LinearShapes> {
         self.linear
             .as_ref()
             .filter(|linear| linear.others.is_empty() && self.bvh.is_none())
-    }
-
-    /// The objects a ray from `apex` at most `half_angle` radians off the unit
-    /// `axis` may hit, as bits (object k as bit k; objects from 64 on always
-    /// count): those whose bounding sphere meets the cone, both widened well
-    /// past rounding error (a thousandth of a radian, a thousandth of the
-    /// radius, and 10⁻⁴ of the coordinates' size), so that no hit a ray's exact
-    /// test would find is left out. For [`ShapeList::closest_lanes_among`],
-    /// with the cone around the rays of one pixel. All objects without the
-    /// lanes layout.
-    pub fn objects_in_cone(&self, apex: Vec3, axis: Vec3, half_angle: f32) -> u64 {
-        let Some(linear) = self.lanes_layout() else {
-            return u64::MAX;
-        };
-        let mut bits = 0;
-        for (object, &(bounds, center, radius)) in linear.object_bounds.iter().enumerate().take(64)
-        {
-            if bounds.is_empty() {
-                continue;
-            }
-            let v = center - apex;
-            let distance = v.length();
-            let size = center.abs().max_element().max(apex.abs().max_element());
-            let r = radius * 1.001 + 1e-4 * size;
-            let off_axis = (axis.dot(v) / distance).clamp(-1.0, 1.0).acos();
-            let seen_within = (r / distance).min(1.0).asin();
-            let meets = !(distance > r && off_axis > half_angle + seen_within + 1e-3);
-            bits |= u64::from(meets) << object;
-        }
-        bits
     }
 
     /// [`ShapeList::closest_primitives_lanes`] with the answers left in lanes.
@@ -206,7 +176,7 @@ impl ShapeList {
 
     /// [`ShapeList::closest_lanes`] where the rays can only hit the objects of
     /// `candidates` (object k as bit k; objects from 64 on always tested), as
-    /// [`ShapeList::objects_in_cone`] finds them: the same answers.
+    /// [`ShapeList::objects_in_frustum`] finds them: the same answers.
     pub fn closest_lanes_among(
         &self,
         rays: &RayLanes,

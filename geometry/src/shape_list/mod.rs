@@ -5,6 +5,7 @@
 //!
 //! - `acceleration`: the BVH over the primitives, and its leaves' triangle packets.
 //! - `closest`: closest-hit queries (with the surface record, without, and batches).
+//! - `frustum`: the objects a pixel's camera rays may hit, for culling.
 //! - `any_hit`: shadow queries, one ray or a batch.
 //! - `linear`: the linear loop's layout, spheres and parallelograms in packets of four.
 //! - `occluders`: shadow rays towards an area light, testing only the shapes that may block them.
@@ -12,6 +13,7 @@
 mod acceleration;
 mod any_hit;
 mod closest;
+mod frustum;
 mod linear;
 mod occluders;
 

@@ -372,11 +372,12 @@ mod lanes {
     use crate::{Parallelogram, RayLanes};
 
     #[test]
-    fn rays_in_a_cone_find_their_hits_among_the_objects_the_cone_meets() {
-        // Narrow cones of eight rays (a pixel's) from random points, against
-        // random spheres and parallelograms, some tiny and some far: the
-        // objects the cone can meet hold every hit, and with them the hits
-        // are each ray's own.
+    fn rays_in_a_frustum_find_their_hits_among_the_objects_it_meets() {
+        // Narrow frusta of eight rays (a pixel's) from random points, against
+        // random spheres and parallelograms, some tiny and some far, some
+        // axis-aligned walls: the objects the frustum can meet hold every hit,
+        // and with them the hits are each ray's own. Rays on the frustum's
+        // edges and corners are included.
         let mut rng = XorShift(0x7a11_c0de_5eed_0001);
         let (mut hits, mut culled) = (0, 0);
         for scene in 0..80 {
@@ -387,6 +388,12 @@ mod lanes {
                 if k % 2 == 0 {
                     let r = (0.05 + rng.unit()) * scale;
                     list.push(Sphere::new(c, r).unwrap());
+                } else if k % 3 == 0 {
+                    // A wall in an axis plane, as a room's are.
+                    let (a, b) =
+                        [(Vec3::X, Vec3::Y), (Vec3::Y, Vec3::Z), (Vec3::Z, Vec3::X)][k % 9 / 3];
+                    let (e1, e2) = (a * 6.0 * scale, b * 5.0 * scale);
+                    list.push(Parallelogram::new(c, e1, e2, false).unwrap());
                 } else {
                     let (e1, e2) = (rng.vec3(-2.0, 2.0) * scale, rng.vec3(-2.0, 2.0) * scale);
                     list.push(Parallelogram::new(c, e1, e2, k % 4 == 1).unwrap());
@@ -396,17 +403,22 @@ mod lanes {
             for _ in 0..100 {
                 let apex = rng.vec3(-6.0, 6.0) * scale;
                 let axis = (rng.vec3(-4.0, 4.0) * scale - apex).normalize();
-                let half_angle = 0.002 + 0.05 * rng.unit();
-                // Rays within the cone: the axis tilted by less than half_angle.
-                let side = axis.any_orthonormal_vector();
-                let up = axis.cross(side);
-                let rays: [Ray; 8] = std::array::from_fn(|_| {
-                    let (tilt, turn) =
-                        (half_angle * rng.unit(), std::f32::consts::TAU * rng.unit());
-                    let d = axis * tilt.cos() + (side * turn.cos() + up * turn.sin()) * tilt.sin();
-                    Ray::new(apex, d)
+                let (side, up) = axis.any_orthonormal_pair();
+                let (a, b) = (0.002 + 0.05 * rng.unit(), 0.002 + 0.05 * rng.unit());
+                let direction = |u: f32, v: f32| {
+                    axis + side * (a * (2.0 * u - 1.0)) + up * (b * (2.0 * v - 1.0))
+                };
+                let corners =
+                    [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(u, v)| direction(u, v));
+                let rays: [Ray; 8] = std::array::from_fn(|k| {
+                    let (u, v) = match k {
+                        0 => (0.0, 0.0),
+                        1 => (1.0, rng.unit()),
+                        _ => (rng.unit(), rng.unit()),
+                    };
+                    Ray::new(apex, direction(u, v))
                 });
-                let candidates = list.objects_in_cone(apex, axis, half_angle);
+                let candidates = list.objects_in_frustum(apex, corners);
                 culled += 12 - candidates.count_ones().min(12);
                 let found = list
                     .closest_lanes_among(&RayLanes::new(rays), 8, candidates)
@@ -418,7 +430,74 @@ mod lanes {
             }
         }
         assert!(hits > 2000, "only {hits} hits");
-        assert!(culled > 40_000, "the cones leave out objects ({culled})");
+        assert!(culled > 40_000, "the frusta leave out objects ({culled})");
+    }
+
+    /// A sphere and an axis-aligned wall that reach only just inside a
+    /// frustum's side plane, mostly outside it, are kept: the ray along the
+    /// frustum's edge hits them both.
+    #[test]
+    fn objects_reaching_just_inside_a_side_plane_are_kept() {
+        let mut rng = XorShift(0x5eed_f00d_0bad_cafe);
+        for round in 0..300 {
+            let scale = [1.0, 1e-3, 1e3][round % 3];
+            let apex = rng.vec3(-6.0, 6.0) * scale;
+            let (a, b) = (0.002 + 0.05 * rng.unit(), 0.002 + 0.05 * rng.unit());
+            let direction =
+                |u: f32, v: f32| Vec3::new(a * (2.0 * u - 1.0), b * (2.0 * v - 1.0), -1.0);
+            let corners =
+                [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(u, v)| direction(u, v));
+            let edge = Ray::new(apex, direction(1.0, rng.unit()));
+            let t = (1.0 + 4.0 * rng.unit()) * scale;
+            let p = edge.at(t);
+            let mut list = ShapeList::new();
+            // The sphere's centre a little outside the plane: the edge ray passes inside its radius.
+            let r = 0.01 * t;
+            let outward = Vec3::new(1.0, 0.0, a).normalize();
+            list.push(Sphere::new(p + outward * (0.98 * r), r).unwrap());
+            // A wall across the edge at depth t, reaching 10⁻⁴·t inside the edge ray.
+            let wall_z = Vec3::new(0.0, 0.0, p.z - apex.z) + apex;
+            let origin = Vec3::new(p.x - 1e-4 * t, p.y - 0.1 * t, wall_z.z);
+            list.push(Parallelogram::new(origin, Vec3::X * t, Vec3::Y * 0.2 * t, false).unwrap());
+            list.build_acceleration();
+            let candidates = list.objects_in_frustum(apex, corners);
+            assert_eq!(candidates & 0b11, 0b11, "round {round}: {candidates:b}");
+            // Each alone is hit by the edge ray (so culling it would lose a hit).
+            for (object, alone) in [(0u32, 0b01u64), (1, 0b10)] {
+                let found = list
+                    .closest_lanes_among(&RayLanes::new([edge; 8]), 1, alone)
+                    .unwrap();
+                assert_eq!(
+                    found.hit(0).map(|h| h.object),
+                    Some(object),
+                    "round {round}"
+                );
+            }
+        }
+    }
+
+    /// The walls of a room seen from inside: a pixel's frustum meets the wall
+    /// it looks at, not the walls beside and behind it (which their bounding
+    /// spheres alone would not tell).
+    #[test]
+    fn a_pixel_looking_at_one_wall_culls_the_others() {
+        let mut list = ShapeList::new();
+        let wall = |o: [f32; 3], e1: Vec3, e2: Vec3| {
+            Parallelogram::new(Vec3::from(o), e1 * 20.0, e2 * 20.0, false).unwrap()
+        };
+        list.push(wall([-10.0, -10.0, -10.0], Vec3::X, Vec3::Y)); // back
+        list.push(wall([-10.0, -10.0, -10.0], Vec3::Z, Vec3::Y)); // left
+        list.push(wall([10.0, -10.0, -10.0], Vec3::Z, Vec3::Y)); // right
+        list.push(wall([-10.0, -10.0, -10.0], Vec3::X, Vec3::Z)); // floor
+        list.build_acceleration();
+        let d = 0.001;
+        let corners = [(-d, -d), (d, -d), (d, d), (-d, d)].map(|(x, y)| Vec3::new(x, y, -1.0));
+        assert_eq!(
+            list.objects_in_frustum(Vec3::new(0.0, 0.0, 5.0), corners),
+            0b0001
+        );
+        // Corners that span no frustum cull nothing.
+        assert_eq!(list.objects_in_frustum(Vec3::ZERO, [Vec3::Z; 4]), u64::MAX);
     }
 
     #[test]
@@ -465,7 +544,10 @@ mod lanes {
         let mut list = scene();
         list.build_acceleration();
         assert!(list.closest_primitives_lanes(&rays, 8).is_none());
-        assert_eq!(list.objects_in_cone(Vec3::ZERO, Vec3::X, 0.1), u64::MAX);
+        assert_eq!(
+            list.objects_in_frustum(Vec3::ZERO, [Vec3::X, Vec3::Y, -Vec3::X, -Vec3::Y]),
+            u64::MAX
+        );
         list.build_bvh();
         assert!(list.closest_primitives_lanes(&rays, 8).is_none());
     }

@@ -85,4 +85,4 @@ mod streams;
 pub use pattern::SamplePattern;
 pub use pcg::{Pcg32, Pcg32Lanes, STREAM};
 pub use sobol::{DimensionPair, SobolPoints, SobolSequence, MAX_JOINT};
-pub use streams::{mix64, pixel_rng, stream_seed, uniform, PixelSample, PIXEL_STREAM};
+pub use streams::{mix64, pixel_key, pixel_rng, stream_seed, uniform, PixelSample, PIXEL_STREAM};

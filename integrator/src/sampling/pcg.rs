@@ -11,6 +11,7 @@
 //! Arbitrary Strides", 1994), which is how eight lanes take consecutive draws
 //! of one stream.
 
+use super::streams::mix64;
 use glint_geometry::lanes::{f32x8, LANES};
 
 /// The LCG's multiplier (Knuth's MMIX constant, PCG's default).
@@ -137,7 +138,7 @@ pub struct Pcg32Lanes {
 
 impl Pcg32Lanes {
     /// Lane k seeded with `seeds[k]`, as [`Pcg32::new`].
-    #[inline]
+    #[inline(always)]
     pub fn new(seeds: [u64; LANES]) -> Self {
         Self {
             state: seeds.map(seeded),
@@ -145,7 +146,7 @@ impl Pcg32Lanes {
     }
 
     /// Each lane's next 32 random bits.
-    #[inline]
+    #[inline(always)]
     pub fn next_u32(&mut self) -> [u32; LANES] {
         let out = self.state.map(output);
         self.state = self.state.map(step);
@@ -153,11 +154,35 @@ impl Pcg32Lanes {
     }
 
     /// Each lane's next uniform f32 in [0, 1), as [`Pcg32::uniform`].
-    #[inline]
+    #[inline(always)]
     pub fn uniform(&mut self) -> f32x8 {
         f32x8::new(self.next_u32().map(unit))
     }
+
+    /// Each lane's next two uniforms, as [`Pcg32::uniform2`]: the second
+    /// draw's state and the state after both are each one multiply-add from
+    /// the current state (the second by a jump of two), not two in a row.
+    #[inline(always)]
+    pub fn uniform2(&mut self) -> (f32x8, f32x8) {
+        let first = self.state;
+        let second = first.map(step);
+        self.state = first.map(|s| jumped(TWO_DRAWS, s));
+        let uniforms = |states: [u64; LANES]| f32x8::new(states.map(|s| unit(output(s))));
+        (uniforms(first), uniforms(second))
+    }
+
+    /// The generators of `key`'s streams `first..first + LANES`, lane k seeded
+    /// with [`mix64`]`(key ^ (first + k))`: with a pixel's
+    /// [`pixel_key`](super::pixel_key), the streams of eight consecutive samples
+    /// as [`stream_seed`](super::stream_seed) names them.
+    #[inline(always)]
+    pub fn for_streams(key: u64, first: u64) -> Self {
+        Self::new(std::array::from_fn(|k| mix64(key ^ (first + k as u64))))
+    }
 }
+
+/// Two draws' step: the state after `uniform2`.
+const TWO_DRAWS: (u64, u64) = jump(2);
 
 /// Fills `out` with uniform points of `rng`, point i from draws 2i and 2i + 1
 /// (x, then y), and leaves `rng` past them: the same points and state as
@@ -168,8 +193,8 @@ pub fn fill_uniform_pairs(rng: &mut Pcg32, out: &mut [glam::Vec2]) {
         state: PAIR_LANES.map(|jump| jumped(jump, rng.state)),
     };
     for chunk in &mut chunks {
-        let x = lanes.uniform().to_array();
-        let y = lanes.uniform().to_array();
+        let (x, y) = lanes.uniform2();
+        let (x, y) = (x.to_array(), y.to_array());
         for (k, p) in chunk.iter_mut().enumerate() {
             *p = glam::Vec2::new(x[k], y[k]);
         }
@@ -214,10 +239,32 @@ mod tests {
         let seeds: [u64; LANES] = std::array::from_fn(|k| 0x9e37_79b9 * k as u64 + 5);
         let mut lanes = Pcg32Lanes::new(seeds);
         let mut scalars = seeds.map(Pcg32::new);
-        for _ in 0..100 {
-            let u = lanes.uniform().to_array();
-            for (k, rng) in scalars.iter_mut().enumerate() {
-                assert_eq!(u[k].to_bits(), rng.uniform().to_bits());
+        for round in 0..100 {
+            // One draw, then two at once: the pairs start at odd and even draws.
+            let u = if round % 3 == 0 {
+                vec![lanes.uniform()]
+            } else {
+                let (x, y) = lanes.uniform2();
+                vec![x, y]
+            };
+            for u in u {
+                for (k, rng) in scalars.iter_mut().enumerate() {
+                    assert_eq!(u.to_array()[k].to_bits(), rng.uniform().to_bits());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn lanes_for_streams_are_the_samples_streams() {
+        use crate::sampling::{pixel_key, stream_seed};
+        for (seed, pixel, first) in [(0, 0, 0), (7, 512 * 300 + 11, 24), (u64::MAX, 3, 56)] {
+            let mut lanes = Pcg32Lanes::for_streams(pixel_key(seed, pixel), first);
+            let (x, y) = lanes.uniform2();
+            for k in 0..LANES {
+                let mut rng = Pcg32::new(stream_seed(seed, pixel, first + k as u64));
+                assert_eq!(x.to_array()[k].to_bits(), rng.uniform().to_bits());
+                assert_eq!(y.to_array()[k].to_bits(), rng.uniform().to_bits());
             }
         }
     }

@@ -23,10 +23,18 @@ pub fn pixel_rng(seed: u64, pixel: u64, sample: u64) -> Pcg32 {
     Pcg32::new(stream_seed(seed, pixel, sample))
 }
 
-/// The seed of [`pixel_rng`]`(seed, pixel, sample)`.
+/// The seed of [`pixel_rng`]`(seed, pixel, sample)`: [`mix64`] of the
+/// sample index and the pixel's [`pixel_key`].
 #[inline]
 pub fn stream_seed(seed: u64, pixel: u64, sample: u64) -> u64 {
-    mix64(mix64(mix64(seed) ^ pixel) ^ sample)
+    mix64(pixel_key(seed, pixel) ^ sample)
+}
+
+/// The part of [`stream_seed`] that all of a pixel's streams share, to hash
+/// once per pixel.
+#[inline]
+pub fn pixel_key(seed: u64, pixel: u64) -> u64 {
+    mix64(mix64(seed) ^ pixel)
 }
 
 /// A uniform f32 in [0, 1) from the top 24 bits of one 32-bit draw.

@@ -76,6 +76,17 @@ impl Vec3x8 {
         }
     }
 
+    /// `self / s` for the same `s` in every lane, as `Vec3 / f32`.
+    #[inline]
+    pub fn div_splat(&self, s: f32) -> Self {
+        let s = f32x8::splat(s);
+        Self {
+            x: self.x / s,
+            y: self.y / s,
+            z: self.z / s,
+        }
+    }
+
     /// `s · v` per lane, as `f32 * Vec3`.
     #[inline]
     pub fn scaled_splat(v: Vec3, s: f32x8) -> Self {

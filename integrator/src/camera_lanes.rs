@@ -21,7 +21,7 @@ use crate::direct::{PairAllocation, SampleContext, ShadingPoint};
 use crate::light_samples::count_lanes;
 use crate::sampling::{pixel_key, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern};
 use crate::{DirectIntegrator, Scene, SurfaceKind};
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
 use glint_geometry::{
     offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayLanes, Shape, SurfaceLanes,
@@ -58,9 +58,9 @@ impl DirectIntegrator {
         used: usize,
         first: PixelSample,
         ctx: &mut SampleContext,
-    ) -> [Vec3; LANES] {
+    ) -> Vec3x8 {
         debug_assert!(self.shades_first_hits_in_lanes(scene));
-        let mut radiance = [Vec3::ZERO; LANES];
+        let mut radiance = Vec3x8::default();
         let mut shaded = ShadedLanes::default();
         let hit_lanes = closest.hits & ((1 << used) - 1);
         if !shaded.set_common(scene, rays, closest, hit_lanes, &mut radiance, ctx) {
@@ -71,7 +71,7 @@ impl DirectIntegrator {
                     continue;
                 };
                 match scene.surface_of(&hit) {
-                    SurfaceKind::Emitter(Light::Area(area)) => radiance[k] = area.color,
+                    SurfaceKind::Emitter(Light::Area(area)) => radiance.set_lane(k, area.color),
                     SurfaceKind::Emitter(_) => {}
                     SurfaceKind::Material(material) => {
                         if ctx.detailed {
@@ -80,7 +80,7 @@ impl DirectIntegrator {
                         let reflectances = material.reflectances_at(hit.uv);
                         let point =
                             ShadingPoint::with_reflectances(&hit, material, &ray, reflectances);
-                        radiance[k] = scene.ambient * point.kd;
+                        radiance.set_lane(k, scene.ambient * point.kd);
                         shaded.set(k, &point, material);
                     }
                 }
@@ -89,6 +89,7 @@ impl DirectIntegrator {
         if shaded.lanes == 0 {
             return radiance;
         }
+        let shaded_mask = lanes::from_bits(shaded.lanes);
         let samples: [PixelSample; LANES] = std::array::from_fn(|k| PixelSample {
             sample: first.sample + k as u64,
             ..first
@@ -128,21 +129,15 @@ impl DirectIntegrator {
             };
             ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
             let reflected = shaded.area_light(scene, area, u, ctx);
-            for (k, radiance) in radiance.iter_mut().enumerate() {
-                if shaded.lanes >> k & 1 == 1 {
-                    let sum = Vec3::ZERO + reflected[k];
-                    *radiance += area.color * sum / self.light_samples as f32;
-                }
-            }
+            // `li_at`'s `L · (0 + Σ reflected) / n` for its one sample.
+            let sum = Vec3x8::default() + reflected;
+            let term =
+                Vec3x8::scaled_splat_lanes(area.color, &sum).div_splat(self.light_samples as f32);
+            radiance = Vec3x8::select(shaded_mask, &(radiance + term), &radiance);
         }
-        for (k, radiance) in radiance.iter_mut().enumerate() {
-            if shaded.lanes >> k & 1 == 1 {
-                // `li_at` adds the absent environment and mirror terms, zeros: a
-                // −0 component becomes +0 there, so it must here too.
-                *radiance += Vec3::ZERO;
-            }
-        }
-        radiance
+        // `li_at` adds the absent environment and mirror terms, zeros: a −0
+        // component becomes +0 there, so it must here too.
+        Vec3x8::select(shaded_mask, &(radiance + Vec3x8::default()), &radiance)
     }
 }
 
@@ -181,7 +176,7 @@ impl<'a> ShadedLanes<'a> {
         rays: &RayLanes,
         closest: &ClosestLanes,
         hit_lanes: u32,
-        radiance: &mut [Vec3; LANES],
+        radiance: &mut Vec3x8,
         ctx: &mut SampleContext,
     ) -> bool {
         let Some(object) = closest.common_object(hit_lanes) else {
@@ -198,9 +193,8 @@ impl<'a> ShadedLanes<'a> {
             SurfaceKind::Material(material) => material,
             SurfaceKind::Emitter(light) => {
                 if let Light::Area(area) = light {
-                    for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
-                        radiance[k] = area.color;
-                    }
+                    let color = Vec3x8::splat(area.color);
+                    *radiance = Vec3x8::select(lanes::from_bits(hit_lanes), &color, radiance);
                 }
                 return true;
             }
@@ -217,9 +211,7 @@ impl<'a> ShadedLanes<'a> {
         self.phong
             .set_lanes(hit_lanes, material, &kd, &ks, &n, &v, specular);
         let ambient = Vec3x8::scaled_splat_lanes(scene.ambient, &kd);
-        for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
-            radiance[k] = ambient.lane(k);
-        }
+        *radiance = Vec3x8::select(lanes::from_bits(hit_lanes), &ambient, radiance);
         self.lanes = hit_lanes;
         self.point = surface.point;
         self.geometric_normal = surface.normal;
@@ -236,7 +228,7 @@ impl<'a> ShadedLanes<'a> {
         light: &AreaLight,
         (ux, uy): (f32x8, f32x8),
         ctx: &mut SampleContext,
-    ) -> [Vec3; LANES] {
+    ) -> Vec3x8 {
         let position = light.sample_points(ux, uy);
         let towards = position - self.point;
         let (l, normalized) = towards.try_normalize();
@@ -262,13 +254,7 @@ impl<'a> ShadedLanes<'a> {
             specular,
         );
         let visible = traced & !self.blocked(scene, &position, &towards, traced);
-        std::array::from_fn(|k| {
-            if visible >> k & 1 == 1 {
-                reflected.lane(k)
-            } else {
-                Vec3::ZERO
-            }
-        })
+        Vec3x8::select(lanes::from_bits(visible), &reflected, &Vec3x8::default())
     }
 
     /// The `traced` lanes whose shadow ray, from the point (offset to the side
@@ -324,6 +310,7 @@ mod tests {
     use super::*;
     use crate::{SceneBuilder, ShadingCounters};
     use glam::UVec2;
+    use glam::Vec3;
     use glint_camera::Camera;
     use glint_geometry::{Parallelogram, Ray, RayDifferential, Sphere};
     use glint_lighting::SpecularLobe;
@@ -494,11 +481,11 @@ mod tests {
                             &mut scalar,
                         );
                         assert_eq!(
-                            values[k].to_array().map(f32::to_bits),
+                            values.lane(k).to_array().map(f32::to_bits),
                             expected.to_array().map(f32::to_bits),
                             "{pattern:?}, pixel ({x}, {y}), sample {}: {} against {expected}",
                             first.sample + k as u64,
-                            values[k]
+                            values.lane(k)
                         );
                         compared += 1;
                     }

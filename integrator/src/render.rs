@@ -4,7 +4,7 @@ use crate::sampling::{pixel_rng, PixelSample, SamplePattern, SobolPoints, PIXEL_
 use crate::{Aov, DirectIntegrator, Scene};
 use glam::{Vec2, Vec3};
 use glint_camera::{Camera, Film};
-use glint_geometry::lanes::{f32x8, Vec3x8, LANES};
+use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
 use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential, RayLanes};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -334,7 +334,7 @@ fn render_rows(
                 let closest = closest.expect("has_closest_lanes");
                 let values =
                     integrator.li_first_hits(scene, &rays, &closest, used, first, &mut ctx);
-                accumulate(&mut sum, values, used, &mut ctx);
+                accumulate(&mut sum, &values, used, &mut ctx);
                 continue;
             }
             let rays: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
@@ -353,12 +353,12 @@ fn render_rows(
             let closest = (settings.aov.is_none() && used > 1)
                 .then(|| scene.shapes.closest_lanes(&ray_lanes, used))
                 .flatten();
-            let values: [Vec3; LANES] = match &closest {
+            let values = match &closest {
                 // One sample per light: the eight samples shaded together.
                 Some(closest) if first_hits_in_lanes => {
                     integrator.li_first_hits(scene, &ray_lanes, closest, used, first, &mut ctx)
                 }
-                _ => std::array::from_fn(|k| {
+                _ => Vec3x8::from_lanes(std::array::from_fn(|k| {
                     let Some((ray, diff)) = rays.get(k).filter(|_| k < used) else {
                         return Vec3::ZERO;
                     };
@@ -373,9 +373,9 @@ fn render_rows(
                         (None, None) => integrator.li(scene, ray, diff, 0, &mut ctx),
                         (Some(aov), _) => aov.evaluate(scene, ray, diff, settings.max_depth),
                     }
-                }),
+                })),
             };
-            accumulate(&mut sum, values, used, &mut ctx);
+            accumulate(&mut sum, &values, used, &mut ctx);
         }
         *radiance = sum / settings.spp as f32;
     }
@@ -411,10 +411,16 @@ fn objects_seen_by_pixel(scene: &Scene, x: u32, y: u32) -> u64 {
 /// Adds the first `used` of a chunk's radiance `values` to `sum`, leaving out
 /// (and counting) those that are NaN or infinite.
 #[inline]
-fn accumulate(sum: &mut Vec3, values: [Vec3; LANES], used: usize, ctx: &mut SampleContext) {
-    for value in values.into_iter().take(used) {
-        if value.is_finite() {
-            *sum += value;
+fn accumulate(sum: &mut Vec3, values: &Vec3x8, used: usize, ctx: &mut SampleContext) {
+    let finite = lanes::bits(values.x.is_finite() & values.y.is_finite() & values.z.is_finite());
+    let (x, y, z) = (
+        values.x.to_array(),
+        values.y.to_array(),
+        values.z.to_array(),
+    );
+    for k in 0..used {
+        if finite >> k & 1 == 1 {
+            *sum += Vec3::new(x[k], y[k], z[k]);
         } else {
             ctx.counters.nonfinite_samples += 1;
         }

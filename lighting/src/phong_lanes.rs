@@ -27,8 +27,11 @@ pub struct PhongLanes<'a> {
     specular: u32,
     /// Lanes whose lobe is a Phong lobe with an integral exponent, taken in lanes.
     lane_lobes: u32,
-    /// Each lane's exponent, where its lobe is taken in lanes.
-    exponents: [u32; LANES],
+    /// The exponents of the lobes taken in lanes, bit by bit: bit k of
+    /// `exponent_bits[b]` is bit b of lane k's exponent.
+    exponent_bits: [u32; 32],
+    /// The bits set in any lane's exponent (their top bit ends the squarings).
+    exponent_top: u32,
 }
 
 impl<'a> PhongLanes<'a> {
@@ -90,7 +93,17 @@ impl<'a> PhongLanes<'a> {
         };
         for k in (0..LANES).filter(|k| lanes >> k & 1 == 1) {
             self.materials[k] = Some(material);
-            self.exponents[k] = exponent;
+        }
+        self.set_exponent(lanes, exponent);
+    }
+
+    /// Gives the lanes `lanes` the lobe exponent `exponent`.
+    fn set_exponent(&mut self, lanes: u32, exponent: u32) {
+        self.exponent_top |= exponent;
+        let bits = 32 - self.exponent_top.leading_zeros() as usize;
+        for (b, lanes_with_bit) in self.exponent_bits.iter_mut().enumerate().take(bits) {
+            let with_bit = if exponent >> b & 1 == 1 { lanes } else { 0 };
+            *lanes_with_bit = (*lanes_with_bit & !lanes) | with_bit;
         }
     }
 
@@ -145,16 +158,12 @@ impl<'a> PhongLanes<'a> {
     /// result alone.
     #[inline]
     fn powers(&self, mut base: f32x8) -> f32x8 {
-        let top = self.exponents.iter().copied().max().unwrap_or(0);
-        let bit = |b: u32| {
-            lanes::from_bits((0..LANES).fold(0, |bits, k| bits | (self.exponents[k] >> b & 1) << k))
-        };
+        let bits = 32 - self.exponent_top.leading_zeros() as usize;
+        let bit = |b: usize| lanes::from_bits(self.exponent_bits[b]);
         let mut result = bit(0).select(base, f32x8::ONE);
-        let mut b = 1;
-        while top >> b != 0 {
+        for b in 1..bits {
             base = base * base;
             result = bit(b).select(result * base, result);
-            b += 1;
         }
         result
     }
@@ -172,7 +181,7 @@ mod tests {
         let exponents = [0u32, 1, 2, 3, 16, 22, 120, 1024];
         for (k, &e) in exponents.iter().enumerate() {
             lanes.set(k, &material, Vec3::ONE, Vec3::ONE, Vec3::Y, Vec3::Y, true);
-            lanes.exponents[k] = e;
+            lanes.set_exponent(1 << k, e);
         }
         for base in [0.0f32, 0.3, 0.5, 0.9, 0.99999, 1.0] {
             let out = lanes.powers(f32x8::splat(base)).to_array();

@@ -268,6 +268,35 @@ pub fn from_bits(bits: u32) -> f32x8 {
     bytemuck::cast(set)
 }
 
+/// The least of the lanes of `v` in `mask` that are not NaN (+∞ if none),
+/// compared in a tree of pairs rather than one after another.
+#[inline]
+pub fn min_lane(v: f32x8, mask: f32x8) -> f32 {
+    let v = (mask & !v.is_nan()).select(v, f32x8::splat(f32::INFINITY));
+    reduce_pairs(v.to_array(), |a, b| if b < a { b } else { a })
+}
+
+/// The greatest of the lanes of `v` in `mask` that are not NaN (−∞ if none),
+/// as [`min_lane`].
+#[inline]
+pub fn max_lane(v: f32x8, mask: f32x8) -> f32 {
+    let v = (mask & !v.is_nan()).select(v, f32x8::splat(f32::NEG_INFINITY));
+    reduce_pairs(v.to_array(), |a, b| if b > a { b } else { a })
+}
+
+/// `pick` folded over the lanes in halves: lane i with lane i + n/2, and so on.
+#[inline]
+fn reduce_pairs(mut lanes: [f32; LANES], pick: impl Fn(f32, f32) -> f32) -> f32 {
+    let mut n = LANES;
+    while n > 1 {
+        n /= 2;
+        for i in 0..n {
+            lanes[i] = pick(lanes[i], lanes[i + n]);
+        }
+    }
+    lanes[0]
+}
+
 /// The mask of the first `n` lanes.
 #[inline]
 pub fn first_lanes(n: usize) -> f32x8 {
@@ -281,6 +310,20 @@ mod tests {
 
     fn lanes(f: impl Fn(usize) -> Vec3) -> Vec3x8 {
         Vec3x8::from_lanes(std::array::from_fn(f))
+    }
+
+    #[test]
+    fn lane_extremes_skip_nan_and_masked_lanes() {
+        let v = f32x8::new([3.0, f32::NAN, -2.0, 7.0, -0.5, 9.0, f32::NAN, 1.0]);
+        let all = first_lanes(LANES);
+        assert_eq!((min_lane(v, all), max_lane(v, all)), (-2.0, 9.0));
+        let some = from_bits(0b1001_0011);
+        assert_eq!((min_lane(v, some), max_lane(v, some)), (-0.5, 3.0));
+        let nan = from_bits(0b0100_0010);
+        assert_eq!(
+            (min_lane(v, nan), max_lane(v, nan)),
+            (f32::INFINITY, f32::NEG_INFINITY)
+        );
     }
 
     #[test]

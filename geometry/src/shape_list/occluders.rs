@@ -239,12 +239,9 @@ fn segments_bounds(rays: &RayLanes, t_max: f32, active: u32) -> Bounds3 {
         // direction does not change.
         let e = e.is_nan().select(o, e);
         let (lo, hi) = (o.min(e), o.max(e));
-        let lo = mask.select(lo, f32x8::splat(f32::INFINITY)).to_array();
-        let hi = mask.select(hi, f32x8::splat(f32::NEG_INFINITY)).to_array();
-        // f32::min and max pass over NaN: a ray with a NaN coordinate hits
-        // nothing (every test compares false), so it needs no room.
-        let min = lo.iter().fold(f32::INFINITY, |m, &v| m.min(v));
-        let max = hi.iter().fold(f32::NEG_INFINITY, |m, &v| m.max(v));
+        // A ray with a NaN coordinate hits nothing (every test compares
+        // false), so it needs no room.
+        let (min, max) = (lanes::min_lane(lo, mask), lanes::max_lane(hi, mask));
         (min, max)
     };
     let (x, y, z) = (

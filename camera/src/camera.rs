@@ -1,7 +1,14 @@
 //! The pinhole camera of the course report (sections 2.1 and 2.2).
 
 use glam::{UVec2, Vec3};
-use wide::f32x8;
+
+/// The f32 lanes of [`Camera::generate_rays_lanes`]: the type, and so the
+/// number of lanes, of `glint_geometry::lanes::F32Lanes` (the integrator,
+/// which passes one to the other, would not compile otherwise).
+pub type F32Lanes = wide::f32x16;
+
+/// The number of lanes of [`F32Lanes`].
+pub const LANES: usize = 16;
 
 /// A ray leaving the camera: origin at the pinhole, unit-length direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -10,12 +17,12 @@ pub struct CameraRay {
     pub direction: Vec3,
 }
 
-/// Eight camera rays in SIMD lanes: the pinhole they share, and each lane's
+/// [`LANES`] camera rays in SIMD lanes: the pinhole they share, and each lane's
 /// unit direction by component (`direction[0]` the x components, and so on).
 #[derive(Clone, Copy, Debug)]
 pub struct CameraRayLanes {
     pub origin: Vec3,
-    pub direction: [f32x8; 3],
+    pub direction: [F32Lanes; 3],
 }
 
 /// A camera ray with the directions of the rays one pixel to the right (`dx`) and
@@ -130,25 +137,27 @@ impl Camera {
         }
     }
 
-    /// [`Self::generate_ray`] for eight raster positions `(x[k], y[k])` at
+    /// [`Self::generate_ray`] for [`LANES`] raster positions `(x[k], y[k])` at
     /// once, each lane's direction bit for bit the scalar one: the same
     /// operations in the same order, nothing fused.
     #[inline]
-    pub fn generate_rays_lanes(&self, x: f32x8, y: f32x8) -> CameraRayLanes {
-        let two = f32x8::splat(2.0);
-        let ndc_x = two * x / f32x8::splat(self.resolution.x as f32) - f32x8::ONE;
-        let ndc_y = f32x8::ONE - two * y / f32x8::splat(self.resolution.y as f32);
+    pub fn generate_rays_lanes(&self, x: F32Lanes, y: F32Lanes) -> CameraRayLanes {
+        let two = F32Lanes::splat(2.0);
+        let ndc_x = two * x / F32Lanes::splat(self.resolution.x as f32) - F32Lanes::ONE;
+        let ndc_y = F32Lanes::ONE - two * y / F32Lanes::splat(self.resolution.y as f32);
         let (a, b) = (
-            ndc_x * f32x8::splat(self.half_width),
-            ndc_y * f32x8::splat(self.half_height),
+            ndc_x * F32Lanes::splat(self.half_width),
+            ndc_y * F32Lanes::splat(self.half_height),
         );
         let on_film = |axis: usize| {
             let f = self.focal_length * self.forward[axis];
-            f32x8::splat(f) + a * f32x8::splat(self.right[axis]) + b * f32x8::splat(self.up[axis])
+            F32Lanes::splat(f)
+                + a * F32Lanes::splat(self.right[axis])
+                + b * F32Lanes::splat(self.up[axis])
         };
         let (dx, dy, dz) = (on_film(0), on_film(1), on_film(2));
         // Vec3::normalize: times 1/length, the length of (x·x + y·y) + z·z.
-        let rcp = f32x8::ONE / (dx * dx + dy * dy + dz * dz).sqrt();
+        let rcp = F32Lanes::ONE / (dx * dx + dy * dy + dz * dz).sqrt();
         CameraRayLanes {
             origin: self.position,
             direction: [dx * rcp, dy * rcp, dz * rcp],
@@ -347,10 +356,10 @@ mod tests {
             (seed >> 8) as f32 / (1 << 24) as f32 * scale
         };
         for _ in 0..500 {
-            let x: [f32; 8] = std::array::from_fn(|_| next(640.0));
-            let y: [f32; 8] = std::array::from_fn(|_| next(360.0));
-            let lanes = camera.generate_rays_lanes(f32x8::new(x), f32x8::new(y));
-            for k in 0..8 {
+            let x: [f32; LANES] = std::array::from_fn(|_| next(640.0));
+            let y: [f32; LANES] = std::array::from_fn(|_| next(360.0));
+            let lanes = camera.generate_rays_lanes(F32Lanes::new(x), F32Lanes::new(y));
+            for k in 0..LANES {
                 let scalar = camera.generate_ray(x[k], y[k]);
                 assert_eq!(lanes.origin, scalar.origin);
                 let d = lanes.direction.map(|c| c.to_array()[k].to_bits());

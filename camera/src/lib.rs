@@ -19,8 +19,8 @@
 //! # Entry points
 //! - [`Camera::new`], then [`Camera::generate_ray`] (a [`CameraRay`]) or
 //!   [`Camera::generate_ray_differential`] (a [`CameraRayDifferential`]) per raster
-//!   position, or [`Camera::generate_rays_lanes`] for eight positions at once in
-//!   SIMD lanes (`wide::f32x8`, each lane the scalar ray bit for bit);
+//!   position, or [`Camera::generate_rays_lanes`] for [`LANES`] positions at once
+//!   in SIMD lanes ([`F32Lanes`], each lane the scalar ray bit for bit);
 //!   [`Camera::with_resolution`] changes the film size and keeps the view.
 //! - [`Film::new`], [`Film::set_pixel`] or [`Film::pixels_mut`] to fill it, and
 //!   [`Film::save`], whose format ([`ImageFormat`]) follows the file extension;
@@ -35,7 +35,9 @@ mod camera;
 mod film;
 
 pub use atomic_file::write_atomically;
-pub use camera::{Camera, CameraError, CameraRay, CameraRayDifferential, CameraRayLanes};
+pub use camera::{
+    Camera, CameraError, CameraRay, CameraRayDifferential, CameraRayLanes, F32Lanes, LANES,
+};
 pub use film::{linear_to_srgb8, srgb_to_linear, Film, FilmError, ImageFormat, MAX_LOAD_SIDE};
 
 #[cfg(doctest)]

@@ -17,8 +17,8 @@
 //!   asked one at a time (`any_hit`), as one batch (`any_hits`), and, for the
 //!   Cornell list, the way the integrator asked from 4 light samples on
 //!   (`occluders_towards` once per shading point, then `any_hit_among`), and
-//!   for both, the way it asks now: a point's rays eight at a time in SIMD lanes
-//!   (`any_hits_among`, the BVH walked by the eight together).
+//!   for both, the way it asks now: a point's rays `LANES` at a time in SIMD lanes
+//!   (`any_hits_among`, the BVH walked by them together).
 //!
 //! Throughput is in rays; the time per ray is the iteration time / 256. See
 //! `docs/microbenchmarks.md`.
@@ -396,9 +396,9 @@ fn bench_shadows(
             })
         });
     }
-    // What the integrator does: each point's rays eight at a time in SIMD lanes,
+    // What the integrator does: each point's rays `LANES` at a time in SIMD lanes,
     // against the shapes its culling keeps (all of them beside a mesh's BVH,
-    // which the eight walk together).
+    // which they walk together).
     let corners = light.corners();
     let batches: Vec<(usize, RayLanes)> = (0..POINTS)
         .flat_map(|p| {

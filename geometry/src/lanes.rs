@@ -1,46 +1,57 @@
-//! Eight 3-vectors at once, in structure-of-arrays form ([`Vec3x8`]), for work
-//! that repeats the same arithmetic on many rays or samples (a shading point's
-//! light samples and their shadow rays).
+//! [`LANES`] 3-vectors at once, in structure-of-arrays form ([`Vec3Lanes`]),
+//! for work that repeats the same arithmetic on many rays or samples (a
+//! pixel's camera samples, a shading point's light samples, their shadow rays).
 //!
 //! Each lane performs exactly the IEEE operations of glam's scalar [`Vec3`]
 //! methods, in the same order: `a.dot(b)` is `(a.x·b.x + a.y·b.y) + a.z·b.z`,
 //! `a + s·b` rounds the product then the sum, and nothing is fused into a
 //! multiply-add. So a lane's result is bit for bit the scalar result, whatever
-//! instructions the CPU has (`wide` uses AVX when the build allows it, two SSE
-//! halves otherwise).
+//! instructions the CPU has and however many lanes there are.
+//!
+//! There are sixteen lanes: one AVX-512 register of f32 (`wide` uses two AVX
+//! halves, or four SSE quarters, where the build lacks it). Sixteen rendered
+//! the course's Cornell box at 64 × 1 samples about 20% faster than eight on
+//! an AVX-512 machine (docs/speed.md). The code depends on the width only
+//! through [`LANES`] and these aliases.
 
 use glam::Vec3;
-pub use wide::f32x8;
 
-/// The number of lanes.
-pub const LANES: usize = 8;
+/// [`LANES`] f32 lanes.
+pub type F32Lanes = wide::f32x16;
+/// [`LANES`] i32 lanes.
+pub type I32Lanes = wide::i32x16;
+/// [`LANES`] u32 lanes.
+pub type U32Lanes = wide::u32x16;
 
-/// Eight 3-vectors, one per lane.
+/// The number of lanes (at most 32: sets of lanes are `u32` bits).
+pub const LANES: usize = 16;
+
+/// [`LANES`] 3-vectors, one per lane.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Vec3x8 {
-    pub x: f32x8,
-    pub y: f32x8,
-    pub z: f32x8,
+pub struct Vec3Lanes {
+    pub x: F32Lanes,
+    pub y: F32Lanes,
+    pub z: F32Lanes,
 }
 
-impl Vec3x8 {
+impl Vec3Lanes {
     /// `v` in every lane.
     #[inline]
     pub fn splat(v: Vec3) -> Self {
         Self {
-            x: f32x8::splat(v.x),
-            y: f32x8::splat(v.y),
-            z: f32x8::splat(v.z),
+            x: F32Lanes::splat(v.x),
+            y: F32Lanes::splat(v.y),
+            z: F32Lanes::splat(v.z),
         }
     }
 
-    /// The eight vectors `v`, lane k holding `v[k]`.
+    /// The vectors `v`, lane k holding `v[k]`.
     #[inline]
     pub fn from_lanes(v: [Vec3; LANES]) -> Self {
         Self {
-            x: f32x8::new(v.map(|v| v.x)),
-            y: f32x8::new(v.map(|v| v.y)),
-            z: f32x8::new(v.map(|v| v.z)),
+            x: F32Lanes::new(v.map(|v| v.x)),
+            y: F32Lanes::new(v.map(|v| v.y)),
+            z: F32Lanes::new(v.map(|v| v.z)),
         }
     }
 
@@ -56,19 +67,21 @@ impl Vec3x8 {
 
     /// `self · other`, as [`Vec3::dot`] rounds it.
     #[inline]
-    pub fn dot(&self, other: &Self) -> f32x8 {
+    pub fn dot(&self, other: &Self) -> F32Lanes {
         self.x * other.x + self.y * other.y + self.z * other.z
     }
 
     /// `self · v` for the same `v` in every lane.
     #[inline]
-    pub fn dot_splat(&self, v: Vec3) -> f32x8 {
-        self.x * f32x8::splat(v.x) + self.y * f32x8::splat(v.y) + self.z * f32x8::splat(v.z)
+    pub fn dot_splat(&self, v: Vec3) -> F32Lanes {
+        self.x * F32Lanes::splat(v.x)
+            + self.y * F32Lanes::splat(v.y)
+            + self.z * F32Lanes::splat(v.z)
     }
 
     /// Each lane times its own scalar, as `Vec3 * f32`.
     #[inline]
-    pub fn scale(&self, s: f32x8) -> Self {
+    pub fn scale(&self, s: F32Lanes) -> Self {
         Self {
             x: self.x * s,
             y: self.y * s,
@@ -79,7 +92,7 @@ impl Vec3x8 {
     /// `self / s` for the same `s` in every lane, as `Vec3 / f32`.
     #[inline]
     pub fn div_splat(&self, s: f32) -> Self {
-        let s = f32x8::splat(s);
+        let s = F32Lanes::splat(s);
         Self {
             x: self.x / s,
             y: self.y / s,
@@ -89,11 +102,11 @@ impl Vec3x8 {
 
     /// `s · v` per lane, as `f32 * Vec3`.
     #[inline]
-    pub fn scaled_splat(v: Vec3, s: f32x8) -> Self {
+    pub fn scaled_splat(v: Vec3, s: F32Lanes) -> Self {
         Self {
-            x: f32x8::splat(v.x) * s,
-            y: f32x8::splat(v.y) * s,
-            z: f32x8::splat(v.z) * s,
+            x: F32Lanes::splat(v.x) * s,
+            y: F32Lanes::splat(v.y) * s,
+            z: F32Lanes::splat(v.z) * s,
         }
     }
 
@@ -101,9 +114,9 @@ impl Vec3x8 {
     #[inline]
     pub fn scaled_splat_lanes(v: Vec3, other: &Self) -> Self {
         Self {
-            x: f32x8::splat(v.x) * other.x,
-            y: f32x8::splat(v.y) * other.y,
-            z: f32x8::splat(v.z) * other.z,
+            x: F32Lanes::splat(v.x) * other.x,
+            y: F32Lanes::splat(v.y) * other.y,
+            z: F32Lanes::splat(v.z) * other.z,
         }
     }
 
@@ -111,9 +124,9 @@ impl Vec3x8 {
     #[inline]
     pub fn sub_splat(&self, v: Vec3) -> Self {
         Self {
-            x: self.x - f32x8::splat(v.x),
-            y: self.y - f32x8::splat(v.y),
-            z: self.z - f32x8::splat(v.z),
+            x: self.x - F32Lanes::splat(v.x),
+            y: self.y - F32Lanes::splat(v.y),
+            z: self.z - F32Lanes::splat(v.z),
         }
     }
 
@@ -121,16 +134,20 @@ impl Vec3x8 {
     #[inline]
     pub fn splat_sub(v: Vec3, other: &Self) -> Self {
         Self {
-            x: f32x8::splat(v.x) - other.x,
-            y: f32x8::splat(v.y) - other.y,
-            z: f32x8::splat(v.z) - other.z,
+            x: F32Lanes::splat(v.x) - other.x,
+            y: F32Lanes::splat(v.y) - other.y,
+            z: F32Lanes::splat(v.z) - other.z,
         }
     }
 
     /// `self × v` for the same `v` in every lane, as [`Vec3::cross`] rounds it.
     #[inline]
     pub fn cross_splat(&self, v: Vec3) -> Self {
-        let (x, y, z) = (f32x8::splat(v.x), f32x8::splat(v.y), f32x8::splat(v.z));
+        let (x, y, z) = (
+            F32Lanes::splat(v.x),
+            F32Lanes::splat(v.y),
+            F32Lanes::splat(v.z),
+        );
         Self {
             x: self.y * z - y * self.z,
             y: self.z * x - z * self.x,
@@ -141,7 +158,11 @@ impl Vec3x8 {
     /// `v × self` for the same `v` in every lane, as [`Vec3::cross`] rounds it.
     #[inline]
     pub fn splat_cross(v: Vec3, other: &Self) -> Self {
-        let (x, y, z) = (f32x8::splat(v.x), f32x8::splat(v.y), f32x8::splat(v.z));
+        let (x, y, z) = (
+            F32Lanes::splat(v.x),
+            F32Lanes::splat(v.y),
+            F32Lanes::splat(v.z),
+        );
         Self {
             x: y * other.z - other.y * z,
             y: z * other.x - other.z * x,
@@ -151,7 +172,7 @@ impl Vec3x8 {
 
     /// Per lane, `if_true` where `mask` is set, else `if_false`.
     #[inline]
-    pub fn select(mask: f32x8, if_true: &Self, if_false: &Self) -> Self {
+    pub fn select(mask: F32Lanes, if_true: &Self, if_false: &Self) -> Self {
         Self {
             x: mask.select(if_true.x, if_false.x),
             y: mask.select(if_true.y, if_false.y),
@@ -162,16 +183,16 @@ impl Vec3x8 {
     /// [`Vec3::try_normalize`] per lane: the unit vectors, and the mask of the
     /// lanes where it succeeds (`1/length` finite and positive).
     #[inline]
-    pub fn try_normalize(&self) -> (Self, f32x8) {
-        let rcp = f32x8::ONE / self.dot(self).sqrt();
-        let ok = rcp.is_finite() & rcp.simd_gt(f32x8::ZERO);
+    pub fn try_normalize(&self) -> (Self, F32Lanes) {
+        let rcp = F32Lanes::ONE / self.dot(self).sqrt();
+        let ok = rcp.is_finite() & rcp.simd_gt(F32Lanes::ZERO);
         (self.scale(rcp), ok)
     }
 
     /// [`Vec3::normalize`] per lane: `self · (1/length)`, rounded as glam rounds it.
     #[inline]
     pub fn normalize(&self) -> Self {
-        self.scale(f32x8::ONE / self.dot(self).sqrt())
+        self.scale(F32Lanes::ONE / self.dot(self).sqrt())
     }
 
     /// Sets lane `lane` to `v`.
@@ -186,20 +207,22 @@ impl Vec3x8 {
     #[inline]
     pub fn splat_add(v: Vec3, other: &Self) -> Self {
         Self {
-            x: f32x8::splat(v.x) + other.x,
-            y: f32x8::splat(v.y) + other.y,
-            z: f32x8::splat(v.z) + other.z,
+            x: F32Lanes::splat(v.x) + other.x,
+            y: F32Lanes::splat(v.y) + other.y,
+            z: F32Lanes::splat(v.z) + other.z,
         }
     }
 
     /// The lanes equal to zero in every component (as `Vec3 == Vec3::ZERO`).
     #[inline]
-    pub fn is_zero(&self) -> f32x8 {
-        self.x.simd_eq(f32x8::ZERO) & self.y.simd_eq(f32x8::ZERO) & self.z.simd_eq(f32x8::ZERO)
+    pub fn is_zero(&self) -> F32Lanes {
+        self.x.simd_eq(F32Lanes::ZERO)
+            & self.y.simd_eq(F32Lanes::ZERO)
+            & self.z.simd_eq(F32Lanes::ZERO)
     }
 }
 
-impl std::ops::Sub for Vec3x8 {
+impl std::ops::Sub for Vec3Lanes {
     type Output = Self;
     #[inline]
     fn sub(self, o: Self) -> Self {
@@ -211,7 +234,7 @@ impl std::ops::Sub for Vec3x8 {
     }
 }
 
-impl std::ops::Neg for Vec3x8 {
+impl std::ops::Neg for Vec3Lanes {
     type Output = Self;
     #[inline]
     fn neg(self) -> Self {
@@ -223,7 +246,7 @@ impl std::ops::Neg for Vec3x8 {
     }
 }
 
-impl std::ops::Add for Vec3x8 {
+impl std::ops::Add for Vec3Lanes {
     type Output = Self;
     #[inline]
     fn add(self, o: Self) -> Self {
@@ -237,50 +260,50 @@ impl std::ops::Add for Vec3x8 {
 
 /// `a > b` per lane.
 #[inline]
-pub fn gt(a: f32x8, b: f32x8) -> f32x8 {
+pub fn gt(a: F32Lanes, b: F32Lanes) -> F32Lanes {
     a.simd_gt(b)
 }
 
 /// `a < b` per lane.
 #[inline]
-pub fn lt(a: f32x8, b: f32x8) -> f32x8 {
+pub fn lt(a: F32Lanes, b: F32Lanes) -> F32Lanes {
     a.simd_lt(b)
 }
 
 /// `a <= b` per lane.
 #[inline]
-pub fn le(a: f32x8, b: f32x8) -> f32x8 {
+pub fn le(a: F32Lanes, b: F32Lanes) -> F32Lanes {
     a.simd_le(b)
 }
 
 /// The lanes of `mask` as bits, lane k as bit k.
 #[inline]
-pub fn bits(mask: f32x8) -> u32 {
+pub fn bits(mask: F32Lanes) -> u32 {
     mask.to_bitmask()
 }
 
 /// The mask of the lanes whose bit is set in `bits` (lane k as bit k): the
 /// inverse of [`bits`].
 #[inline]
-pub fn from_bits(bits: u32) -> f32x8 {
-    const BIT: wide::u32x8 = wide::u32x8::new([1, 2, 4, 8, 16, 32, 64, 128]);
-    let set = (wide::u32x8::splat(bits) & BIT).simd_eq(BIT);
+pub fn from_bits(bits: u32) -> F32Lanes {
+    let bit = U32Lanes::new(std::array::from_fn(|k| 1 << k));
+    let set = (U32Lanes::splat(bits) & bit).simd_eq(bit);
     bytemuck::cast(set)
 }
 
 /// The least of the lanes of `v` in `mask` that are not NaN (+∞ if none),
 /// compared in a tree of pairs rather than one after another.
 #[inline]
-pub fn min_lane(v: f32x8, mask: f32x8) -> f32 {
-    let v = (mask & !v.is_nan()).select(v, f32x8::splat(f32::INFINITY));
+pub fn min_lane(v: F32Lanes, mask: F32Lanes) -> f32 {
+    let v = (mask & !v.is_nan()).select(v, F32Lanes::splat(f32::INFINITY));
     reduce_pairs(v.to_array(), |a, b| if b < a { b } else { a })
 }
 
 /// The greatest of the lanes of `v` in `mask` that are not NaN (−∞ if none),
 /// as [`min_lane`].
 #[inline]
-pub fn max_lane(v: f32x8, mask: f32x8) -> f32 {
-    let v = (mask & !v.is_nan()).select(v, f32x8::splat(f32::NEG_INFINITY));
+pub fn max_lane(v: F32Lanes, mask: F32Lanes) -> f32 {
+    let v = (mask & !v.is_nan()).select(v, F32Lanes::splat(f32::NEG_INFINITY));
     reduce_pairs(v.to_array(), |a, b| if b > a { b } else { a })
 }
 
@@ -297,24 +320,33 @@ fn reduce_pairs(mut lanes: [f32; LANES], pick: impl Fn(f32, f32) -> f32) -> f32 
     lanes[0]
 }
 
+/// Every lane as bits: the low [`LANES`] bits set.
+#[inline]
+pub const fn all_bits() -> u32 {
+    u32::MAX >> (32 - LANES)
+}
+
 /// The mask of the first `n` lanes.
 #[inline]
-pub fn first_lanes(n: usize) -> f32x8 {
-    const INDEX: f32x8 = f32x8::new([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
-    INDEX.simd_lt(f32x8::splat(n as f32))
+pub fn first_lanes(n: usize) -> F32Lanes {
+    let index = F32Lanes::new(std::array::from_fn(|k| k as f32));
+    index.simd_lt(F32Lanes::splat(n as f32))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn lanes(f: impl Fn(usize) -> Vec3) -> Vec3x8 {
-        Vec3x8::from_lanes(std::array::from_fn(f))
+    fn lanes(f: impl Fn(usize) -> Vec3) -> Vec3Lanes {
+        Vec3Lanes::from_lanes(std::array::from_fn(f))
     }
 
     #[test]
     fn lane_extremes_skip_nan_and_masked_lanes() {
-        let v = f32x8::new([3.0, f32::NAN, -2.0, 7.0, -0.5, 9.0, f32::NAN, 1.0]);
+        let first = [3.0, f32::NAN, -2.0, 7.0, -0.5, 9.0, f32::NAN, 1.0];
+        let v = F32Lanes::new(std::array::from_fn(|k| {
+            first.get(k).copied().unwrap_or(f32::NAN)
+        }));
         let all = first_lanes(LANES);
         assert_eq!((min_lane(v, all), max_lane(v, all)), (-2.0, 9.0));
         let some = from_bits(0b1001_0011);
@@ -331,7 +363,7 @@ mod tests {
         for bits in 0..=255u32 {
             let mask = from_bits(bits);
             assert_eq!(super::bits(mask), bits);
-            let picked = mask.select(f32x8::ONE, f32x8::ZERO).to_array();
+            let picked = mask.select(F32Lanes::ONE, F32Lanes::ZERO).to_array();
             for (k, &p) in picked.iter().enumerate() {
                 assert_eq!(p, (bits >> k & 1) as f32, "bits {bits:#b}, lane {k}");
             }
@@ -353,7 +385,7 @@ mod tests {
     fn every_lane_is_the_scalar_result_bit_for_bit() {
         let a = lanes(|k| sample(k, 0.25));
         let b = lanes(|k| sample(k, 0.75));
-        let s = f32x8::new(std::array::from_fn(|k| sample(k, 0.5).z));
+        let s = F32Lanes::new(std::array::from_fn(|k| sample(k, 0.5).z));
         let (unit, ok) = a.try_normalize();
         let zero = (a - a).is_zero();
         for k in 0..LANES {
@@ -369,7 +401,7 @@ mod tests {
                 assert!(same((a + b).lane(k)[axis], (sa + sb)[axis]));
                 assert!(same(a.cross_splat(sb).lane(k)[axis], sa.cross(sb)[axis]));
                 assert!(same(
-                    Vec3x8::splat_cross(sb, &a).lane(k)[axis],
+                    Vec3Lanes::splat_cross(sb, &a).lane(k)[axis],
                     sb.cross(sa)[axis]
                 ));
             }
@@ -383,7 +415,7 @@ mod tests {
             if sa.length_squared() > 0.0 && sa.is_finite() {
                 assert_eq!(a.normalize().lane(k), sa.normalize(), "normalize, lane {k}");
             }
-            let mut set = Vec3x8::default();
+            let mut set = Vec3Lanes::default();
             set.set_lane(k, sb);
             assert_eq!(
                 set.lane(k).to_array().map(f32::to_bits),
@@ -391,13 +423,14 @@ mod tests {
             );
             for axis in 0..3 {
                 assert!(same(
-                    Vec3x8::splat_add(sb, &a).lane(k)[axis],
+                    Vec3Lanes::splat_add(sb, &a).lane(k)[axis],
                     (sb + sa)[axis]
                 ));
             }
             assert_eq!(bits(zero) >> k & 1 == 1, (sa - sa) == Vec3::ZERO);
         }
         assert_eq!(bits(first_lanes(3)), 0b111);
-        assert_eq!(bits(first_lanes(8)), 0xff);
+        assert_eq!(bits(first_lanes(LANES)), all_bits());
+        assert_eq!(all_bits().count_ones() as usize, LANES);
     }
 }

@@ -44,9 +44,9 @@
 //! - [`Hit::differentials`] turns a [`RayDifferential`] into the pixel's footprint
 //!   on the surface ([`SurfaceDifferentials`]); [`reflect_differential`] follows it
 //!   through a mirror.
-//! - [`lanes::Vec3x8`]: eight 3-vectors in SIMD lanes, each lane bit for bit the
+//! - [`lanes::Vec3Lanes`]: [`lanes::LANES`] (16) 3-vectors in SIMD lanes, each lane bit for bit the
 //!   scalar arithmetic, for shading a point's light samples together; their
-//!   shadow rays as [`RayLanes`], tested eight at a time against one shape
+//!   shadow rays as [`RayLanes`], tested 16 at a time against one shape
 //!   ([`Sphere::hits_lanes`]) by [`ShapeList::any_hits_among`].
 //! - [`bvh::Bvh`] on its own: a BVH over any primitives given by their bounds.
 

@@ -6,10 +6,10 @@
 //! of the point (its floating-point error grows the same way). Near the world origin,
 //! where ULPs become tiny, a small absolute offset takes over.
 
-use crate::lanes::{self, f32x8, Vec3x8};
+use crate::lanes::I32Lanes;
+use crate::lanes::{self, F32Lanes, Vec3Lanes};
 use crate::{Hit, Ray};
 use glam::Vec3;
-use wide::i32x8;
 
 const ORIGIN: f32 = 1.0 / 32.0;
 const FLOAT_SCALE: f32 = 1.0 / 65536.0;
@@ -35,21 +35,21 @@ pub fn offset_ray_origin(point: Vec3, normal: Vec3) -> Vec3 {
     Vec3::select(near_origin, point + FLOAT_SCALE * normal, p_int)
 }
 
-/// [`offset_ray_origin`] for eight points at once, each lane bit for bit the
+/// [`offset_ray_origin`] for [`LANES`](crate::lanes::LANES) points at once, each lane bit for bit the
 /// scalar origin (the same integer nudge of the bits, the same small absolute
 /// offset near the world origin).
 #[inline]
-pub fn offset_ray_origins(point: &Vec3x8, normal: &Vec3x8) -> Vec3x8 {
-    let axis = |p: f32x8, n: f32x8| {
+pub fn offset_ray_origins(point: &Vec3Lanes, normal: &Vec3Lanes) -> Vec3Lanes {
+    let axis = |p: F32Lanes, n: F32Lanes| {
         // `as i32` per lane: truncation, NaN to 0, saturating.
-        let o = (f32x8::splat(INT_SCALE) * n).trunc_int();
-        let negative: i32x8 = bytemuck::cast(lanes::lt(p, f32x8::ZERO));
+        let o = (F32Lanes::splat(INT_SCALE) * n).trunc_int();
+        let negative: I32Lanes = bytemuck::cast(lanes::lt(p, F32Lanes::ZERO));
         let o = negative.select(-o, o);
-        let p_int: f32x8 = bytemuck::cast(bytemuck::cast::<f32x8, i32x8>(p) + o);
-        let near_origin = lanes::lt(p.abs(), f32x8::splat(ORIGIN));
-        near_origin.select(p + f32x8::splat(FLOAT_SCALE) * n, p_int)
+        let p_int: F32Lanes = bytemuck::cast(bytemuck::cast::<F32Lanes, I32Lanes>(p) + o);
+        let near_origin = lanes::lt(p.abs(), F32Lanes::splat(ORIGIN));
+        near_origin.select(p + F32Lanes::splat(FLOAT_SCALE) * n, p_int)
     };
-    Vec3x8 {
+    Vec3Lanes {
         x: axis(point.x, normal.x),
         y: axis(point.y, normal.y),
         z: axis(point.z, normal.z),
@@ -82,9 +82,10 @@ pub fn spawn_ray_to(hit: &Hit, target: Vec3) -> (Ray, f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lanes::LANES;
 
     #[test]
-    fn eight_origins_are_the_scalar_origins_bit_for_bit() {
+    fn origins_in_lanes_are_the_scalar_origins_bit_for_bit() {
         // Coordinates of every size and sign, zeros of both signs, values at the
         // near-origin threshold, and normals along and across the axes.
         let values = [
@@ -112,13 +113,14 @@ mod tests {
         ];
         let mut compared = 0;
         for (i, _) in values.iter().enumerate() {
-            let points: [Vec3; 8] = std::array::from_fn(|k| {
+            let points: [Vec3; LANES] = std::array::from_fn(|k| {
                 let v = |j: usize| values[(i + j * 3 + k) % values.len()];
                 Vec3::new(v(0), v(1), v(2))
             });
-            let ns: [Vec3; 8] = std::array::from_fn(|k| normals[(i + k) % normals.len()]);
-            let lanes = offset_ray_origins(&Vec3x8::from_lanes(points), &Vec3x8::from_lanes(ns));
-            for k in 0..8 {
+            let ns: [Vec3; LANES] = std::array::from_fn(|k| normals[(i + k) % normals.len()]);
+            let lanes =
+                offset_ray_origins(&Vec3Lanes::from_lanes(points), &Vec3Lanes::from_lanes(ns));
+            for k in 0..LANES {
                 let scalar = offset_ray_origin(points[k], ns[k]);
                 assert_eq!(
                     lanes.lane(k).to_array().map(f32::to_bits),
@@ -130,7 +132,7 @@ mod tests {
                 compared += 1;
             }
         }
-        assert_eq!(compared, 8 * values.len());
+        assert_eq!(compared, LANES * values.len());
     }
 
     #[test]

@@ -1,13 +1,13 @@
-//! The first hits of eight camera samples shaded at once.
+//! The first hits of a pixel's camera samples shaded [`LANES`] at once.
 //!
 //! With one sample per area light per camera sample (`--light-samples 1`, the
 //! way Mitsuba's `direct` integrator is usually run), a shading point has no
 //! light samples for [`crate::light_samples`]' lanes to batch. The lanes are
-//! then the camera samples: the eight samples of a pixel that
+//! then the camera samples: the [`LANES`] samples of a pixel that
 //! [`glint_geometry::ShapeList::closest_primitives_lanes`] found the hits of
 //! together are shaded together too. Their light points, directions, Phong
 //! reflections ([`PhongLanes`], each lane with its own material) and
-//! horizon tests run in SIMD lanes, and their shadow rays, from eight origins,
+//! horizon tests run in SIMD lanes, and their shadow rays, from as many origins,
 //! are traced as one batch.
 //!
 //! This is only done where a scene needs nothing else at a first hit
@@ -22,7 +22,7 @@ use crate::light_samples::count_lanes;
 use crate::sampling::{pixel_key, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern};
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::Vec2;
-use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
+use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{
     offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayLanes, Shape, SurfaceLanes,
     SHADOW_EPSILON,
@@ -31,8 +31,8 @@ use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial};
 use glint_texture::{TexCoord, Texture};
 
 impl DirectIntegrator {
-    /// Whether the first hits of `scene`'s camera samples can be shaded eight at
-    /// a time ([`Self::li_first_hits`]): one sample per area light, only area
+    /// Whether the first hits of `scene`'s camera samples can be shaded [`LANES`] at
+    /// a time (`li_first_hits`): one sample per area light, only area
     /// lights, no environment, and materials without mirrors or texture
     /// footprints.
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
@@ -45,7 +45,7 @@ impl DirectIntegrator {
                 .all(|m| m.reflectivity == 0.0 && !m.uses_footprint())
     }
 
-    /// The radiance of the first `used` of eight camera samples of one pixel,
+    /// The radiance of the first `used` of [`LANES`] camera samples of one pixel,
     /// samples `first.sample..first.sample + used`, whose camera rays `rays`
     /// have the closest hits `closest`: for each, what [`Self::li_at`] gives it
     /// alone (with [`SampleContext::begin_sample`] for that sample), bit for bit.
@@ -58,9 +58,9 @@ impl DirectIntegrator {
         used: usize,
         first: PixelSample,
         ctx: &mut SampleContext,
-    ) -> Vec3x8 {
+    ) -> Vec3Lanes {
         debug_assert!(self.shades_first_hits_in_lanes(scene));
-        let mut radiance = Vec3x8::default();
+        let mut radiance = Vec3Lanes::default();
         let mut shaded = ShadedLanes::default();
         let hit_lanes = closest.hits & ((1 << used) - 1);
         if !shaded.set_common(scene, rays, closest, hit_lanes, &mut radiance, ctx) {
@@ -124,33 +124,33 @@ impl DirectIntegrator {
                         }
                         u[0]
                     });
-                    (f32x8::new(u.map(|u| u.x)), f32x8::new(u.map(|u| u.y)))
+                    (F32Lanes::new(u.map(|u| u.x)), F32Lanes::new(u.map(|u| u.y)))
                 }
             };
             ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
             let reflected = shaded.area_light(scene, area, u, ctx);
             // `li_at`'s `L · (0 + Σ reflected) / n` for its one sample.
-            let sum = Vec3x8::default() + reflected;
-            let term =
-                Vec3x8::scaled_splat_lanes(area.color, &sum).div_splat(self.light_samples as f32);
-            radiance = Vec3x8::select(shaded_mask, &(radiance + term), &radiance);
+            let sum = Vec3Lanes::default() + reflected;
+            let term = Vec3Lanes::scaled_splat_lanes(area.color, &sum)
+                .div_splat(self.light_samples as f32);
+            radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
         }
         // `li_at` adds the absent environment and mirror terms, zeros: a −0
         // component becomes +0 there, so it must here too.
-        Vec3x8::select(shaded_mask, &(radiance + Vec3x8::default()), &radiance)
+        Vec3Lanes::select(shaded_mask, &(radiance + Vec3Lanes::default()), &radiance)
     }
 }
 
-/// The shading points of up to eight lanes: all at once where the lanes hit
+/// The shading points of up to [`LANES`] lanes: all at once where the lanes hit
 /// one shape ([`ShadedLanes::set_common`]), else one by one ([`ShadedLanes::set`]).
 #[derive(Default)]
 struct ShadedLanes<'a> {
     /// The lanes holding a point (bit k for lane k).
     lanes: u32,
-    point: Vec3x8,
-    geometric_normal: Vec3x8,
+    point: Vec3Lanes,
+    geometric_normal: Vec3Lanes,
     /// The geometric normals on the viewer's side.
-    ng: Vec3x8,
+    ng: Vec3Lanes,
     phong: PhongLanes<'a>,
 }
 
@@ -176,7 +176,7 @@ impl<'a> ShadedLanes<'a> {
         rays: &RayLanes,
         closest: &ClosestLanes,
         hit_lanes: u32,
-        radiance: &mut Vec3x8,
+        radiance: &mut Vec3Lanes,
         ctx: &mut SampleContext,
     ) -> bool {
         let Some(object) = closest.common_object(hit_lanes) else {
@@ -193,8 +193,8 @@ impl<'a> ShadedLanes<'a> {
             SurfaceKind::Material(material) => material,
             SurfaceKind::Emitter(light) => {
                 if let Light::Area(area) = light {
-                    let color = Vec3x8::splat(area.color);
-                    *radiance = Vec3x8::select(lanes::from_bits(hit_lanes), &color, radiance);
+                    let color = Vec3Lanes::splat(area.color);
+                    *radiance = Vec3Lanes::select(lanes::from_bits(hit_lanes), &color, radiance);
                 }
                 return true;
             }
@@ -204,14 +204,14 @@ impl<'a> ShadedLanes<'a> {
         // geometric normal to its side, and the unit direction to the viewer.
         let d = &rays.direction;
         let g = &surface.normal;
-        let n = Vec3x8::select(lanes::gt(g.dot(d), f32x8::ZERO), &-*g, g);
-        let ng = Vec3x8::select(lanes::lt(g.dot(&n), f32x8::ZERO), &-*g, g);
+        let n = Vec3Lanes::select(lanes::gt(g.dot(d), F32Lanes::ZERO), &-*g, g);
+        let ng = Vec3Lanes::select(lanes::lt(g.dot(&n), F32Lanes::ZERO), &-*g, g);
         let v = -d.normalize();
         let specular = hit_lanes & !lanes::bits(ks.is_zero());
         self.phong
             .set_lanes(hit_lanes, material, &kd, &ks, &n, &v, specular);
-        let ambient = Vec3x8::scaled_splat_lanes(scene.ambient, &kd);
-        *radiance = Vec3x8::select(lanes::from_bits(hit_lanes), &ambient, radiance);
+        let ambient = Vec3Lanes::scaled_splat_lanes(scene.ambient, &kd);
+        *radiance = Vec3Lanes::select(lanes::from_bits(hit_lanes), &ambient, radiance);
         self.lanes = hit_lanes;
         self.point = surface.point;
         self.geometric_normal = surface.normal;
@@ -226,9 +226,9 @@ impl<'a> ShadedLanes<'a> {
         &self,
         scene: &Scene,
         light: &AreaLight,
-        (ux, uy): (f32x8, f32x8),
+        (ux, uy): (F32Lanes, F32Lanes),
         ctx: &mut SampleContext,
-    ) -> Vec3x8 {
+    ) -> Vec3Lanes {
         let position = light.sample_points(ux, uy);
         let towards = position - self.point;
         let (l, normalized) = towards.try_normalize();
@@ -237,10 +237,10 @@ impl<'a> ShadedLanes<'a> {
         let lit = self.lanes
             & lanes::bits(lanes::gt(
                 (self.point - position).dot_splat(normal),
-                f32x8::ZERO,
+                F32Lanes::ZERO,
             ));
         let normalized = lanes::bits(normalized);
-        let above = lanes::bits(lanes::gt(l.dot(&self.ng), f32x8::ZERO));
+        let above = lanes::bits(lanes::gt(l.dot(&self.ng), F32Lanes::ZERO));
         let shaded = lit & normalized & above;
         let traced = shaded & !lanes::bits(reflected.is_zero());
         let specular = self.phong.specular_lanes();
@@ -254,14 +254,21 @@ impl<'a> ShadedLanes<'a> {
             specular,
         );
         let visible = traced & !self.blocked(scene, &position, &towards, traced);
-        Vec3x8::select(lanes::from_bits(visible), &reflected, &Vec3x8::default())
+        Vec3Lanes::select(lanes::from_bits(visible), &reflected, &Vec3Lanes::default())
     }
 
     /// The `traced` lanes whose shadow ray, from the point (offset to the side
     /// `towards` leaves on) to `position`, is blocked.
-    fn blocked(&self, scene: &Scene, position: &Vec3x8, towards: &Vec3x8, traced: u32) -> u32 {
-        let from_back = lanes::lt(towards.dot(&self.geometric_normal), f32x8::ZERO);
-        let outgoing = Vec3x8::select(from_back, &-self.geometric_normal, &self.geometric_normal);
+    fn blocked(
+        &self,
+        scene: &Scene,
+        position: &Vec3Lanes,
+        towards: &Vec3Lanes,
+        traced: u32,
+    ) -> u32 {
+        let from_back = lanes::lt(towards.dot(&self.geometric_normal), F32Lanes::ZERO);
+        let outgoing =
+            Vec3Lanes::select(from_back, &-self.geometric_normal, &self.geometric_normal);
         let origin = offset_ray_origins(&self.point, &outgoing);
         let rays = RayLanes {
             origin,
@@ -281,7 +288,7 @@ fn reflectances_lanes(
     surface: &SurfaceLanes,
     hit_lanes: u32,
     ctx: &mut SampleContext,
-) -> (Vec3x8, Vec3x8) {
+) -> (Vec3Lanes, Vec3Lanes) {
     let (u, v) = (surface.u.to_array(), surface.v.to_array());
     let uv = |k: usize| Vec2::new(u[k], v[k]);
     if ctx.detailed {
@@ -291,10 +298,10 @@ fn reflectances_lanes(
     }
     let specular = material.specular.as_ref().map(Texture::as_constant);
     match (material.diffuse.as_constant(), specular) {
-        (Some(kd), None) => (Vec3x8::splat(kd), Vec3x8::splat(kd)),
-        (Some(kd), Some(Some(ks))) => (Vec3x8::splat(kd), Vec3x8::splat(ks)),
+        (Some(kd), None) => (Vec3Lanes::splat(kd), Vec3Lanes::splat(kd)),
+        (Some(kd), Some(Some(ks))) => (Vec3Lanes::splat(kd), Vec3Lanes::splat(ks)),
         _ => {
-            let (mut kd, mut ks) = (Vec3x8::default(), Vec3x8::default());
+            let (mut kd, mut ks) = (Vec3Lanes::default(), Vec3Lanes::default());
             for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
                 let (d, s) = material.reflectances_at(uv(k));
                 kd.set_lane(k, d);
@@ -414,7 +421,7 @@ mod tests {
         b.build(camera).unwrap()
     }
 
-    /// Every camera sample of every pixel, in chunks of eight (and of three
+    /// Every camera sample of every pixel, in chunks of [`LANES`] (and of three
     /// and one, partly filled): the lanes give each sample's `li_at` radiance
     /// and the shading counts bit for bit, for every light pattern.
     #[test]
@@ -441,9 +448,10 @@ mod tests {
             let mut compared = 0;
             for pixel in 0..(resolution.x * resolution.y) as u64 {
                 let (x, y) = (pixel % resolution.x as u64, pixel / resolution.x as u64);
-                for (chunk, used) in [(0u64, 8usize), (1, 3), (2, 1)] {
+                for (chunk, used) in [(0u64, LANES), (1, 3), (2, 1)] {
                     let rays: [Ray; LANES] = std::array::from_fn(|k| {
-                        let jitter = ((k as f32 + 0.5) / 8.0, ((k * 5 % 8) as f32 + 0.5) / 8.0);
+                        let n = LANES as f32;
+                        let jitter = ((k as f32 + 0.5) / n, ((k * 5 % LANES) as f32 + 0.5) / n);
                         let c = scene
                             .camera
                             .generate_ray(x as f32 + jitter.0, y as f32 + jitter.1);
@@ -496,7 +504,7 @@ mod tests {
                     total += scalar.counters;
                 }
             }
-            assert_eq!(compared, 12 * 10 * 12);
+            assert_eq!(compared, 12 * 10 * (LANES + 3 + 1));
         }
         // Both ways of gathering the points were taken, and lanes that all see a light.
         assert!(common.iter().all(|&n| n > 0), "{common:?}");

@@ -1,11 +1,11 @@
-//! A shading point's samples of one area light, shaded eight at a time.
+//! A shading point's samples of one area light, shaded [`LANES`] at a time.
 //!
 //! For N samples of an area light, the integrator sums, over the samples that
 //! face the point, the Phong reflection of each unoccluded one (report section
 //! 2.5). Sample by sample the work is a chain of dependent steps (the light
 //! point, the direction and its square root, the Phong lobe, the shadow ray's
 //! origin), each waiting on the last. [`ShadingPoint::area_light_sum`] runs the
-//! chain on eight samples at once in SIMD lanes ([`Vec3x8`]) and traces the
+//! chain on [`LANES`] samples at once in SIMD lanes ([`Vec3Lanes`]) and traces the
 //! shadow rays of the lanes that need one. Every lane does the scalar path's
 //! operations in its order, and the sum is taken sample by sample in the same
 //! order, so the result and the shading counts ([`crate::ShadingCounters`]) are
@@ -16,7 +16,7 @@
 use crate::direct::{SampleContext, ShadingPoint};
 use crate::{Scene, ShadingCounters};
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
+use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{offset_ray_origin, Occluders, RayLanes, SHADOW_EPSILON};
 use glint_lighting::AreaLight;
 
@@ -44,8 +44,8 @@ impl ShadingPoint<'_> {
         // A shadow ray leaves from the side of the surface its target is on: one of
         // two offset origins, the same for all of the point's samples.
         let origins = [
-            Vec3x8::splat(offset_ray_origin(point, normal)),
-            Vec3x8::splat(offset_ray_origin(point, -normal)),
+            Vec3Lanes::splat(offset_ray_origin(point, normal)),
+            Vec3Lanes::splat(offset_ray_origin(point, -normal)),
         ];
         let mut sum = Vec3::ZERO;
         for chunk in samples.chunks(LANES) {
@@ -63,12 +63,12 @@ impl ShadingPoint<'_> {
             );
             let used = lanes::bits(lanes::first_lanes(chunk.len()));
             let lit = used & lanes::bits(light.illuminates_lanes(&position, point));
-            let above = lanes::bits(lanes::gt(l.dot_splat(self.ng), f32x8::ZERO));
+            let above = lanes::bits(lanes::gt(l.dot_splat(self.ng), F32Lanes::ZERO));
             let shaded = lit & lanes::bits(normalized) & above;
             let traced = shaded & !lanes::bits(reflected.is_zero());
-            let from_back = lanes::lt(towards.dot_splat(normal), f32x8::ZERO);
+            let from_back = lanes::lt(towards.dot_splat(normal), F32Lanes::ZERO);
             self.count(ctx, used, lit, lanes::bits(normalized), shaded, traced);
-            let origin = Vec3x8::select(from_back, &origins[1], &origins[0]);
+            let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);
             let shadow_rays = RayLanes {
                 origin,
                 direction: position - origin,
@@ -158,11 +158,11 @@ pub(crate) fn count_lanes(
     counters.light_shadow_rays += ones(traced);
 }
 
-/// Up to eight sample coordinates as x and y lanes (unused lanes 0).
+/// Up to [`LANES`] sample coordinates as x and y lanes (unused lanes 0).
 #[inline]
-fn gather(chunk: &[Vec2]) -> (f32x8, f32x8) {
+fn gather(chunk: &[Vec2]) -> (F32Lanes, F32Lanes) {
     let coordinate = |axis: usize| {
-        f32x8::new(std::array::from_fn(|k| {
+        F32Lanes::new(std::array::from_fn(|k| {
             chunk.get(k).map_or(0.0, |u| u[axis])
         }))
     };

@@ -4,10 +4,13 @@ use crate::sampling::{pixel_rng, PixelSample, SamplePattern, SobolPoints, PIXEL_
 use crate::{Aov, DirectIntegrator, Scene};
 use glam::{Vec2, Vec3};
 use glint_camera::{Camera, Film};
-use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
+use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential, RayLanes};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
+
+// The camera's ray lanes are the geometry's lanes: one camera ray per lane.
+const _: () = assert!(glint_camera::LANES == LANES);
 use std::time::{Duration, Instant};
 
 /// Height in rows of the tiles (full-width bands) the image is split into for
@@ -313,18 +316,18 @@ fn render_rows(
                 sample: (chunk * LANES) as u64,
             };
             if all_in_lanes && used > 1 {
-                // Camera rays, closest hits and shading, eight samples at a time.
+                // Camera rays, closest hits and shading, LANES samples at a time.
                 let jitter = |axis: usize| {
-                    f32x8::new(std::array::from_fn(|k| jitters[k.min(used - 1)][axis]))
+                    F32Lanes::new(std::array::from_fn(|k| jitters[k.min(used - 1)][axis]))
                 };
                 let c = scene.camera.generate_rays_lanes(
-                    f32x8::splat(x as f32) + jitter(0),
-                    f32x8::splat(y as f32) + jitter(1),
+                    F32Lanes::splat(x as f32) + jitter(0),
+                    F32Lanes::splat(y as f32) + jitter(1),
                 );
                 let [dx, dy, dz] = c.direction;
                 let rays = RayLanes {
-                    origin: Vec3x8::splat(c.origin),
-                    direction: Vec3x8 {
+                    origin: Vec3Lanes::splat(c.origin),
+                    direction: Vec3Lanes {
                         x: dx,
                         y: dy,
                         z: dz,
@@ -354,11 +357,11 @@ fn render_rows(
                 .then(|| scene.shapes.closest_lanes(&ray_lanes, used))
                 .flatten();
             let values = match &closest {
-                // One sample per light: the eight samples shaded together.
+                // One sample per light: the chunk's samples shaded together.
                 Some(closest) if first_hits_in_lanes => {
                     integrator.li_first_hits(scene, &ray_lanes, closest, used, first, &mut ctx)
                 }
-                _ => Vec3x8::from_lanes(std::array::from_fn(|k| {
+                _ => Vec3Lanes::from_lanes(std::array::from_fn(|k| {
                     let Some((ray, diff)) = rays.get(k).filter(|_| k < used) else {
                         return Vec3::ZERO;
                     };
@@ -411,7 +414,7 @@ fn objects_seen_by_pixel(scene: &Scene, x: u32, y: u32) -> u64 {
 /// Adds the first `used` of a chunk's radiance `values` to `sum`, leaving out
 /// (and counting) those that are NaN or infinite.
 #[inline]
-fn accumulate(sum: &mut Vec3, values: &Vec3x8, used: usize, ctx: &mut SampleContext) {
+fn accumulate(sum: &mut Vec3, values: &Vec3Lanes, used: usize, ctx: &mut SampleContext) {
     let finite = lanes::bits(values.x.is_finite() & values.y.is_finite() & values.z.is_finite());
     let (x, y, z) = (
         values.x.to_array(),

@@ -1,5 +1,5 @@
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{self, f32x8, Vec3x8};
+use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes};
 use glint_geometry::Parallelogram;
 
 /// A rectangular (parallelogram) light of uniform color, emitting from its front side.
@@ -45,23 +45,23 @@ impl AreaLight {
         self.surface.normal().dot(receiver - light_point) > 0.0
     }
 
-    /// [`Self::sample_point`] for eight sample coordinates `(ux, uy)` at once,
+    /// [`Self::sample_point`] for [`LANES`](glint_geometry::lanes::LANES) sample coordinates `(ux, uy)` at once,
     /// each lane bit for bit the scalar point.
     #[inline]
-    pub fn sample_points(&self, ux: f32x8, uy: f32x8) -> Vec3x8 {
+    pub fn sample_points(&self, ux: F32Lanes, uy: F32Lanes) -> Vec3Lanes {
         let (e1, e2) = self.surface.edges();
         // origin + u.x·edge1 + u.y·edge2, rounded in that order.
-        Vec3x8::splat(self.surface.origin())
-            + Vec3x8::scaled_splat(e1, ux)
-            + Vec3x8::scaled_splat(e2, uy)
+        Vec3Lanes::splat(self.surface.origin())
+            + Vec3Lanes::scaled_splat(e1, ux)
+            + Vec3Lanes::scaled_splat(e2, uy)
     }
 
-    /// [`Self::illuminates`] for eight light points at once: the mask of the
+    /// [`Self::illuminates`] for [`LANES`](glint_geometry::lanes::LANES) light points at once: the mask of the
     /// lanes whose point shines on `receiver`.
     #[inline]
-    pub fn illuminates_lanes(&self, light_points: &Vec3x8, receiver: Vec3) -> f32x8 {
-        let towards = Vec3x8::splat_sub(receiver, light_points);
-        lanes::gt(towards.dot_splat(self.surface.normal()), f32x8::ZERO)
+    pub fn illuminates_lanes(&self, light_points: &Vec3Lanes, receiver: Vec3) -> F32Lanes {
+        let towards = Vec3Lanes::splat_sub(receiver, light_points);
+        lanes::gt(towards.dot_splat(self.surface.normal()), F32Lanes::ZERO)
     }
 }
 

@@ -14,7 +14,7 @@
 //!   [`PhongMaterial::reflectances`] gives `(kd, ks)` from the textures, then
 //!   [`PhongMaterial::reflect`] the reflection of one light and
 //!   [`PhongMaterial::brdf_cos`] the energy-normalised BRDF for the environment;
-//!   [`PhongLanes`] reflects one light sample at each of eight points at once.
+//!   [`PhongLanes`] reflects one light sample at each of 16 points at once.
 //! - [`PointLight`], [`AreaLight::new`] (sampled with [`AreaLight::sample_point`]),
 //!   both wrapped in [`Light`].
 //! - [`EnvironmentLight::new`], with [`EnvironmentLight::radiance`],

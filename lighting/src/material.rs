@@ -1,5 +1,5 @@
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{self, f32x8, Vec3x8};
+use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes};
 use glint_texture::{TexCoord, Texture};
 
 /// A per-material change of texture coordinates: `uv' = uv · scale + offset`
@@ -210,7 +210,7 @@ impl PhongMaterial {
     }
 
     /// [`Self::reflect`] (with `specular`) or [`Self::reflect_diffuse`] (without)
-    /// for eight light directions `l` at once, each lane bit for bit the scalar
+    /// for [`LANES`](glint_geometry::lanes::LANES) light directions `l` at once, each lane bit for bit the scalar
     /// value: the same operations in the same order, nothing fused.
     #[inline]
     pub fn reflect_lanes(
@@ -218,36 +218,36 @@ impl PhongMaterial {
         kd: Vec3,
         ks: Vec3,
         n: Vec3,
-        l: &Vec3x8,
+        l: &Vec3Lanes,
         v: Vec3,
         specular: bool,
-    ) -> Vec3x8 {
+    ) -> Vec3Lanes {
         let n_dot_l = l.dot_splat(n);
-        let diffuse = Vec3x8::scaled_splat(kd, n_dot_l);
+        let diffuse = Vec3Lanes::scaled_splat(kd, n_dot_l);
         let reflected = if specular {
-            diffuse + Vec3x8::scaled_splat(ks, self.specular_lobe_lanes(n, l, v, n_dot_l))
+            diffuse + Vec3Lanes::scaled_splat(ks, self.specular_lobe_lanes(n, l, v, n_dot_l))
         } else {
             diffuse
         };
         // `n·l ≤ 0` gives zero (a NaN goes on, as in the scalar test).
-        let behind = lanes::le(n_dot_l, f32x8::ZERO);
-        Vec3x8::select(behind, &Vec3x8::default(), &reflected)
+        let behind = lanes::le(n_dot_l, F32Lanes::ZERO);
+        Vec3Lanes::select(behind, &Vec3Lanes::default(), &reflected)
     }
 
-    /// [`Self::specular_lobe`] for eight directions at once.
+    /// [`Self::specular_lobe`] for [`LANES`](glint_geometry::lanes::LANES) directions at once.
     #[inline]
-    fn specular_lobe_lanes(&self, n: Vec3, l: &Vec3x8, v: Vec3, n_dot_l: f32x8) -> f32x8 {
+    fn specular_lobe_lanes(&self, n: Vec3, l: &Vec3Lanes, v: Vec3, n_dot_l: F32Lanes) -> F32Lanes {
         if self.lobe != SpecularLobe::Phong || !self.integral_exponent() {
             let n_dot_l = n_dot_l.as_array();
-            return f32x8::new(std::array::from_fn(|k| {
+            return F32Lanes::new(std::array::from_fn(|k| {
                 self.specular_lobe(n, l.lane(k), v, n_dot_l[k])
             }));
         }
         // (2·(n·l))·n − l, then its dot product with v.
-        let mirror = Vec3x8::scaled_splat(n, f32x8::splat(2.0) * n_dot_l) - *l;
+        let mirror = Vec3Lanes::scaled_splat(n, F32Lanes::splat(2.0) * n_dot_l) - *l;
         let cosine = mirror.dot_splat(v);
-        let lobe = powi(cosine, self.shininess as i32, f32x8::ONE);
-        lanes::le(cosine, f32x8::ZERO).select(f32x8::ZERO, lobe)
+        let lobe = powi(cosine, self.shininess as i32, F32Lanes::ONE);
+        lanes::le(cosine, F32Lanes::ZERO).select(F32Lanes::ZERO, lobe)
     }
 }
 
@@ -279,6 +279,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glint_geometry::lanes::LANES;
     use glint_snapfmt::vec3;
     use glint_texture::Checkerboard;
     use std::fmt::Write;
@@ -299,7 +300,7 @@ mod tests {
     }
 
     #[test]
-    fn eight_lanes_reflect_the_scalar_bits() {
+    fn lanes_reflect_the_scalar_bits() {
         let n = Vec3::new(0.2, 0.9, -0.1).normalize();
         let v = Vec3::new(-0.3, 0.8, 0.6).normalize();
         let (kd, ks) = (Vec3::new(0.7, 0.5, 0.2), Vec3::new(0.3, 0.3, 0.9));
@@ -308,7 +309,7 @@ mod tests {
             (0, 0) => Vec3::ZERO,
             (0, 1) => Vec3::new(f32::NAN, 1.0, 0.0),
             _ => {
-                let a = (k + 8 * batch) as f32 * 0.37 - 1.5;
+                let a = (k + LANES * batch) as f32 * 0.37 - 1.5;
                 Vec3::new(a.sin(), a.cos(), 0.3 * a).normalize()
             }
         };
@@ -319,11 +320,11 @@ mod tests {
                     ..PhongMaterial::new(kd, shininess)
                 };
                 for batch in 0..4 {
-                    let l: [Vec3; 8] = std::array::from_fn(|k| direction(k, batch));
-                    let lanes = Vec3x8 {
-                        x: f32x8::new(l.map(|l| l.x)),
-                        y: f32x8::new(l.map(|l| l.y)),
-                        z: f32x8::new(l.map(|l| l.z)),
+                    let l: [Vec3; LANES] = std::array::from_fn(|k| direction(k, batch));
+                    let lanes = Vec3Lanes {
+                        x: F32Lanes::new(l.map(|l| l.x)),
+                        y: F32Lanes::new(l.map(|l| l.y)),
+                        z: F32Lanes::new(l.map(|l| l.z)),
                     };
                     for specular in [true, false] {
                         let out = m.reflect_lanes(kd, ks, n, &lanes, v, specular);

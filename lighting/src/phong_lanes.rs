@@ -1,8 +1,8 @@
-//! The Phong reflection of eight shading points at once, each with its own
+//! The Phong reflection of [`LANES`] shading points at once, each with its own
 //! material, reflectances, normal and viewer: one light direction per lane.
 //!
-//! [`PhongMaterial::reflect_lanes`] shades eight light samples of *one* point;
-//! [`PhongLanes`] shades one light sample of each of eight points (eight camera
+//! [`PhongMaterial::reflect_lanes`] shades [`LANES`] light samples of *one* point;
+//! [`PhongLanes`] shades one light sample of each of [`LANES`] points (a pixel's camera
 //! samples' hits). Each lane is bit for bit what [`PhongMaterial::reflect`]
 //! (or [`PhongMaterial::reflect_diffuse`] where the lane has no specular term)
 //! gives for that point: the same operations in the same order, nothing fused.
@@ -12,17 +12,17 @@
 
 use crate::{PhongMaterial, SpecularLobe};
 use glam::Vec3;
-use glint_geometry::lanes::{self, f32x8, Vec3x8, LANES};
+use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 
-/// Eight shading points' Phong parameters, one per lane; lanes never set
+/// [`LANES`] shading points' Phong parameters, one per lane; lanes never set
 /// reflect nothing.
 #[derive(Clone, Debug, Default)]
 pub struct PhongLanes<'a> {
     materials: [Option<&'a PhongMaterial>; LANES],
-    kd: Vec3x8,
-    ks: Vec3x8,
-    n: Vec3x8,
-    v: Vec3x8,
+    kd: Vec3Lanes,
+    ks: Vec3Lanes,
+    n: Vec3Lanes,
+    v: Vec3Lanes,
     /// Lanes with a specular term (bit k for lane k).
     specular: u32,
     /// Lanes whose lobe is a Phong lobe with an integral exponent, taken in lanes.
@@ -65,17 +65,17 @@ impl<'a> PhongLanes<'a> {
         &mut self,
         lanes: u32,
         material: &'a PhongMaterial,
-        kd: &Vec3x8,
-        ks: &Vec3x8,
-        n: &Vec3x8,
-        v: &Vec3x8,
+        kd: &Vec3Lanes,
+        ks: &Vec3Lanes,
+        n: &Vec3Lanes,
+        v: &Vec3Lanes,
         specular: u32,
     ) {
         let mask = lanes::from_bits(lanes);
-        self.kd = Vec3x8::select(mask, kd, &self.kd);
-        self.ks = Vec3x8::select(mask, ks, &self.ks);
-        self.n = Vec3x8::select(mask, n, &self.n);
-        self.v = Vec3x8::select(mask, v, &self.v);
+        self.kd = Vec3Lanes::select(mask, kd, &self.kd);
+        self.ks = Vec3Lanes::select(mask, ks, &self.ks);
+        self.n = Vec3Lanes::select(mask, n, &self.n);
+        self.v = Vec3Lanes::select(mask, v, &self.v);
         self.set_material(lanes, material, specular & lanes);
     }
 
@@ -115,7 +115,7 @@ impl<'a> PhongLanes<'a> {
     /// Per lane, the fraction of a unit light from direction `l` reflected
     /// towards the lane's viewer: `kd · n·l + ks · lobe`, zero where `n·l ≤ 0`.
     #[inline]
-    pub fn reflect(&self, l: &Vec3x8) -> Vec3x8 {
+    pub fn reflect(&self, l: &Vec3Lanes) -> Vec3Lanes {
         let n = self.n;
         let n_dot_l = n.dot(l);
         let diffuse = self.kd.scale(n_dot_l);
@@ -124,20 +124,20 @@ impl<'a> PhongLanes<'a> {
         } else {
             let lobe = self.specular_lobe(&n, l, n_dot_l);
             let specular = diffuse + self.ks.scale(lobe);
-            Vec3x8::select(lanes::from_bits(self.specular), &specular, &diffuse)
+            Vec3Lanes::select(lanes::from_bits(self.specular), &specular, &diffuse)
         };
         // `n·l ≤ 0` gives zero (a NaN goes on, as in the scalar test).
-        let behind = lanes::le(n_dot_l, f32x8::ZERO);
-        Vec3x8::select(behind, &Vec3x8::default(), &reflected)
+        let behind = lanes::le(n_dot_l, F32Lanes::ZERO);
+        Vec3Lanes::select(behind, &Vec3Lanes::default(), &reflected)
     }
 
     /// [`PhongMaterial::specular_lobe`] per lane.
     #[inline]
-    fn specular_lobe(&self, n: &Vec3x8, l: &Vec3x8, n_dot_l: f32x8) -> f32x8 {
+    fn specular_lobe(&self, n: &Vec3Lanes, l: &Vec3Lanes, n_dot_l: F32Lanes) -> F32Lanes {
         // (2·(n·l))·n − l, then its dot product with v.
-        let mirror = n.scale(f32x8::splat(2.0) * n_dot_l) - *l;
+        let mirror = n.scale(F32Lanes::splat(2.0) * n_dot_l) - *l;
         let cosine = mirror.dot(&self.v);
-        let lobe = lanes::le(cosine, f32x8::ZERO).select(f32x8::ZERO, self.powers(cosine));
+        let lobe = lanes::le(cosine, F32Lanes::ZERO).select(F32Lanes::ZERO, self.powers(cosine));
         let one_by_one = self.specular & !self.lane_lobes;
         if one_by_one == 0 {
             return lobe;
@@ -149,7 +149,7 @@ impl<'a> PhongLanes<'a> {
                 *lobe = m.specular_lobe(self.n.lane(k), l.lane(k), self.v.lane(k), n_dot_l[k]);
             }
         }
-        f32x8::new(lobe)
+        F32Lanes::new(lobe)
     }
 
     /// `base^exponent` per lane by the binary exponentiation of [`powi`]: bit
@@ -157,10 +157,10 @@ impl<'a> PhongLanes<'a> {
     /// scalar loop's order; the squarings past a lane's top bit leave its
     /// result alone.
     #[inline]
-    fn powers(&self, mut base: f32x8) -> f32x8 {
+    fn powers(&self, mut base: F32Lanes) -> F32Lanes {
         let bits = 32 - self.exponent_top.leading_zeros() as usize;
         let bit = |b: usize| lanes::from_bits(self.exponent_bits[b]);
-        let mut result = bit(0).select(base, f32x8::ONE);
+        let mut result = bit(0).select(base, F32Lanes::ONE);
         for b in 1..bits {
             base = base * base;
             result = bit(b).select(result * base, result);
@@ -184,7 +184,7 @@ mod tests {
             lanes.set_exponent(1 << k, e);
         }
         for base in [0.0f32, 0.3, 0.5, 0.9, 0.99999, 1.0] {
-            let out = lanes.powers(f32x8::splat(base)).to_array();
+            let out = lanes.powers(F32Lanes::splat(base)).to_array();
             for (k, &e) in exponents.iter().enumerate() {
                 let expected = powi(base, e as i32, 1.0);
                 assert_eq!(out[k].to_bits(), expected.to_bits(), "{base}^{e}");
@@ -193,7 +193,7 @@ mod tests {
     }
 
     #[test]
-    fn eight_points_reflect_the_scalar_bits() {
+    fn points_in_lanes_reflect_the_scalar_bits() {
         let materials: Vec<PhongMaterial> = [1.0, 16.0, 22.0, 120.0, 7.5, 2000.0, 0.0, 40.0]
             .iter()
             .enumerate()
@@ -212,7 +212,7 @@ mod tests {
             let mut lanes = PhongLanes::default();
             let mut points = Vec::new();
             for k in 0..LANES {
-                let (m, g) = (&materials[(k + batch) % LANES], k as f32);
+                let (m, g) = (&materials[(k + batch) % materials.len()], k as f32);
                 let kd = Vec3::new(0.1 * g, 0.9 - 0.1 * g, 0.5);
                 let ks = if batch % 3 == 0 {
                     Vec3::ZERO
@@ -231,9 +231,9 @@ mod tests {
             let l: [Vec3; LANES] = std::array::from_fn(|k| match (batch, k) {
                 (0, 0) => Vec3::ZERO,
                 (1, 1) => Vec3::new(f32::NAN, 1.0, 0.0),
-                _ => unit(0.37 * (k + 8 * batch) as f32 - 1.5, 0.4 * f),
+                _ => unit(0.37 * (k + LANES * batch) as f32 - 1.5, 0.4 * f),
             });
-            let out = lanes.reflect(&Vec3x8::from_lanes(l));
+            let out = lanes.reflect(&Vec3Lanes::from_lanes(l));
             for (k, m, kd, ks, n, v, specular) in points {
                 let scalar = if specular {
                     m.reflect(kd, ks, n, l[k], v)
@@ -266,7 +266,7 @@ mod tests {
         let (lanes, specular) = (0b1011_0110, 0b0011_0100);
         let mut together = PhongLanes::default();
         together.set(0, &other, Vec3::ONE, Vec3::ONE, Vec3::Y, Vec3::Y, true);
-        let x = |a: [Vec3; LANES]| Vec3x8::from_lanes(a);
+        let x = |a: [Vec3; LANES]| Vec3Lanes::from_lanes(a);
         together.set_lanes(lanes, &shiny, &x(kd), &x(ks), &x(n), &x(v), specular | 1);
         let mut one_by_one = PhongLanes::default();
         one_by_one.set(0, &other, Vec3::ONE, Vec3::ONE, Vec3::Y, Vec3::Y, true);

@@ -1,7 +1,7 @@
-//! Eight shadow rays through the tree together ([`Bvh::any_hit_lanes`]): the
+//! [`LANES`] shadow rays through the tree together ([`Bvh::any_hit_lanes`]): the
 //! shadow rays of one shading point start at the same point and end on the same
 //! light, so they enter nearly the same nodes, and one walk of the tree with all
-//! eight in SIMD lanes replaces eight walks.
+//! them in SIMD lanes replaces as many walks.
 //!
 //! The node test is [`PreparedRay::enters`](super::prepared_ray) lane by lane:
 //! each (ray, child) pair performs its scalar operations in the same order, the
@@ -14,7 +14,7 @@ use super::bounds::EXIT_SCALE;
 use super::wide::{Link, WIDTH};
 use super::Bvh;
 use crate::counters::count;
-use crate::lanes::{f32x8, LANES};
+use crate::lanes::{self, F32Lanes, LANES};
 use crate::RayLanes;
 use std::cell::RefCell;
 
@@ -37,7 +37,7 @@ impl Bvh {
         mut blocked: impl FnMut(u32, u32, usize) -> bool,
     ) -> u32 {
         let finite = !(nan_lanes(rays));
-        let active = active & finite & ((1 << LANES) - 1);
+        let active = active & finite & lanes::all_bits();
         if active == 0 || self.is_empty() {
             return 0;
         }
@@ -87,30 +87,34 @@ impl Bvh {
 
 /// The lanes of `rays` with a NaN in the origin or direction.
 fn nan_lanes(rays: &RayLanes) -> u32 {
-    let nan = |v: f32x8| v.is_nan();
+    let nan = |v: F32Lanes| v.is_nan();
     let (o, d) = (&rays.origin, &rays.direction);
     (nan(o.x) | nan(o.y) | nan(o.z) | nan(d.x) | nan(d.y) | nan(d.z)).to_bitmask()
 }
 
-/// Eight rays set up for box tests, as [`PreparedRay`](super::prepared_ray) sets
+/// [`LANES`] rays set up for box tests, as [`PreparedRay`](super::prepared_ray) sets
 /// up one.
 struct PreparedLanes {
-    origin: [f32x8; 3],
-    inv_dir: [f32x8; 3],
+    origin: [F32Lanes; 3],
+    inv_dir: [F32Lanes; 3],
     /// Per axis, the lanes whose `1/d ≥ 0` meet the minimum plane first.
-    min_first: [f32x8; 3],
-    t_max: f32x8,
+    min_first: [F32Lanes; 3],
+    t_max: F32Lanes,
 }
 
 impl PreparedLanes {
     fn new(rays: &RayLanes, t_max: f32) -> Self {
         let (o, d) = (&rays.origin, &rays.direction);
-        let inv_dir = [f32x8::ONE / d.x, f32x8::ONE / d.y, f32x8::ONE / d.z];
+        let inv_dir = [
+            F32Lanes::ONE / d.x,
+            F32Lanes::ONE / d.y,
+            F32Lanes::ONE / d.z,
+        ];
         Self {
             origin: [o.x, o.y, o.z],
-            min_first: inv_dir.map(|inv| inv.simd_ge(f32x8::ZERO)),
+            min_first: inv_dir.map(|inv| inv.simd_ge(F32Lanes::ZERO)),
             inv_dir,
-            t_max: f32x8::splat(t_max),
+            t_max: F32Lanes::splat(t_max),
         }
     }
 
@@ -119,11 +123,11 @@ impl PreparedLanes {
     /// `t_max`: the scalar test's verdict in each lane.
     #[inline]
     fn enter_child(&self, planes: &[glam::Vec4; 6], child: usize) -> u32 {
-        let mut enter = f32x8::ZERO;
+        let mut enter = F32Lanes::ZERO;
         let mut exit = self.t_max;
         for axis in 0..3 {
-            let lo = f32x8::splat(planes[axis][child]);
-            let hi = f32x8::splat(planes[axis + 3][child]);
+            let lo = F32Lanes::splat(planes[axis][child]);
+            let hi = F32Lanes::splat(planes[axis + 3][child]);
             let near_plane = self.min_first[axis].select(lo, hi);
             let far_plane = self.min_first[axis].select(hi, lo);
             let near = (near_plane - self.origin[axis]) * self.inv_dir[axis];
@@ -133,7 +137,7 @@ impl PreparedLanes {
             enter = near.simd_gt(enter).select(near, enter);
             exit = far.simd_lt(exit).select(far, exit);
         }
-        let hit = enter.simd_le(exit * f32x8::splat(EXIT_SCALE)) & enter.simd_lt(self.t_max);
+        let hit = enter.simd_le(exit * F32Lanes::splat(EXIT_SCALE)) & enter.simd_lt(self.t_max);
         hit.to_bitmask()
     }
 }

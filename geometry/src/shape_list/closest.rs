@@ -6,14 +6,14 @@
 use super::{LinearShapes, Object, ObjectRef, Primitive, ShapeList};
 use crate::bvh::RayStream;
 use crate::counters::count;
-use crate::lanes::{self, f32x8, LANES};
+use crate::lanes::I32Lanes;
+use crate::lanes::{self, F32Lanes, LANES};
 use crate::prefetch::prefetch;
 use crate::triangle::WatertightRay;
 use crate::{Hit, Ray};
 use crate::{RayLanes, Shape};
 use glam::{Vec3, Vec4};
 use std::ops::ControlFlow;
-use wide::i32x8;
 
 /// A candidate for the closest hit: a primitive, or a position in the BVH's leaf
 /// order, looked up only when needed.
@@ -34,13 +34,13 @@ pub struct PrimitiveHit {
     pub primitive: u32,
 }
 
-/// The closest hits of eight rays, in lanes ([`ShapeList::closest_lanes`]).
+/// The closest hits of [`LANES`] rays, in lanes ([`ShapeList::closest_lanes`]).
 #[derive(Clone, Copy, Debug)]
 pub struct ClosestLanes {
     /// The lanes whose ray hits something (bit k for lane k).
     pub hits: u32,
     /// Each hit lane's distance, as [`PrimitiveHit::t`].
-    pub t: f32x8,
+    pub t: F32Lanes,
     /// Each hit lane's object, as [`PrimitiveHit::object`] (shapes only: the
     /// primitive is 0).
     pub object: [u32; LANES],
@@ -142,7 +142,7 @@ impl ShapeList {
     }
 
     /// [`ShapeList::closest_primitive`] without an upper limit for each of the
-    /// eight rays of `rays`, one shape against the eight rays at a time: the same
+    /// `LANES` rays of `rays`, one shape against all the rays at a time: the same
     /// answers. The first `used` lanes hold real rays (the others are counted
     /// by no `--stats` test, and their answers are to be ignored). `None` unless
     /// the list is the linear loop with every object in its packets (spheres and
@@ -186,8 +186,8 @@ impl ShapeList {
         let tested = used.min(LANES) as u64;
         let linear = self.lanes_layout()?;
         // The nearest so far per lane, and its object (i32::MAX: none yet).
-        let mut best_t = f32x8::splat(f32::INFINITY);
-        let mut best_object = i32x8::splat(i32::MAX);
+        let mut best_t = F32Lanes::splat(f32::INFINITY);
+        let mut best_object = I32Lanes::splat(i32::MAX);
         let spheres = linear.spheres.iter().map(|(_, objects)| objects);
         let parallelograms = linear.parallelograms.iter().map(|(_, objects)| objects);
         let used = spheres
@@ -210,16 +210,16 @@ impl ShapeList {
                 continue;
             }
             // The rule of `ClosestSearch::consider`: nearer, or as near and lower.
-            let o = i32x8::splat(object as i32);
-            let lower: f32x8 = bytemuck::cast(o.simd_lt(best_object));
+            let o = I32Lanes::splat(object as i32);
+            let lower: F32Lanes = bytemuck::cast(o.simd_lt(best_object));
             let nearer = lanes::lt(t, best_t) | (t.simd_eq(best_t) & lower);
             let take = lanes::from_bits(hits) & nearer;
             best_t = take.select(t, best_t);
-            best_object = bytemuck::cast::<f32x8, i32x8>(take).select(o, best_object);
+            best_object = bytemuck::cast::<F32Lanes, I32Lanes>(take).select(o, best_object);
         }
-        let none: f32x8 = bytemuck::cast(best_object.simd_eq(i32x8::splat(i32::MAX)));
+        let none: F32Lanes = bytemuck::cast(best_object.simd_eq(I32Lanes::splat(i32::MAX)));
         Some(ClosestLanes {
-            hits: !lanes::bits(none) & 0xff,
+            hits: !lanes::bits(none) & lanes::all_bits(),
             t: best_t,
             object: bytemuck::cast(best_object),
         })

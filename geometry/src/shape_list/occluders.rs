@@ -14,7 +14,7 @@
 use super::{ObjectRef, ShapeList};
 use crate::bvh::Bounds3;
 use crate::counters::count;
-use crate::lanes::{self, f32x8, LANES};
+use crate::lanes::{self, F32Lanes, LANES};
 use crate::triangle::WatertightRay;
 use crate::{Ray, RayLanes, Shape};
 use glam::{Vec3, Vec4};
@@ -141,7 +141,7 @@ impl ShapeList {
     /// whose ray is blocked. Each lane's answer is the one its ray gets alone.
     /// (The `--stats` counts differ: a kept shape counts one test per active
     /// ray, and BVH nodes and leaves count once per ray that reaches them.)
-    /// One shape is tested against all eight rays at once
+    /// One shape is tested against all the rays at once
     /// ([`Sphere::hits_lanes`](crate::Sphere::hits_lanes)), which pays for the
     /// shadow rays of one point, all meeting the same few shapes.
     pub fn any_hits_among(
@@ -160,7 +160,7 @@ impl ShapeList {
         };
         let tested = u64::from(active.count_ones());
         let mut blocked = 0;
-        // Rays from eight points, not culled for one point (`Occluders::ALL`):
+        // Rays from several points, not culled for one point (`Occluders::ALL`):
         // only the shapes near their segments. After a point's own culling
         // this would cost more than it saves.
         let reach = (occluders.lanes == u64::MAX).then(|| segments_bounds(rays, t_max, active));
@@ -232,9 +232,9 @@ impl ShapeList {
 /// where one of those rays can hit a shape with `0 < t < t_max`, with room
 /// to spare for rounding.
 fn segments_bounds(rays: &RayLanes, t_max: f32, active: u32) -> Bounds3 {
-    let ends = rays.at(f32x8::splat(t_max));
+    let ends = rays.at(F32Lanes::splat(t_max));
     let mask = lanes::from_bits(active);
-    let axis = |o: f32x8, e: f32x8| {
+    let axis = |o: F32Lanes, e: F32Lanes| {
         // 0·∞ = NaN: with t_max infinite, a ray keeps a coordinate its
         // direction does not change.
         let e = e.is_nan().select(o, e);

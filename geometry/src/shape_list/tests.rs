@@ -2,6 +2,7 @@
 //! the linear loop and batches of rays.
 
 use super::*;
+use crate::lanes::LANES;
 use crate::{Plane, Sphere};
 use glam::Vec3;
 
@@ -109,12 +110,12 @@ mod bvh_agreement {
 
     #[test]
     fn shadow_rays_among_culled_occluders_get_the_full_answer_beside_a_bvh() {
-        // Eight shadow rays from one point to a quad, traced in lanes (the BVH
-        // walked by all eight at once) and one by one, in every layout: packets
+        // A lane's worth of shadow rays from one point to a quad, traced in lanes (the BVH
+        // walked by all of them at once) and one by one, in every layout: packets
         // beside a BVH, a BVH alone, the linear loop with objects outside its
         // packets, and no acceleration built. Some rays run parallel to an axis,
         // one is NaN, one lane is inactive, and in odd rounds the rays start at
-        // eight different points.
+        // as many different points.
         let mut rng = Rng(0x51_7cc1_b727_220a);
         let mut blocked = 0;
         for scene in 0..40 {
@@ -140,7 +141,7 @@ mod bvh_agreement {
                 let from = rng.in_cube(6.0);
                 let (corner, e1, e2) = (rng.in_cube(5.0), rng.in_cube(2.0), rng.in_cube(2.0));
                 let corners = [corner, corner + e1, corner + e1 + e2, corner + e2];
-                let mut targets: [Vec3; 8] =
+                let mut targets: [Vec3; LANES] =
                     std::array::from_fn(|_| corner + rng.next() * e1 + rng.next() * e2);
                 // Odd rounds: no culling, and targets off the quad.
                 let occluders = if round % 2 == 0 {
@@ -153,7 +154,7 @@ mod bvh_agreement {
                     }
                     Occluders::ALL
                 };
-                let rays: [Ray; 8] = std::array::from_fn(|k| {
+                let rays: [Ray; LANES] = std::array::from_fn(|k| {
                     let origin = if round % 2 == 0 {
                         from
                     } else {
@@ -373,7 +374,7 @@ mod lanes {
 
     #[test]
     fn rays_in_a_frustum_find_their_hits_among_the_objects_it_meets() {
-        // Narrow frusta of eight rays (a pixel's) from random points, against
+        // Narrow frusta of `LANES` rays (a pixel's) from random points, against
         // random spheres and parallelograms, some tiny and some far, some
         // axis-aligned walls: the objects the frustum can meet hold every hit,
         // and with them the hits are each ray's own. Rays on the frustum's
@@ -410,7 +411,7 @@ mod lanes {
                 };
                 let corners =
                     [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(u, v)| direction(u, v));
-                let rays: [Ray; 8] = std::array::from_fn(|k| {
+                let rays: [Ray; LANES] = std::array::from_fn(|k| {
                     let (u, v) = match k {
                         0 => (0.0, 0.0),
                         1 => (1.0, rng.unit()),
@@ -421,7 +422,7 @@ mod lanes {
                 let candidates = list.objects_in_frustum(apex, corners);
                 culled += 12 - candidates.count_ones().min(12);
                 let found = list
-                    .closest_lanes_among(&RayLanes::new(rays), 8, candidates)
+                    .closest_lanes_among(&RayLanes::new(rays), LANES, candidates)
                     .unwrap();
                 for (k, ray) in rays.iter().enumerate() {
                     assert_eq!(found.hit(k), list.closest_primitive(ray, f32::INFINITY));
@@ -465,7 +466,7 @@ mod lanes {
             // Each alone is hit by the edge ray (so culling it would lose a hit).
             for (object, alone) in [(0u32, 0b01u64), (1, 0b10)] {
                 let found = list
-                    .closest_lanes_among(&RayLanes::new([edge; 8]), 1, alone)
+                    .closest_lanes_among(&RayLanes::new([edge; LANES]), 1, alone)
                     .unwrap();
                 assert_eq!(
                     found.hit(0).map(|h| h.object),
@@ -527,10 +528,10 @@ mod lanes {
             list.build_acceleration();
             for _ in 0..40 {
                 let origin = rng.vec3(-5.0, 5.0);
-                let rays: [Ray; 8] =
+                let rays: [Ray; LANES] =
                     std::array::from_fn(|_| Ray::new(origin, rng.vec3(-3.0, 3.0) - origin));
                 let found = list
-                    .closest_primitives_lanes(&RayLanes::new(rays), 8)
+                    .closest_primitives_lanes(&RayLanes::new(rays), LANES)
                     .unwrap();
                 for (ray, lane) in rays.iter().zip(found) {
                     assert_eq!(lane, list.closest_primitive(ray, f32::INFINITY));
@@ -540,16 +541,16 @@ mod lanes {
         }
         assert!(hits > 3000, "only {hits} hits");
         // Layouts it does not serve: a plane outside the packets, and a BVH.
-        let rays = RayLanes::new([Ray::new(Vec3::ZERO, Vec3::X); 8]);
+        let rays = RayLanes::new([Ray::new(Vec3::ZERO, Vec3::X); LANES]);
         let mut list = scene();
         list.build_acceleration();
-        assert!(list.closest_primitives_lanes(&rays, 8).is_none());
+        assert!(list.closest_primitives_lanes(&rays, LANES).is_none());
         assert_eq!(
             list.objects_in_frustum(Vec3::ZERO, [Vec3::X, Vec3::Y, -Vec3::X, -Vec3::Y]),
             u64::MAX
         );
         list.build_bvh();
-        assert!(list.closest_primitives_lanes(&rays, 8).is_none());
+        assert!(list.closest_primitives_lanes(&rays, LANES).is_none());
     }
 }
 

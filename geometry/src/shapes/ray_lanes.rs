@@ -1,31 +1,31 @@
-//! One shape against eight rays at once ([`RayLanes`]): the shadow rays of one
+//! One shape against [`LANES`] rays at once ([`RayLanes`]): the shadow rays of one
 //! shading point, which all meet the same few shapes.
 //!
 //! [`SpherePacket`](super::SpherePacket) puts four shapes in lanes against one
-//! ray; this puts eight rays in lanes against one shape. As there, every lane
+//! ray; this puts [`LANES`] rays in lanes against one shape. As there, every lane
 //! performs exactly the IEEE operations of the scalar test
 //! ([`Sphere::hit_distance`], [`Parallelogram::hit_distance`]) in the same order,
 //! so a lane's verdict is bit for bit the scalar test's.
 
 use super::{Parallelogram, Sphere};
-use crate::lanes::{self, f32x8, Vec3x8, LANES};
+use crate::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use crate::Ray;
 use glam::Vec3;
 
-/// Eight rays, `origin + t·direction` in each lane.
+/// [`LANES`] rays, `origin + t·direction` in each lane.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RayLanes {
-    pub origin: Vec3x8,
-    pub direction: Vec3x8,
+    pub origin: Vec3Lanes,
+    pub direction: Vec3Lanes,
 }
 
 impl RayLanes {
-    /// The eight rays `rays`, lane k holding `rays[k]`.
+    /// The rays `rays`, lane k holding `rays[k]`.
     pub fn new(rays: [Ray; LANES]) -> Self {
-        let lanes = |of: fn(&Ray) -> Vec3| Vec3x8 {
-            x: f32x8::new(rays.each_ref().map(|r| of(r).x)),
-            y: f32x8::new(rays.each_ref().map(|r| of(r).y)),
-            z: f32x8::new(rays.each_ref().map(|r| of(r).z)),
+        let lanes = |of: fn(&Ray) -> Vec3| Vec3Lanes {
+            x: F32Lanes::new(rays.each_ref().map(|r| of(r).x)),
+            y: F32Lanes::new(rays.each_ref().map(|r| of(r).y)),
+            z: F32Lanes::new(rays.each_ref().map(|r| of(r).z)),
         };
         Self {
             origin: lanes(|r| r.origin),
@@ -42,8 +42,8 @@ impl RayLanes {
 
 /// Whether `t` lies in (0, t_max), per lane.
 #[inline(always)]
-fn in_range(t: f32x8, t_max: f32x8) -> f32x8 {
-    lanes::gt(t, f32x8::ZERO) & lanes::lt(t, t_max)
+fn in_range(t: F32Lanes, t_max: F32Lanes) -> F32Lanes {
+    lanes::gt(t, F32Lanes::ZERO) & lanes::lt(t, t_max)
 }
 
 impl Sphere {
@@ -57,12 +57,12 @@ impl Sphere {
     /// [`Self::hit_distance`] for each lane's ray: the lanes with a hit in
     /// (0, `t_max`), and in those lanes its distance, bit for bit the scalar one.
     #[inline]
-    pub fn hit_distance_lanes(&self, rays: &RayLanes, t_max: f32) -> (u32, f32x8) {
-        let zero = f32x8::ZERO;
+    pub fn hit_distance_lanes(&self, rays: &RayLanes, t_max: f32) -> (u32, F32Lanes) {
+        let zero = F32Lanes::ZERO;
         let d = &rays.direction;
         let f = rays.origin.sub_splat(self.center);
         let b = f.dot(d);
-        let r2 = f32x8::splat(self.radius * self.radius);
+        let r2 = F32Lanes::splat(self.radius * self.radius);
         let c = f.dot(&f) - r2;
         let receding = lanes::gt(c, zero) & lanes::gt(b, zero);
         let a = d.dot(d);
@@ -76,7 +76,7 @@ impl Sphere {
         let q_zero = q.simd_eq(zero);
         let t0 = q_zero.select(-h, x.min(y));
         let t1 = q_zero.select(h, x.max(y));
-        let t_max = f32x8::splat(t_max);
+        let t_max = F32Lanes::splat(t_max);
         let near = in_range(t0, t_max);
         let hit = (near | in_range(t1, t_max)) & !missed;
         (lanes::bits(hit), near.select(t0, t1))
@@ -87,10 +87,10 @@ impl Parallelogram {
     /// The edge coordinates (α, β) of each lane's point `p`, as `coordinates`
     /// rounds them.
     #[inline]
-    fn coordinates_lanes(&self, p: &Vec3x8) -> (f32x8, f32x8) {
+    fn coordinates_lanes(&self, p: &Vec3Lanes) -> (F32Lanes, F32Lanes) {
         let local = p.sub_splat(self.origin);
         let alpha = local.cross_splat(self.edge2).dot_splat(self.w);
-        let beta = Vec3x8::splat_cross(self.edge1, &local).dot_splat(self.w);
+        let beta = Vec3Lanes::splat_cross(self.edge1, &local).dot_splat(self.w);
         (alpha, beta)
     }
 
@@ -104,38 +104,38 @@ impl Parallelogram {
     /// [`Self::hit_distance`] for each lane's ray, as
     /// [`Sphere::hit_distance_lanes`] for spheres.
     #[inline]
-    pub fn hit_distance_lanes(&self, rays: &RayLanes, t_max: f32) -> (u32, f32x8) {
-        let zero = f32x8::ZERO;
-        let one = f32x8::ONE;
+    pub fn hit_distance_lanes(&self, rays: &RayLanes, t_max: f32) -> (u32, F32Lanes) {
+        let zero = F32Lanes::ZERO;
+        let one = F32Lanes::ONE;
         let denom = rays.direction.dot_splat(self.normal);
         let mut facing_away = denom.simd_eq(zero);
         if !self.two_sided {
             facing_away |= lanes::gt(denom, zero);
         }
-        let t = Vec3x8::splat_sub(self.origin, &rays.origin).dot_splat(self.normal) / denom;
+        let t = Vec3Lanes::splat_sub(self.origin, &rays.origin).dot_splat(self.normal) / denom;
         let (alpha, beta) = self.coordinates_lanes(&rays.at(t));
-        let within = |x: f32x8| x.simd_ge(zero) & x.simd_le(one);
-        let hit = in_range(t, f32x8::splat(t_max)) & within(alpha) & within(beta) & !facing_away;
+        let within = |x: F32Lanes| x.simd_ge(zero) & x.simd_le(one);
+        let hit = in_range(t, F32Lanes::splat(t_max)) & within(alpha) & within(beta) & !facing_away;
         (lanes::bits(hit), t)
     }
 }
 
-/// The surface points of eight rays' hits on one shape, in lanes: what
+/// The surface points of [`LANES`] rays' hits on one shape, in lanes: what
 /// [`Sphere::surface_point`] and [`Parallelogram::surface_at`] give each lane,
 /// bit for bit, without the derivatives.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SurfaceLanes {
-    pub point: Vec3x8,
+    pub point: Vec3Lanes,
     /// The geometric normal, which is also the shading normal on these shapes.
-    pub normal: Vec3x8,
-    pub u: f32x8,
-    pub v: f32x8,
+    pub normal: Vec3Lanes,
+    pub u: F32Lanes,
+    pub v: F32Lanes,
 }
 
 impl RayLanes {
     /// Each lane's point at its own parameter `t`, as [`Ray::at`] rounds it.
     #[inline]
-    pub fn at(&self, t: f32x8) -> Vec3x8 {
+    pub fn at(&self, t: F32Lanes) -> Vec3Lanes {
         self.origin + self.direction.scale(t)
     }
 }
@@ -145,9 +145,9 @@ impl Sphere {
     /// distance `t`; the other lanes are left undefined. The polar angles are
     /// taken one lane at a time, by the same `acos` and `atan2` as the scalar path.
     #[inline]
-    pub fn surface_points_lanes(&self, rays: &RayLanes, t: f32x8, lanes: u32) -> SurfaceLanes {
+    pub fn surface_points_lanes(&self, rays: &RayLanes, t: F32Lanes, lanes: u32) -> SurfaceLanes {
         let n = rays.at(t).sub_splat(self.center).normalize();
-        let point = Vec3x8::splat_add(self.center, &n.scale(f32x8::splat(self.radius)));
+        let point = Vec3Lanes::splat_add(self.center, &n.scale(F32Lanes::splat(self.radius)));
         let (ny, nz, nx) = (n.y.to_array(), n.z.to_array(), n.x.to_array());
         let mut u = [0.0; LANES];
         let mut v = [0.0; LANES];
@@ -158,8 +158,8 @@ impl Sphere {
         SurfaceLanes {
             point,
             normal: n,
-            u: f32x8::new(u),
-            v: f32x8::new(v),
+            u: F32Lanes::new(u),
+            v: F32Lanes::new(v),
         }
     }
 }
@@ -168,17 +168,17 @@ impl Parallelogram {
     /// [`Self::surface_at`] of each lane at its distance `t`, without the
     /// derivatives (the edges, the same in every lane).
     #[inline]
-    pub fn surface_points_lanes(&self, rays: &RayLanes, t: f32x8) -> SurfaceLanes {
+    pub fn surface_points_lanes(&self, rays: &RayLanes, t: F32Lanes) -> SurfaceLanes {
         let (alpha, beta) = self.coordinates_lanes(&rays.at(t));
         // Vec2::clamp: max with the lower bound, then min with the upper.
-        let (zero, one) = (f32x8::ZERO, f32x8::ONE);
+        let (zero, one) = (F32Lanes::ZERO, F32Lanes::ONE);
         let (u, v) = (alpha.max(zero).min(one), beta.max(zero).min(one));
         // origin + α·edge1 + β·edge2, as `point_at` rounds it.
-        let point = Vec3x8::splat_add(self.origin, &Vec3x8::scaled_splat(self.edge1, u))
-            + Vec3x8::scaled_splat(self.edge2, v);
+        let point = Vec3Lanes::splat_add(self.origin, &Vec3Lanes::scaled_splat(self.edge1, u))
+            + Vec3Lanes::scaled_splat(self.edge2, v);
         SurfaceLanes {
             point,
-            normal: Vec3x8::splat(self.normal),
+            normal: Vec3Lanes::splat(self.normal),
             u,
             v,
         }
@@ -191,7 +191,7 @@ mod tests {
     use crate::bvh::test_support::XorShift;
     use crate::Hit;
 
-    fn rays_from(origin: Vec3, targets: [Vec3; 8]) -> RayLanes {
+    fn rays_from(origin: Vec3, targets: [Vec3; LANES]) -> RayLanes {
         RayLanes::new(targets.map(|t| Ray::new(origin, t - origin)))
     }
 
@@ -221,10 +221,11 @@ mod tests {
             let (walls, wall_t) = wall.hit_distance_lanes(&rays, t_max);
             assert_eq!(spheres, sphere.hits_lanes(&rays, t_max));
             assert_eq!(walls, wall.hits_lanes(&rays, t_max));
-            for k in 0..8 {
+            for k in 0..LANES {
                 let ray = rays.lane(k);
-                let lane =
-                    |bits: u32, t: f32x8| (bits >> k & 1 == 1).then(|| t.to_array()[k].to_bits());
+                let lane = |bits: u32, t: F32Lanes| {
+                    (bits >> k & 1 == 1).then(|| t.to_array()[k].to_bits())
+                };
                 let scalar = |t: Option<f32>| t.map(f32::to_bits);
                 assert_eq!(
                     lane(spheres, sphere_t),
@@ -234,7 +235,7 @@ mod tests {
             }
             let sphere_points = sphere.surface_points_lanes(&rays, sphere_t, spheres);
             let wall_points = wall.surface_points_lanes(&rays, wall_t);
-            for k in 0..8 {
+            for k in 0..LANES {
                 let bits = |v: Vec3| v.to_array().map(f32::to_bits);
                 let lane = |s: &SurfaceLanes| {
                     let uv = [s.u.as_array()[k], s.v.as_array()[k]].map(f32::to_bits);
@@ -269,8 +270,11 @@ mod tests {
             Vec3::ZERO,
             std::array::from_fn(|k| Vec3::new(1.0, k as f32, 0.5)),
         );
-        assert_eq!(sphere.hits_lanes(&rays, f32::INFINITY), 0xff);
-        let nan = rays_from(Vec3::NAN, [Vec3::X; 8]);
+        assert_eq!(
+            sphere.hits_lanes(&rays, f32::INFINITY),
+            crate::lanes::all_bits()
+        );
+        let nan = rays_from(Vec3::NAN, [Vec3::X; LANES]);
         assert_eq!(sphere.hits_lanes(&nan, f32::INFINITY), 0);
     }
 }

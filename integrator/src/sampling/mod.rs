@@ -68,7 +68,7 @@
 //! # Files
 //! - `pattern`: [`SamplePattern`] and how each fills N points.
 //! - `sobol`: [`DimensionPair`], [`SobolSequence`] and [`SobolPoints`].
-//! - `pcg`: the PCG32 generator ([`Pcg32`]), and eight of them in lanes
+//! - `pcg`: the PCG32 generator ([`Pcg32`]), and a lane's worth of them
 //!   ([`Pcg32Lanes`]).
 //! - `streams`: [`pixel_rng`], [`uniform`] and [`PixelSample`], which names a
 //!   camera sample's stream and its Sobol points.

@@ -1,18 +1,18 @@
 //! PCG32 (O'Neill, "PCG: A Family of Simple Fast Space-Efficient Statistically
 //! Good Algorithms for Random Number Generation", 2014): the 64-bit LCG
 //! `s ← a·s + c` with the XSH-RR output permutation, on Glint's one stream
-//! [`STREAM`]. One generator ([`Pcg32`]) or eight stepping in lanes
+//! [`STREAM`]. One generator ([`Pcg32`]) or [`LANES`] stepping in lanes
 //! ([`Pcg32Lanes`]), each lane the scalar generator's numbers bit for bit.
 //!
 //! The numbers are those of `rand_pcg::Pcg32` (`Lcg64Xsh32`) seeded with
 //! `Pcg32::new(state, STREAM)` (the tests compare), Glint's generator before
 //! it had lanes; having the state at hand lets a stream jump ahead by any
 //! number of draws in one multiply-add (Brown, "Random Number Generation with
-//! Arbitrary Strides", 1994), which is how eight lanes take consecutive draws
+//! Arbitrary Strides", 1994), which is how the lanes take consecutive draws
 //! of one stream.
 
 use super::streams::mix64;
-use glint_geometry::lanes::{f32x8, LANES};
+use glint_geometry::lanes::{F32Lanes, LANES};
 
 /// The LCG's multiplier (Knuth's MMIX constant, PCG's default).
 const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
@@ -130,7 +130,7 @@ const PAIR_LANES: [(u64, u64); LANES] = {
 /// next: the lanes take `2·LANES` draws a chunk.
 const NEXT_PAIRS: (u64, u64) = jump(2 * LANES as u64 - 2);
 
-/// Eight PCG32 generators on [`STREAM`], stepped together.
+/// [`LANES`] PCG32 generators on [`STREAM`], stepped together.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Pcg32Lanes {
     state: [u64; LANES],
@@ -155,25 +155,25 @@ impl Pcg32Lanes {
 
     /// Each lane's next uniform f32 in [0, 1), as [`Pcg32::uniform`].
     #[inline(always)]
-    pub fn uniform(&mut self) -> f32x8 {
-        f32x8::new(self.next_u32().map(unit))
+    pub fn uniform(&mut self) -> F32Lanes {
+        F32Lanes::new(self.next_u32().map(unit))
     }
 
     /// Each lane's next two uniforms, as [`Pcg32::uniform2`]: the second
     /// draw's state and the state after both are each one multiply-add from
     /// the current state (the second by a jump of two), not two in a row.
     #[inline(always)]
-    pub fn uniform2(&mut self) -> (f32x8, f32x8) {
+    pub fn uniform2(&mut self) -> (F32Lanes, F32Lanes) {
         let first = self.state;
         let second = first.map(step);
         self.state = first.map(|s| jumped(TWO_DRAWS, s));
-        let uniforms = |states: [u64; LANES]| f32x8::new(states.map(|s| unit(output(s))));
+        let uniforms = |states: [u64; LANES]| F32Lanes::new(states.map(|s| unit(output(s))));
         (uniforms(first), uniforms(second))
     }
 
     /// The generators of `key`'s streams `first..first + LANES`, lane k seeded
     /// with [`mix64`]`(key ^ (first + k))`: with a pixel's
-    /// [`pixel_key`](super::pixel_key), the streams of eight consecutive samples
+    /// [`pixel_key`](super::pixel_key), the streams of [`LANES`] consecutive samples
     /// as [`stream_seed`](super::stream_seed) names them.
     #[inline(always)]
     pub fn for_streams(key: u64, first: u64) -> Self {
@@ -186,7 +186,7 @@ const TWO_DRAWS: (u64, u64) = jump(2);
 
 /// Fills `out` with uniform points of `rng`, point i from draws 2i and 2i + 1
 /// (x, then y), and leaves `rng` past them: the same points and state as
-/// drawing them one by one, eight points at a time in lanes.
+/// drawing them one by one, [`LANES`] points at a time in lanes.
 pub fn fill_uniform_pairs(rng: &mut Pcg32, out: &mut [glam::Vec2]) {
     let mut chunks = out.chunks_exact_mut(LANES);
     let mut lanes = Pcg32Lanes {

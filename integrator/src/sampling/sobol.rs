@@ -25,9 +25,10 @@
 
 use super::streams::mix64;
 use glam::Vec2;
-use glint_geometry::lanes::{f32x8, LANES};
+use glint_geometry::lanes::U32Lanes;
+use glint_geometry::lanes::{F32Lanes, LANES};
 use sobol_burley::parts::{hash, owen_scramble_rev, u32_to_f32_norm};
-use wide::{bytemuck::cast, u32x8};
+use wide::bytemuck::cast;
 
 /// Which 2D sample dimensions of a pixel a set of points is for; each has its own
 /// Sobol sequence, so that no two of them correlate.
@@ -142,8 +143,8 @@ impl SobolSequence {
         self.scrambles(index).point(index as u32 & BLOCK_MASK)
     }
 
-    /// Points `first..first + out.len()`, eight at a time
-    /// (hashed in SIMD lanes) where eight consecutive ones share a block.
+    /// Points `first..first + out.len()`, [`LANES`] at a time
+    /// (hashed in SIMD lanes) where that many consecutive ones share a block.
     #[inline]
     pub fn fill(self, first: u64, out: &mut [Vec2]) {
         for (chunk, start) in out.chunks_mut(LANES).zip((first..).step_by(LANES)) {
@@ -191,17 +192,17 @@ impl Scrambles {
         }
     }
 
-    /// Points `i..i + out.len()` (at most eight, all below 2^16), as
-    /// [`Self::point`] computes each, bit for bit: the integer hashing of the
-    /// eight in SIMD lanes (wrapping products, exact), the table lookups lane by
+    /// Points `i..i + out.len()` (at most [`LANES`], all below 2^16), as
+    /// [`Self::point`] computes each, bit for bit: the integer hashing of them
+    /// all in SIMD lanes (wrapping products, exact), the table lookups lane by
     /// lane.
     #[inline]
     fn points(self, i: u32, out: &mut [Vec2]) {
-        let index = u32x8::new(std::array::from_fn(|k| i.wrapping_add(k as u32)));
+        let index = U32Lanes::new(std::array::from_fn(|k| i.wrapping_add(k as u32)));
         let shuffled = owen_scramble_lanes(reverse_bits_lanes(index), self.index).to_array();
         let tables = self.tables();
         let sobol = |axis: usize| {
-            u32x8::new(std::array::from_fn(|k| {
+            U32Lanes::new(std::array::from_fn(|k| {
                 let (low, high) = (shuffled[k] >> 24, shuffled[k] >> 16 & 0xff);
                 tables[axis][0][low as usize] ^ tables[axis][1][high as usize]
             }))
@@ -241,41 +242,41 @@ impl Scrambles {
     }
 }
 
-/// `sobol_burley::parts::owen_scramble_rev` on eight integers (wrapping
+/// `sobol_burley::parts::owen_scramble_rev` on [`LANES`] integers (wrapping
 /// products and sums, so the same bits).
 #[inline]
-fn owen_scramble_lanes(mut n_rev: u32x8, scramble: u32) -> u32x8 {
-    n_rev ^= n_rev * u32x8::splat(0x3d20_adea);
-    n_rev += u32x8::splat(scramble);
-    n_rev *= u32x8::splat((scramble >> 16) | 1);
-    n_rev ^= n_rev * u32x8::splat(0x0552_6c56);
-    n_rev ^= n_rev * u32x8::splat(0x53a2_2864);
+fn owen_scramble_lanes(mut n_rev: U32Lanes, scramble: u32) -> U32Lanes {
+    n_rev ^= n_rev * U32Lanes::splat(0x3d20_adea);
+    n_rev += U32Lanes::splat(scramble);
+    n_rev *= U32Lanes::splat((scramble >> 16) | 1);
+    n_rev ^= n_rev * U32Lanes::splat(0x0552_6c56);
+    n_rev ^= n_rev * U32Lanes::splat(0x53a2_2864);
     n_rev
 }
 
-/// `u32::reverse_bits` on eight integers: swaps of ever larger bit groups.
+/// `u32::reverse_bits` on [`LANES`] integers: swaps of ever larger bit groups.
 #[inline]
-fn reverse_bits_lanes(mut v: u32x8) -> u32x8 {
+fn reverse_bits_lanes(mut v: U32Lanes) -> U32Lanes {
     for (shift, mask) in [
         (1, 0x5555_5555),
         (2, 0x3333_3333),
         (4, 0x0f0f_0f0f),
         (8, 0x00ff_00ff),
     ] {
-        let mask = u32x8::splat(mask);
+        let mask = U32Lanes::splat(mask);
         v = ((v >> shift) & mask) | ((v & mask) << shift);
     }
     (v >> 16) | (v << 16)
 }
 
-/// The coordinates in [0, 1) of eight scrambled Sobol values, as
+/// The coordinates in [0, 1) of [`LANES`] scrambled Sobol values, as
 /// `u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits())`: the top 23
 /// bits as the mantissa of a float in [1, 2), minus 1.
 #[inline]
-fn unit_lanes(v: u32x8, scramble: u32) -> [f32; LANES] {
+fn unit_lanes(v: U32Lanes, scramble: u32) -> [f32; LANES] {
     let bits =
-        (reverse_bits_lanes(owen_scramble_lanes(v, scramble)) >> 9) | u32x8::splat(0x3f80_0000);
-    (cast::<u32x8, f32x8>(bits) - f32x8::ONE).to_array()
+        (reverse_bits_lanes(owen_scramble_lanes(v, scramble)) >> 9) | U32Lanes::splat(0x3f80_0000);
+    (cast::<U32Lanes, F32Lanes>(bits) - F32Lanes::ONE).to_array()
 }
 
 /// The unscrambled Sobol points of dimensions 0 and 1 by bytes of the index, bits

@@ -458,11 +458,12 @@ fn textures<'a>(
             TextureTable::Image(i) => {
                 // The same file under two spellings (./a.png, a.png) is loaded once.
                 let joined = base_dir.join(i.file.get_ref());
-                let path = std::fs::canonicalize(&joined).unwrap_or(joined);
+                let path = std::fs::canonicalize(&joined).unwrap_or(joined.clone());
                 let image = match images.get(&path) {
                     Some(image) => image.clone(),
                     None => {
-                        let loaded = load_image(&path).map_err(|e| {
+                        // Read under the name the scene gives, which errors then show.
+                        let loaded = load_image(&joined).map_err(|e| {
                             Problem::new(
                                 i.file.span(),
                                 format!("textures.{name}.image.file"),

@@ -37,10 +37,18 @@ pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, materials) = tobj::load_obj(path, &options)
-        .map_err(|e| format!("{}: cannot read the OBJ file: {e}", path.display()))?;
-    // A missing or broken MTL file: the faces use the scene's material.
-    let materials = materials.unwrap_or_default();
+    let cannot_read =
+        |e: &dyn std::fmt::Display| format!("{}: cannot read the OBJ file: {e}", path.display());
+    // tobj reports a file it cannot open without the reason.
+    std::fs::File::open(path).map_err(|e| cannot_read(&e))?;
+    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| cannot_read(&e))?;
+    // The MTL materials are needed only without a scene material; then a
+    // material library the OBJ names must be there and parse.
+    let materials = match materials {
+        Ok(materials) => materials,
+        Err(_) if !with_materials => Vec::new(),
+        Err(e) => return Err(material_library_error(path, e)),
+    };
     let base = path.parent().unwrap_or(Path::new(""));
     // MTL images are read only when the scene uses the MTL materials, each once.
     let mut images = HashMap::new();
@@ -121,15 +129,41 @@ pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
     Ok(mesh)
 }
 
-/// The MTL files an OBJ names (`mtllib` lines, relative to the OBJ) that exist.
-fn material_libraries(path: &Path) -> Vec<PathBuf> {
+/// Why the material libraries of the OBJ at `path` could not be read: the
+/// first one missing or unreadable by name, else tobj's parse error `e`, with
+/// what the user can do about it.
+fn material_library_error(path: &Path, e: tobj::LoadError) -> String {
     let base = path.parent().unwrap_or(Path::new(""));
+    let named = library_names(path);
+    let unreadable = named.iter().find_map(|name| {
+        std::fs::read(base.join(name))
+            .err()
+            .map(|io| format!("{name}: {io}"))
+    });
+    let why = unreadable.unwrap_or_else(|| format!("{}: {e}", named.join(", ")));
+    format!(
+        "{}: cannot read its material library {why} (give the mesh a `material` to render it without)",
+        path.display()
+    )
+}
+
+/// The names of the MTL files an OBJ names on its `mtllib` lines.
+fn library_names(path: &Path) -> Vec<String> {
     let Ok(text) = std::fs::read_to_string(path) else {
         return Vec::new();
     };
     text.lines()
         .filter_map(|l| l.trim_start().strip_prefix("mtllib"))
         .flat_map(|names| names.split_whitespace())
+        .map(str::to_owned)
+        .collect()
+}
+
+/// The MTL files an OBJ names (`mtllib` lines, relative to the OBJ) that exist.
+fn material_libraries(path: &Path) -> Vec<PathBuf> {
+    let base = path.parent().unwrap_or(Path::new(""));
+    library_names(path)
+        .into_iter()
         .map(|name| base.join(name))
         .filter(|p| p.is_file())
         .collect()
@@ -230,5 +264,25 @@ mod tests {
         let bad = dir.path().join("bad.obj");
         std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
         assert!(load_obj(&bad, true).is_err());
+        // A material library that is missing or does not parse: an error when
+        // the MTL materials are used, not read at all when they are not.
+        let lost = dir.path().join("lost.obj");
+        let faces = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+        std::fs::write(&lost, format!("mtllib gone.mtl\n{faces}")).unwrap();
+        let e = load_obj(&lost, true).err().unwrap();
+        assert!(
+            e.contains("lost.obj: cannot read its material library gone.mtl: "),
+            "{e}"
+        );
+        assert_eq!(load_obj(&lost, false).unwrap().indices.len(), 1);
+        let broken = dir.path().join("broken.obj");
+        std::fs::write(dir.path().join("broken.mtl"), "newmtl red\nKd 1 x 0\n").unwrap();
+        std::fs::write(&broken, format!("mtllib broken.mtl\n{faces}")).unwrap();
+        let e = load_obj(&broken, true).err().unwrap();
+        assert!(
+            e.contains("material library broken.mtl: material parse error"),
+            "{e}"
+        );
+        assert!(load_obj(&broken, false).is_ok());
     }
 }

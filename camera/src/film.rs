@@ -1,9 +1,12 @@
 //! The film: a grid of linear RGB radiance values and the writers that turn it
 //! into PNG (8-bit sRGB), OpenEXR (32-bit float, linear) or PFM (32-bit float, linear).
-//! Reading images back ([`Film::load`]) is in the `read` submodule.
+//! Reading images back ([`Film::load`]) is in the `read` submodule; a partly
+//! rendered film with its coverage ([`PartialFilm`]) in `partial`.
 
+mod partial;
 mod read;
 
+pub use partial::PartialFilm;
 pub use read::{srgb_to_linear, MAX_LOAD_SIDE};
 
 use glam::{UVec2, Vec3};

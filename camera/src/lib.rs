@@ -38,7 +38,9 @@ pub use atomic_file::write_atomically;
 pub use camera::{
     Camera, CameraError, CameraRay, CameraRayDifferential, CameraRayLanes, F32Lanes, LANES,
 };
-pub use film::{linear_to_srgb8, srgb_to_linear, Film, FilmError, ImageFormat, MAX_LOAD_SIDE};
+pub use film::{
+    linear_to_srgb8, srgb_to_linear, Film, FilmError, ImageFormat, PartialFilm, MAX_LOAD_SIDE,
+};
 
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]

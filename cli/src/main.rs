@@ -3,7 +3,8 @@
 //! crate) and write the film (camera crate).
 //!
 //! Exit status: 0 on success, 2 for bad input (usage, scene file, settings,
-//! output path), 1 for anything else. Errors are one line on stderr, prefixed
+//! output path), 130 or 143 for a render stopped by Ctrl-C or SIGTERM (after
+//! writing the pixels it finished), 1 for anything else. Errors are one line on stderr, prefixed
 //! `glint: error: `.
 //!
 //! # Entry points
@@ -15,6 +16,7 @@
 
 mod bench;
 mod diff;
+mod interrupt;
 mod output;
 mod render;
 mod stats;
@@ -31,7 +33,8 @@ use std::process::ExitCode;
     version,
     about = "Glint: a ray tracer for direct lighting and texturing",
     long_about = "Glint: a ray tracer for direct lighting and texturing.\n\n\
-                  Exit status: 0 on success, 2 for bad input (usage, scene or asset errors), 1 otherwise."
+                  Exit status: 0 on success, 2 for bad input (usage, scene or asset errors), \
+                  130 (Ctrl-C) or 143 (SIGTERM) for an interrupted render, 1 otherwise."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -57,6 +60,9 @@ pub(crate) enum Failure {
     Other(String),
     /// A bug; the panic hook has already printed it. Exit status 1.
     Panicked,
+    /// Stopped by a signal after writing what was finished, which the message
+    /// says; the exit status is the signal's (130 for Ctrl-C, 143 for SIGTERM).
+    Interrupted { message: String, status: u8 },
 }
 
 fn main() -> ExitCode {
@@ -87,6 +93,10 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
         Err(Failure::Panicked) => ExitCode::from(1),
+        Err(Failure::Interrupted { message, status }) => {
+            eprintln!("glint: interrupted: {message}");
+            ExitCode::from(status)
+        }
     }
 }
 

@@ -1,11 +1,12 @@
 //! `glint render`: a scene file to an image.
 
+use crate::interrupt::Interrupts;
 use crate::stats::StatsReport;
 use crate::{named, progress_bar, Failure};
 use clap::Args;
 use glam::UVec2;
-use glint_camera::ImageFormat;
-use glint_integrator::{Aov, RenderSettings, SamplePattern};
+use glint_camera::{ImageFormat, PartialFilm};
+use glint_integrator::{Aov, RenderControl, RenderSettings, SamplePattern};
 use glint_scene::SceneDescription;
 use glint_texture::TextureFilter;
 use std::path::{Path, PathBuf};
@@ -94,6 +95,12 @@ pub(crate) struct RenderArgs {
     /// them (the schema is in docs/command-line.md)
     #[arg(long, value_name = "FILE")]
     stats_json: Option<PathBuf>,
+
+    /// Continue the interrupted render in OUT (an .exr whose alpha channel marks
+    /// the pixels finished): only the others are rendered, and with the same
+    /// scene and settings the image is the uninterrupted render's, bit for bit
+    #[arg(long)]
+    resume: bool,
 }
 
 pub(crate) fn parse_resolution(text: &str) -> Result<UVec2, String> {
@@ -135,6 +142,14 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         .validate()
         .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
 
+    let partial = match args.resume {
+        true => {
+            Some(PartialFilm::load(&output).map_err(|e| Failure::Input(format!("--resume: {e}")))?)
+        }
+        false => None,
+    };
+    let interrupts =
+        Interrupts::install().map_err(|e| Failure::Other(format!("cannot handle Ctrl-C: {e}")))?;
     let progress =
         progress_bar("{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} tiles (eta {eta})");
     let on_tile = |done: usize, total: usize| {
@@ -143,8 +158,18 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
             bar.set_position(done as u64);
         }
     };
-    let rendered = glint_integrator::render(&scene, &settings, &on_tile)
-        .map_err(|e| Failure::Other(e.to_string()))?;
+    let control = RenderControl {
+        stop: Some(interrupts.stop()),
+        resume: partial.as_ref(),
+    };
+    let rendered = glint_integrator::render_with(&scene, &settings, &on_tile, control).map_err(
+        |e| match e {
+            glint_integrator::SettingsError::ResumeResolution { .. } => {
+                Failure::Input(format!("--resume: {}: {e}", output.display()))
+            }
+            e => Failure::Other(e.to_string()),
+        },
+    )?;
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
@@ -154,9 +179,20 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         }
         _ => rendered.film,
     };
+    let finished = rendered.finished.iter().filter(|&&f| f).count();
+    if finished < rendered.finished.len() {
+        let status = interrupts
+            .exit_status()
+            .expect("only a signal stops a render early");
+        let _writing = interrupts.writing();
+        return Err(write_partial(&output, film, rendered.finished, status));
+    }
     let write_start = std::time::Instant::now();
-    film.save(&output)
-        .map_err(|e| Failure::Other(e.to_string()))?;
+    {
+        let _writing = interrupts.writing();
+        film.save(&output)
+            .map_err(|e| Failure::Other(e.to_string()))?;
+    }
     let write = write_start.elapsed();
 
     let stats = rendered.stats;
@@ -188,6 +224,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
     }
     if let Some(path) = &args.stats_json {
         let text = serde_json::to_string_pretty(&report.to_json()).expect("JSON of numbers");
+        let _writing = interrupts.writing();
         crate::output::write_text(path, &(text + "\n"))?;
     }
     if stats.shading.nonfinite_samples > 0 {
@@ -197,6 +234,40 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         );
     }
     Ok(())
+}
+
+/// Writes the pixels an interrupted render finished to `output` (atomically;
+/// what was there is only replaced by a complete write) and says so.
+fn write_partial(
+    output: &Path,
+    film: glint_camera::Film,
+    finished: Vec<bool>,
+    status: u8,
+) -> Failure {
+    let total = finished.len();
+    let partial = PartialFilm { film, finished };
+    let done = partial.finished_count();
+    if let Err(e) = partial.save(output) {
+        return Failure::Other(format!(
+            "interrupted, and could not write the partial image: {e}"
+        ));
+    }
+    let rest = match ImageFormat::from_path(output) {
+        Ok(ImageFormat::Exr) => {
+            "its alpha channel marks them; the same command with --resume finishes it".to_owned()
+        }
+        _ => format!(
+            "the other {} are black (write an .exr to be able to --resume)",
+            total - done
+        ),
+    };
+    Failure::Interrupted {
+        message: format!(
+            "wrote {} with {done} of {total} pixels rendered; {rest}",
+            output.display()
+        ),
+        status,
+    }
 }
 
 /// The output path: `-o`, or SCENE-NAME.png in the current directory; its

@@ -39,8 +39,8 @@ pub use aov::Aov;
 pub use counters::{LookupKind, ShadingCounters, TextureCounters};
 pub use direct::{DirectIntegrator, SampleContext};
 pub use render::{
-    camera_ray, render, RenderOutput, RenderSettings, RenderStats, SampleCount, SettingsError,
-    MAX_SAMPLES, MAX_THREADS, TILE_SIZE,
+    camera_ray, render, render_with, RenderControl, RenderOutput, RenderSettings, RenderStats,
+    SampleCount, SettingsError, MAX_SAMPLES, MAX_THREADS, TILE_SIZE,
 };
 pub use sampling::SamplePattern;
 pub use scene::{Scene, SceneBuilder, SceneError, Surface, SurfaceKind};

@@ -2,12 +2,12 @@ use crate::counters::{ShadingCounters, TextureCounters};
 use crate::direct::SampleContext;
 use crate::sampling::{pixel_rng, PixelSample, SamplePattern, SobolPoints, PIXEL_STREAM};
 use crate::{Aov, DirectIntegrator, Scene};
-use glam::{Vec2, Vec3};
-use glint_camera::{Camera, Film};
+use glam::{UVec2, Vec2, Vec3};
+use glint_camera::{Camera, Film, PartialFilm};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential, RayLanes};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 // The camera's ray lanes are the geometry's lanes: one camera ray per lane.
 const _: () = assert!(glint_camera::LANES == LANES);
@@ -109,6 +109,8 @@ pub enum SettingsError {
     Threads(usize),
     #[error("could not start the worker threads: {0}")]
     ThreadPool(String),
+    #[error("the partial render to resume is {}x{} pixels, the camera's film {}x{}", film.x, film.y, camera.x, camera.y)]
+    ResumeResolution { film: UVec2, camera: UVec2 },
 }
 
 impl RenderSettings {
@@ -169,6 +171,8 @@ pub struct RenderStats {
 /// What one tile's worker counted.
 #[derive(Clone, Copy, Debug, Default)]
 struct TileCounts {
+    /// The pixels it rendered (not those a resumed render kept).
+    pixels: u64,
     shading: ShadingCounters,
     queries: QueryCounters,
     textures: TextureCounters,
@@ -176,6 +180,7 @@ struct TileCounts {
 
 impl TileCounts {
     fn add(mut self, other: TileCounts) -> TileCounts {
+        self.pixels += other.pixels;
         self.shading += other.shading;
         self.queries += other.queries;
         self.textures += other.textures;
@@ -193,10 +198,26 @@ impl RenderStats {
     }
 }
 
+/// How a render may be cut short, or continue an earlier one ([`render_with`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RenderControl<'a> {
+    /// Once set (say by a signal handler), each worker stops after the pixel it
+    /// is on and starts no other: the pixels not reached stay unfinished.
+    pub stop: Option<&'a AtomicBool>,
+    /// A partial render to continue: its finished pixels are kept as they are
+    /// and only the others rendered. Every pixel depends only on the scene, the
+    /// settings and its own index, so with the same scene and settings the
+    /// result is the uninterrupted render's, bit for bit.
+    pub resume: Option<&'a PartialFilm>,
+}
+
 /// A rendered image and what it cost.
 #[derive(Clone, Debug)]
 pub struct RenderOutput {
     pub film: Film,
+    /// Per pixel (row-major from the top left), whether it is finished: all of
+    /// them unless [`RenderControl::stop`] was set.
+    pub finished: Vec<bool>,
     pub stats: RenderStats,
 }
 
@@ -211,14 +232,32 @@ pub fn render(
     settings: &RenderSettings,
     on_tile_done: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<RenderOutput, SettingsError> {
+    render_with(scene, settings, on_tile_done, RenderControl::default())
+}
+
+/// [`render`], which `control` may stop early or set to continue a partial
+/// render.
+pub fn render_with(
+    scene: &Scene,
+    settings: &RenderSettings,
+    on_tile_done: &(dyn Fn(usize, usize) + Sync),
+    control: RenderControl,
+) -> Result<RenderOutput, SettingsError> {
     settings.validate()?;
+    if let Some(partial) = control.resume {
+        let (film, camera) = (partial.film.resolution(), scene.camera.resolution());
+        if film != camera {
+            return Err(SettingsError::ResumeResolution { film, camera });
+        }
+    }
+    let run = || render_on_current_pool(scene, settings, on_tile_done, control);
     match settings.threads {
-        None => Ok(render_on_current_pool(scene, settings, on_tile_done)),
+        None => Ok(run()),
         Some(threads) => rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .map_err(|e| SettingsError::ThreadPool(e.to_string()))
-            .map(|pool| pool.install(|| render_on_current_pool(scene, settings, on_tile_done))),
+            .map(|pool| pool.install(run)),
     }
 }
 
@@ -226,6 +265,7 @@ fn render_on_current_pool(
     scene: &Scene,
     settings: &RenderSettings,
     on_tile_done: &(dyn Fn(usize, usize) + Sync),
+    control: RenderControl,
 ) -> RenderOutput {
     let start = Instant::now();
     let resolution = scene.camera.resolution();
@@ -236,7 +276,13 @@ fn render_on_current_pool(
         environment_pattern: settings.environment_pattern,
         max_depth: settings.max_depth,
     };
-    let mut film = Film::new(resolution);
+    let (mut film, mut finished) = match control.resume {
+        Some(partial) => (partial.film.clone(), partial.finished.clone()),
+        None => (
+            Film::new(resolution),
+            vec![false; resolution.x as usize * resolution.y as usize],
+        ),
+    };
     let band = (TILE_SIZE * resolution.x) as usize;
     let total = film.pixels().len().div_ceil(band);
     let done = AtomicUsize::new(0);
@@ -244,17 +290,23 @@ fn render_on_current_pool(
     let counts = film
         .pixels_mut()
         .par_chunks_mut(band)
+        .zip(finished.par_chunks_mut(band))
         .enumerate()
-        .map(|(i, pixels)| {
+        .map(|(i, (pixels, finished))| {
             let first_row = i as u32 * TILE_SIZE;
-            let counts = render_rows(scene, settings, &integrator, first_row, pixels);
+            let rows = Rows {
+                first_row,
+                pixels,
+                finished,
+            };
+            let counts = render_rows(scene, settings, &integrator, rows, control.stop);
             on_tile_done(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             counts
         })
         .reduce(TileCounts::default, TileCounts::add);
     let shading = counts.shading;
     let stats = RenderStats {
-        camera_rays: resolution.x as u64 * resolution.y as u64 * settings.spp as u64,
+        camera_rays: counts.pixels * settings.spp as u64,
         shadow_rays: shading.light_shadow_rays + shading.environment_shadow_rays,
         reflection_rays: shading.reflection_rays,
         shading,
@@ -262,10 +314,22 @@ fn render_on_current_pool(
         textures: counts.textures,
         elapsed: start.elapsed(),
     };
-    RenderOutput { film, stats }
+    RenderOutput {
+        film,
+        finished,
+        stats,
+    }
 }
 
-/// Renders the rows starting at `first_row` into `pixels` (whole rows, row-major);
+/// One tile: whole rows of the film from `first_row`, row-major, with which of
+/// their pixels are finished.
+struct Rows<'a> {
+    first_row: u32,
+    pixels: &'a mut [Vec3],
+    finished: &'a mut [bool],
+}
+
+/// Renders the unfinished pixels of `rows`, in order, until `stop` is set;
 /// returns what it counted. A camera sample whose radiance is NaN or infinite
 /// is left out of its pixel (counted in `nonfinite_samples`): one bad sample
 /// would otherwise blot out the pixel.
@@ -273,9 +337,15 @@ fn render_rows(
     scene: &Scene,
     settings: &RenderSettings,
     integrator: &DirectIntegrator,
-    first_row: u32,
-    pixels: &mut [Vec3],
+    rows: Rows,
+    stop: Option<&AtomicBool>,
 ) -> TileCounts {
+    let Rows {
+        first_row,
+        pixels,
+        finished,
+    } = rows;
+    let mut rendered = 0;
     if settings.stats {
         // Drop what other work on this thread counted: the tile's counts are its own.
         let _ = take_counters();
@@ -294,7 +364,13 @@ fn render_rows(
         && settings.aov.is_none()
         && !differentials
         && scene.shapes.has_closest_lanes();
-    for (offset, radiance) in pixels.iter_mut().enumerate() {
+    for (offset, (radiance, finished)) in pixels.iter_mut().zip(finished).enumerate() {
+        if *finished {
+            continue;
+        }
+        if stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
+            break;
+        }
         let (x, y) = (offset as u32 % width, first_row + offset as u32 / width);
         let pixel = y as u64 * width as u64 + x as u64;
         let mut rng = pixel_rng(settings.seed, pixel, PIXEL_STREAM);
@@ -381,8 +457,11 @@ fn render_rows(
             accumulate(&mut sum, &values, used, &mut ctx);
         }
         *radiance = sum / settings.spp as f32;
+        *finished = true;
+        rendered += 1;
     }
     TileCounts {
+        pixels: rendered,
         shading: ctx.counters,
         queries: if settings.stats {
             take_counters()

@@ -106,6 +106,15 @@ fn open(path: &Path) -> Result<BufReader<std::fs::File>, String> {
 /// PNG, JPEG and OpenEXR through the `image` crate: the header first (size
 /// check), then the pixels.
 fn read_with_image_crate(path: &Path, format: image::ImageFormat) -> Result<Film, String> {
+    Ok(from_dynamic(decode(path, format)?))
+}
+
+/// The image at `path` decoded by the image crate, its size checked from the
+/// header before any pixel memory is taken.
+pub(super) fn decode(
+    path: &Path,
+    format: image::ImageFormat,
+) -> Result<image::DynamicImage, String> {
     let (w, h) = image::ImageReader::with_format(open(path)?, format)
         .into_dimensions()
         .map_err(|e| e.to_string())?;
@@ -118,8 +127,7 @@ fn read_with_image_crate(path: &Path, format: image::ImageFormat) -> Result<Film
     // size is 4 GiB); the default allocation limit would refuse large renders.
     limits.max_alloc = None;
     reader.limits(limits);
-    let decoded = reader.decode().map_err(|e| e.to_string())?;
-    Ok(from_dynamic(decoded))
+    reader.decode().map_err(|e| e.to_string())
 }
 
 /// A decoded image as linear RGB: integers are sRGB, floats linear and kept as is.

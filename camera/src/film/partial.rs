@@ -1,0 +1,149 @@
+//! A partly rendered film: what an interrupted render writes, and what a
+//! resumed one reads back. In OpenEXR the coverage is the alpha channel (1 for
+//! a rendered pixel, 0 for one not reached), so viewers show the unfinished
+//! pixels as transparent; the colour channels are the film's, 32-bit float.
+
+use super::read::decode;
+use super::{Film, FilmError, ImageFormat};
+use glam::Vec3;
+use std::path::Path;
+
+/// A film and, per pixel (row-major from the top left), whether it was rendered.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartialFilm {
+    pub film: Film,
+    pub finished: Vec<bool>,
+}
+
+impl PartialFilm {
+    /// The pixels rendered.
+    pub fn finished_count(&self) -> usize {
+        self.finished.iter().filter(|&&f| f).count()
+    }
+
+    /// Writes the film to `path` (atomically, as [`Film::save`]): in OpenEXR
+    /// with the coverage as alpha; in PNG and PFM, which keep no coverage, with
+    /// the pixels not rendered black.
+    pub fn save(&self, path: &Path) -> Result<(), FilmError> {
+        if ImageFormat::from_path(path)? != ImageFormat::Exr {
+            let mut film = self.film.clone();
+            for (pixel, &done) in film.pixels_mut().iter_mut().zip(&self.finished) {
+                if !done {
+                    *pixel = Vec3::ZERO;
+                }
+            }
+            return film.save(path);
+        }
+        let (w, h) = (self.film.resolution().x, self.film.resolution().y);
+        let data = self
+            .film
+            .pixels()
+            .iter()
+            .zip(&self.finished)
+            .flat_map(|(p, &done)| [p.x, p.y, p.z, if done { 1.0 } else { 0.0 }])
+            .collect();
+        let image = image::Rgba32FImage::from_raw(w, h, data).expect("buffer matches resolution");
+        let io_err = |source| FilmError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        crate::write_atomically(path, io_err, |out| {
+            image
+                .write_to(out, image::ImageFormat::OpenExr)
+                .map_err(|e| FilmError::Encode {
+                    path: path.to_path_buf(),
+                    message: e.to_string(),
+                })
+        })
+    }
+
+    /// Reads an OpenEXR film with a coverage (alpha) channel, as
+    /// [`PartialFilm::save`] writes it: alpha 1 is a rendered pixel, anything
+    /// else one to render. A file without alpha is refused (it is not partial).
+    pub fn load(path: &Path) -> Result<Self, FilmError> {
+        let fail = |message: String| FilmError::Read {
+            path: path.to_path_buf(),
+            message,
+        };
+        if ImageFormat::from_path(path).ok() != Some(ImageFormat::Exr) {
+            return Err(fail(
+                "a partial render is an OpenEXR file (.exr), whose alpha channel says which pixels are rendered".into(),
+            ));
+        }
+        let decoded = decode(path, image::ImageFormat::OpenExr).map_err(fail)?;
+        let (w, h) = (decoded.width(), decoded.height());
+        if !decoded.color().has_alpha() {
+            return Err(fail(
+                "it has no coverage (alpha) channel: not the output of an interrupted render"
+                    .into(),
+            ));
+        }
+        let rgba = decoded.into_rgba32f();
+        let mut film = Film::new(glam::UVec2::new(w, h));
+        let mut finished = Vec::with_capacity(film.pixels().len());
+        for (pixel, p) in film.pixels_mut().iter_mut().zip(rgba.pixels()) {
+            *pixel = Vec3::new(p.0[0], p.0[1], p.0[2]);
+            finished.push(p.0[3] == 1.0);
+        }
+        Ok(Self { film, finished })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::UVec2;
+
+    fn partial() -> PartialFilm {
+        let mut film = Film::new(UVec2::new(5, 3));
+        for (k, p) in film.pixels_mut().iter_mut().enumerate() {
+            *p = Vec3::new(k as f32 * 0.37, -1.5e-7, f32::MAX / (k + 1) as f32);
+        }
+        let finished = (0..15).map(|k| k % 3 != 1).collect();
+        PartialFilm { film, finished }
+    }
+
+    #[test]
+    fn exr_keeps_every_value_and_the_coverage_bit_for_bit() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("partial.exr");
+        let original = partial();
+        original.save(&path).unwrap();
+        assert_eq!(PartialFilm::load(&path).unwrap(), original);
+        assert_eq!(original.finished_count(), 10);
+    }
+
+    #[test]
+    fn png_and_pfm_leave_the_unfinished_pixels_black() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("partial.pfm");
+        let original = partial();
+        original.save(&path).unwrap();
+        let read = Film::load(&path).unwrap();
+        for (k, (read, written)) in read.pixels().iter().zip(original.film.pixels()).enumerate() {
+            let expected = if original.finished[k] {
+                *written
+            } else {
+                Vec3::ZERO
+            };
+            assert_eq!(*read, expected, "pixel {k}");
+        }
+    }
+
+    #[test]
+    fn a_complete_or_non_exr_image_is_not_a_partial_render() {
+        let dir = tempfile::tempdir().unwrap();
+        let complete = dir.path().join("complete.exr");
+        partial().film.save(&complete).unwrap();
+        let e = PartialFilm::load(&complete).unwrap_err().to_string();
+        assert!(e.contains("no coverage (alpha) channel"), "{e}");
+        let png = dir.path().join("partial.png");
+        partial().save(&png).unwrap();
+        let e = PartialFilm::load(&png).unwrap_err().to_string();
+        assert!(e.contains("is an OpenEXR file"), "{e}");
+        let e = PartialFilm::load(&dir.path().join("gone.exr"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("gone.exr: cannot read the image"), "{e}");
+    }
+}

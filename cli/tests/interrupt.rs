@@ -1,0 +1,172 @@
+//! Renders stopped by Ctrl-C (SIGINT) or SIGTERM: the pixels finished so far are
+//! written, with one line saying so and the signal's exit status, and
+//! `--resume` finishes an interrupted EXR into the uninterrupted image, bit for
+//! bit.
+
+mod common;
+
+use common::{glint, scene, stderr};
+use std::path::Path;
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// A render of a few seconds at most, long enough to be interrupted: the
+/// Cornell box at 64 × 64 pixels, `spp` samples each.
+fn args(spp: u32, output: &str) -> Vec<String> {
+    [
+        "render",
+        &scene("cornell-set1"),
+        "--resolution",
+        "64x64",
+        "--spp",
+        &spp.to_string(),
+        "--light-samples",
+        "1",
+        "--sampler",
+        "random",
+        "--light-sampler",
+        "random",
+        "-o",
+        output,
+    ]
+    .map(str::to_owned)
+    .to_vec()
+}
+
+fn spawn(args: &[String], dir: &Path) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("glint runs")
+}
+
+fn signal(child: &Child, name: &str) {
+    let status = Command::new("kill")
+        .args([format!("-{name}"), child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(status.success());
+}
+
+/// Starts the render, sends `name` once it has had time to start rendering,
+/// and returns its output and the time from the signal to its exit. Tries
+/// more samples if a render finished before the signal.
+fn interrupted(output: &str, name: &str, dir: &Path) -> (Output, Duration, u32) {
+    for spp in [4096, 16384, 65536] {
+        let child = spawn(&args(spp, output), dir);
+        std::thread::sleep(Duration::from_millis(400));
+        signal(&child, name);
+        let sent = Instant::now();
+        let out = child.wait_with_output().unwrap();
+        if out.status.code() != Some(0) {
+            return (out, sent.elapsed(), spp);
+        }
+    }
+    panic!("every render finished before the signal");
+}
+
+fn no_hidden_files(dir: &Path) {
+    let hidden: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "left behind: {hidden:?}");
+}
+
+#[test]
+fn ctrl_c_writes_the_finished_pixels_and_resume_completes_them_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("out.exr"), b"the previous image").unwrap();
+    let (out, took, spp) = interrupted("out.exr", "INT", dir.path());
+    assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+    assert!(took < Duration::from_secs(2), "took {took:?} to stop");
+    let err = stderr(&out);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("glint: interrupted: wrote out.exr with ") && err.contains("--resume"),
+        "{err}"
+    );
+    no_hidden_files(dir.path());
+    let partial = glint_camera::PartialFilm::load(&dir.path().join("out.exr")).unwrap();
+    let done = partial.finished_count();
+    assert!(
+        done < 64 * 64,
+        "{done} pixels: the render was not cut short"
+    );
+    let resumed = glint(
+        &[args(spp, "out.exr"), vec!["--resume".to_owned()]]
+            .concat()
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert_eq!(resumed.status.code(), Some(0), "{}", stderr(&resumed));
+    let full = glint(
+        &args(spp, "full.exr")
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert_eq!(full.status.code(), Some(0), "{}", stderr(&full));
+    let read = |name: &str| std::fs::read(dir.path().join(name)).unwrap();
+    assert!(
+        read("out.exr") == read("full.exr"),
+        "the resumed image differs"
+    );
+    no_hidden_files(dir.path());
+}
+
+#[test]
+fn sigterm_writes_a_png_with_the_rest_black_and_exits_143() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, _, _) = interrupted("out.png", "TERM", dir.path());
+    assert_eq!(out.status.code(), Some(143), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.starts_with("glint: interrupted: wrote out.png with ") && err.contains("are black"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+    let film = glint_camera::Film::load(&dir.path().join("out.png")).unwrap();
+    assert_eq!(film.resolution(), glam::UVec2::new(64, 64));
+    // The last pixel of the last band is never reached first: black.
+    assert_eq!(film.pixel(63, 63), glam::Vec3::ZERO);
+    no_hidden_files(dir.path());
+}
+
+#[test]
+fn resume_refuses_what_is_not_a_partial_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |output: &str| {
+        let mut a = args(4, output);
+        a.push("--resume".to_owned());
+        glint(
+            &a.iter().map(String::as_str).collect::<Vec<_>>(),
+            dir.path(),
+        )
+    };
+    common::assert_input_error(
+        &run("gone.exr"),
+        "--resume: gone.exr: cannot read the image",
+    );
+    assert_eq!(
+        glint(
+            &args(4, "done.exr")
+                .iter()
+                .map(String::as_str)
+                .collect::<Vec<_>>(),
+            dir.path()
+        )
+        .status
+        .code(),
+        Some(0)
+    );
+    common::assert_input_error(&run("done.exr"), "no coverage (alpha) channel");
+    common::assert_input_error(&run("out.png"), "a partial render is an OpenEXR file");
+}

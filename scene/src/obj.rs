@@ -40,16 +40,34 @@ pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
     let cannot_read =
         |e: &dyn std::fmt::Display| format!("{}: cannot read the OBJ file: {e}", path.display());
     // tobj reports a file it cannot open without the reason.
-    std::fs::File::open(path).map_err(|e| cannot_read(&e))?;
-    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| cannot_read(&e))?;
-    // The MTL materials are needed only without a scene material; then a
-    // material library the OBJ names must be there and parse.
-    let materials = match materials {
-        Ok(materials) => materials,
-        Err(_) if !with_materials => Vec::new(),
-        Err(e) => return Err(material_library_error(path, e)),
-    };
+    let file = std::fs::File::open(path).map_err(|e| cannot_read(&e))?;
+    check_face_indices(path)?;
     let base = path.parent().unwrap_or(Path::new(""));
+    // The MTL materials are read only without a scene material; then a
+    // material library the OBJ names must be there and parse, and one tobj
+    // would panic on is refused first (the loader is `Fn`: the reason is kept
+    // in a cell).
+    let refused = std::cell::RefCell::new(None);
+    let (models, materials) =
+        tobj::load_obj_buf(&mut std::io::BufReader::new(file), &options, |library| {
+            if !with_materials {
+                return Ok(Default::default());
+            }
+            let library = base.join(library);
+            if let Err(e) = check_material_library(&library) {
+                *refused.borrow_mut() = Some(e);
+                return Err(tobj::LoadError::MaterialParseError);
+            }
+            tobj::load_mtl(library)
+        })
+        .map_err(|e| cannot_read(&e))?;
+    if let Some(why) = refused.into_inner() {
+        return Err(format!(
+            "{}: cannot read its material library {why}",
+            path.display()
+        ));
+    }
+    let materials = materials.map_err(|e| material_library_error(path, e))?;
     // MTL images are read only when the scene uses the MTL materials, each once.
     let mut images = HashMap::new();
     let phong = if with_materials {
@@ -69,7 +87,12 @@ pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
         triangle_materials: Vec::new(),
         materials: phong,
         files: std::iter::once(path.to_owned())
-            .chain(material_libraries(path))
+            .chain(
+                with_materials
+                    .then(|| material_libraries(path))
+                    .into_iter()
+                    .flatten(),
+            )
             .chain(images.into_keys())
             .collect(),
     };
@@ -147,15 +170,75 @@ fn material_library_error(path: &Path, e: tobj::LoadError) -> String {
     )
 }
 
+/// Refuses a face index that tobj 4 would overflow on when it scales it to an
+/// array offset (a relative index before the first element, or one beyond
+/// 2⁴⁰), naming the line; tobj reports the other bad indices itself.
+fn check_face_indices(path: &Path) -> Result<(), String> {
+    let Ok(bytes) = std::fs::read(path) else {
+        return Ok(()); // tobj reports it
+    };
+    // Elements so far: positions, texture coordinates, normals.
+    let mut counts = [0i64; 3];
+    for (number, line) in String::from_utf8_lossy(&bytes).lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => counts[0] += 1,
+            Some("vt") => counts[1] += 1,
+            Some("vn") => counts[2] += 1,
+            Some("f") => {
+                for (kind, index) in words.flat_map(|w| w.split('/').enumerate()) {
+                    let (Ok(index), Some(&count)) = (index.parse::<i64>(), counts.get(kind)) else {
+                        continue;
+                    };
+                    if count + index < 0 || index > 1 << 40 {
+                        return Err(format!(
+                            "{}: line {}: face index {index} is out of range",
+                            path.display(),
+                            number + 1
+                        ));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a colour line (`Ka`, `Kd`, `Ks`, `Ke`) with fewer than three values
+/// in the material library at `library`, naming the file and line: tobj 4
+/// panics on one (it unwraps a three-element conversion).
+fn check_material_library(library: &Path) -> Result<(), String> {
+    let Ok(bytes) = std::fs::read(library) else {
+        return Ok(()); // tobj reports it
+    };
+    // tobj reads line by line: the lines before a bad byte still count.
+    for (number, line) in String::from_utf8_lossy(&bytes).lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let key = words.next();
+        if matches!(key, Some("Ka" | "Kd" | "Ks" | "Ke")) && words.count() < 3 {
+            return Err(format!(
+                "{}: line {}: `{}` needs three numbers (r g b)",
+                library.display(),
+                number + 1,
+                key.unwrap_or_default()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The names of the MTL files an OBJ names on its `mtllib` lines.
 fn library_names(path: &Path) -> Vec<String> {
-    let Ok(text) = std::fs::read_to_string(path) else {
+    let Ok(bytes) = std::fs::read(path) else {
         return Vec::new();
     };
-    text.lines()
-        .filter_map(|l| l.trim_start().strip_prefix("mtllib"))
-        .flat_map(|names| names.split_whitespace())
-        .map(str::to_owned)
+    // As tobj reads them: the rest of the line is one name, spaces and all.
+    String::from_utf8_lossy(&bytes)
+        .lines()
+        .map(str::trim)
+        .filter(|l| l.split_whitespace().next() == Some("mtllib"))
+        .map(|l| l.split_once(' ').unwrap_or_default().1.trim().to_owned())
         .collect()
 }
 
@@ -284,5 +367,30 @@ mod tests {
             "{e}"
         );
         assert!(load_obj(&broken, false).is_ok());
+        // Face indices tobj 4 would overflow on: refused by line.
+        for face in [
+            "f 1 2 -9",
+            "f 1/-2 2/1 3/1",
+            "f 1//99999999999999999 2//1 3//1",
+        ] {
+            let far = dir.path().join("far.obj");
+            std::fs::write(
+                &far,
+                format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n{face}\n"),
+            )
+            .unwrap();
+            let e = load_obj(&far, false).err().unwrap();
+            assert!(e.contains("far.obj: line 6: face index"), "{face}: {e}");
+        }
+        // A colour with one value (tobj 4 would panic on it): refused by line.
+        let short = dir.path().join("short.obj");
+        std::fs::write(dir.path().join("short.mtl"), "newmtl red\n\nKs 60\n").unwrap();
+        std::fs::write(&short, format!("mtllib short.mtl\n{faces}")).unwrap();
+        let e = load_obj(&short, true).err().unwrap();
+        assert!(
+            e.contains("short.mtl: line 3: `Ks` needs three numbers"),
+            "{e}"
+        );
+        assert!(load_obj(&short, false).is_ok());
     }
 }

@@ -358,9 +358,14 @@ mod tests {
             "{e}"
         );
         assert_eq!(load_obj(&lost, false).unwrap().indices.len(), 1);
-        let broken = dir.path().join("broken.obj");
-        std::fs::write(dir.path().join("broken.mtl"), "newmtl red\nKd 1 x 0\n").unwrap();
-        std::fs::write(&broken, format!("mtllib broken.mtl\n{faces}")).unwrap();
+        // An OBJ `NAME.obj` of one red triangle whose library `NAME.mtl` is `mtl`.
+        let with_library = |name: &str, mtl: &str| {
+            std::fs::write(dir.path().join(format!("{name}.mtl")), mtl).unwrap();
+            let obj = dir.path().join(format!("{name}.obj"));
+            std::fs::write(&obj, format!("mtllib {name}.mtl\n{faces}")).unwrap();
+            obj
+        };
+        let broken = with_library("broken", "newmtl red\nKd 1 x 0\n");
         let e = load_obj(&broken, true).err().unwrap();
         assert!(
             e.contains("material library broken.mtl: material parse error"),
@@ -383,9 +388,7 @@ mod tests {
             assert!(e.contains("far.obj: line 6: face index"), "{face}: {e}");
         }
         // A colour with one value (tobj 4 would panic on it): refused by line.
-        let short = dir.path().join("short.obj");
-        std::fs::write(dir.path().join("short.mtl"), "newmtl red\n\nKs 60\n").unwrap();
-        std::fs::write(&short, format!("mtllib short.mtl\n{faces}")).unwrap();
+        let short = with_library("short", "newmtl red\n\nKs 60\n");
         let e = load_obj(&short, true).err().unwrap();
         assert!(
             e.contains("short.mtl: line 3: `Ks` needs three numbers"),

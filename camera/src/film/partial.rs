@@ -116,17 +116,19 @@ mod tests {
     #[test]
     fn png_and_pfm_leave_the_unfinished_pixels_black() {
         let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("partial.pfm");
         let original = partial();
-        original.save(&path).unwrap();
-        let read = Film::load(&path).unwrap();
-        for (k, (read, written)) in read.pixels().iter().zip(original.film.pixels()).enumerate() {
-            let expected = if original.finished[k] {
-                *written
-            } else {
-                Vec3::ZERO
-            };
-            assert_eq!(*read, expected, "pixel {k}");
+        for name in ["partial.pfm", "partial.png"] {
+            let path = dir.path().join(name);
+            original.save(&path).unwrap();
+            let read = Film::load(&path).unwrap();
+            for (k, (read, written)) in read.pixels().iter().zip(original.film.pixels()).enumerate()
+            {
+                if !original.finished[k] {
+                    assert_eq!(*read, Vec3::ZERO, "{name}, pixel {k}");
+                } else if name.ends_with("pfm") {
+                    assert_eq!(read, written, "{name}, pixel {k}");
+                }
+            }
         }
     }
 

@@ -123,26 +123,32 @@ fn floor(at: Vec3, scale: f32, degrees: f32, steps: &[f32]) -> Counts {
     for &u in steps {
         for &v in steps {
             let target = at + Vec3::new(-0.9 + 1.8 * u, 0.0, -0.9 + 1.8 * v) * half;
-            let ray = Ray::new(eye, target - eye);
-            counts.rays += 1;
-            let Some(hit) = list.closest_hit(&ray, f32::INFINITY) else {
-                continue;
-            };
-            if !finite(&hit) {
-                counts.non_finite += 1;
-                continue;
-            }
-            let (shadow, t_max) = spawn_ray_to(&hit, light);
-            counts.non_finite += u64::from(!shadow.origin.is_finite());
-            counts.acne += u64::from(list.any_hit(&shadow, t_max));
-            let mirror = spawn_ray(
-                &hit,
-                reflect(-ray.direction.normalize(), hit.geometric_normal),
-            );
-            counts.self_hits += u64::from(list.closest_hit(&mirror, f32::INFINITY).is_some());
+            lit_and_mirrored(&list, &Ray::new(eye, target - eye), light, &mut counts);
         }
     }
     counts
+}
+
+/// Traces `ray` into `list`, where nothing can shadow a point from `light`
+/// on the side its normal points to, nor meet its mirror ray: counts a blocked
+/// shadow ray as acne, a hit of the mirror ray as a self-hit.
+fn lit_and_mirrored(list: &ShapeList, ray: &Ray, light: Vec3, counts: &mut Counts) {
+    counts.rays += 1;
+    let Some(hit) = list.closest_hit(ray, f32::INFINITY) else {
+        return;
+    };
+    if !finite(&hit) {
+        counts.non_finite += 1;
+        return;
+    }
+    if hit.geometric_normal.dot(light - hit.point) > 0.0 {
+        let (shadow, t_max) = spawn_ray_to(&hit, light);
+        counts.non_finite += u64::from(!shadow.origin.is_finite());
+        counts.acne += u64::from(list.any_hit(&shadow, t_max));
+    }
+    let wo = -ray.direction.normalize();
+    let mirror = spawn_ray(&hit, reflect(wo, hit.geometric_normal));
+    counts.self_hits += u64::from(list.closest_hit(&mirror, f32::INFINITY).is_some());
 }
 
 /// A sphere alone, lit from one side: no point with n·l > 0 is shadowed, and no
@@ -158,24 +164,7 @@ fn sphere(at: Vec3, scale: f32, steps: &[f32]) -> Counts {
         for &v in steps {
             // Across the disc the sphere covers, out to its silhouette.
             let target = at + Vec3::new(-1.0 + 2.0 * u, -1.0 + 2.0 * v, 0.0) * scale;
-            let ray = Ray::new(eye, target - eye);
-            counts.rays += 1;
-            let Some(hit) = list.closest_hit(&ray, f32::INFINITY) else {
-                continue;
-            };
-            if !finite(&hit) {
-                counts.non_finite += 1;
-                continue;
-            }
-            if hit.geometric_normal.dot(light - hit.point) > 0.0 {
-                let (shadow, t_max) = spawn_ray_to(&hit, light);
-                counts.acne += u64::from(list.any_hit(&shadow, t_max));
-            }
-            let mirror = spawn_ray(
-                &hit,
-                reflect(-ray.direction.normalize(), hit.geometric_normal),
-            );
-            counts.self_hits += u64::from(list.closest_hit(&mirror, f32::INFINITY).is_some());
+            lit_and_mirrored(&list, &Ray::new(eye, target - eye), light, &mut counts);
         }
     }
     counts
@@ -185,7 +174,7 @@ fn sphere(at: Vec3, scale: f32, steps: &[f32]) -> Counts {
 /// edges or as one `AaBox`, seen from inside, with a light outside: every
 /// camera ray hits a wall, and every shadow ray traced (from a wall the light
 /// is in front of, seen from inside) is blocked by another. Rays are aimed at
-/// a grid over each face, edges and corners included.
+/// `steps` × `steps` points over each face.
 fn closed_box(at: Vec3, scale: f32, steps: &[f32], as_aabox: bool) -> Counts {
     let mut list = ShapeList::new();
     let (lo, hi) = (at - Vec3::splat(scale), at + Vec3::splat(scale));

@@ -28,7 +28,8 @@ use glam::{Vec2, Vec3};
 use glint_geometry::lanes::LANES;
 use glint_geometry::triangle::WatertightRay;
 use glint_geometry::{
-    spawn_ray_to, AaBox, Hit, Parallelogram, Plane, Ray, RayLanes, ShapeList, Sphere, TriangleMesh,
+    spawn_ray_to, AaBox, Hit, Parallelogram, Plane, Ray, RayLanes, RayTarget, ShapeList, Sphere,
+    TriangleMesh,
 };
 use std::hint::black_box;
 use std::time::Duration;
@@ -278,9 +279,13 @@ fn shadow_rays(list: &ShapeList, camera: &[Ray], light: &Parallelogram) -> Shado
     for hit in &points {
         for k in 0..LIGHT_SAMPLES {
             let cell = Vec2::new((k % 4) as f32 + 0.5, (k / 4) as f32 + 0.5) / 4.0;
-            let (ray, t) = spawn_ray_to(hit, light.point_at(cell));
-            rays.push(ray);
-            t_max.push(t);
+            let target = RayTarget {
+                point: light.point_at(cell),
+                error: light.error_bound(),
+                normal: light.normal(),
+            };
+            rays.push(spawn_ray_to(hit, &target));
+            t_max.push(1.0);
         }
     }
     ShadowRays {

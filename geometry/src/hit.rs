@@ -6,6 +6,9 @@ pub struct Hit {
     /// Ray parameter of the hit, in multiples of the ray's direction.
     pub t: f32,
     pub point: Vec3,
+    /// Bound on the rounding error of `point`, per axis: the exact surface point
+    /// lies within `point ± error` ([`crate::error_bounds`]).
+    pub error: Vec3,
     /// Unit normal of the surface as the shape defines it (outward or front side).
     pub geometric_normal: Vec3,
     /// Unit normal used for shading; equals the geometric normal for analytic shapes.
@@ -53,6 +56,7 @@ mod tests {
         let hit = Hit {
             t: 1.0,
             point: Vec3::ZERO,
+            error: Vec3::ZERO,
             geometric_normal: Vec3::Z,
             shading_normal: Vec3::new(0.0, 0.9, -0.1).normalize(),
             uv: Vec2::ZERO,

@@ -15,8 +15,10 @@
 //!   (towards +y on spheres and box sides), as in pbrt; `dpdu` and `dpdv` are the
 //!   partial derivatives of the surface point with respect to them (world units per
 //!   unit of uv), the Jacobian later stages use for texture filtering.
-//! - New rays leaving a surface start at [`offset_ray_origin`], never at a fixed
-//!   epsilon: the offset scales with the magnitude of the hit point.
+//! - Every [`Hit`] carries an error bound of its point ([`Hit::error`], derived
+//!   shape by shape in [`error_bounds`]); new rays leaving a surface start just
+//!   outside it ([`offset_ray_origin`]), and shadow rays end just short of the
+//!   light's surface ([`RayTarget`]). No distance is a fixed epsilon.
 //! - Triangles are intersected watertightly ([`triangle`]): rays through shared
 //!   edges and vertices of a closed mesh never slip through. Hits at exactly equal
 //!   distances go to the lowest object index, with or without the BVH.
@@ -40,7 +42,8 @@
 //!   [`ParallelogramPacket`]).
 //! - [`CountingGuard`] and [`take_counters`]: counts of BVH visits and tests by
 //!   shape ([`QueryCounters`]) for `--stats`.
-//! - [`spawn_ray`] and [`spawn_ray_to`] start secondary rays off a [`Hit`].
+//! - [`spawn_ray`] and [`spawn_ray_to`] start secondary rays off a [`Hit`], the
+//!   latter towards a [`RayTarget`].
 //! - [`Hit::differentials`] turns a [`RayDifferential`] into the pixel's footprint
 //!   on the surface ([`SurfaceDifferentials`]); [`reflect_differential`] follows it
 //!   through a mirror.
@@ -53,6 +56,7 @@
 pub mod bvh;
 mod counters;
 mod differentials;
+pub mod error_bounds;
 mod hit;
 pub mod lanes;
 mod offset;
@@ -64,7 +68,7 @@ mod shapes;
 pub use counters::{take_counters, CountingGuard, QueryCounters};
 pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceDifferentials};
 pub use hit::Hit;
-pub use offset::{offset_ray_origin, offset_ray_origins, spawn_ray, spawn_ray_to, SHADOW_EPSILON};
+pub use offset::{offset_ray_origin, offset_ray_origins, spawn_ray, spawn_ray_to, RayTarget};
 pub use ray::Ray;
 pub use shape_list::{ClosestLanes, ObjectRef, Occluders, PrimitiveHit, ShapeList};
 pub use shapes::{triangle, triangle_packet};

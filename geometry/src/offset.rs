@@ -1,58 +1,58 @@
 //! Starting secondary rays without self-intersection.
 //!
-//! Wächter and Binder, "A Fast and Robust Method for Avoiding Self-Intersection",
-//! Ray Tracing Gems (2019), chapter 6: the origin is pushed along the normal by a
-//! fixed number of ULPs of each coordinate, so the offset grows with the magnitude
-//! of the point (its floating-point error grows the same way). Near the world origin,
-//! where ULPs become tiny, a small absolute offset takes over.
+//! A computed hit point is only known to lie within its error bound
+//! ([`Hit::error`], see [`crate::error_bounds`]) of the surface. A new ray starts
+//! outside that box of uncertainty: moved along the normal by the bound's extent
+//! in that direction, `d = |n|·error`, then each coordinate one float further the
+//! way it moved, so that the rounding of the sum cannot leave it on the surface
+//! (Pharr, Jakob and Humphreys, *pbrt-v4*, §6.8.6). The offset scales with the
+//! magnitude of the point, as its error does, and with nothing else: there is no
+//! fixed epsilon.
 
-use crate::lanes::I32Lanes;
 use crate::lanes::{self, F32Lanes, Vec3Lanes};
 use crate::{Hit, Ray};
 use glam::Vec3;
 
-const ORIGIN: f32 = 1.0 / 32.0;
-const FLOAT_SCALE: f32 = 1.0 / 65536.0;
-const INT_SCALE: f32 = 256.0;
-
-/// Fraction of a shadow ray's length left unexamined at its far end, so that the
-/// surface the ray aims at (a light sample) does not occlude itself.
-pub const SHADOW_EPSILON: f32 = 1e-4;
-
-/// `point` moved off its surface to the side that `normal` points to.
-pub fn offset_ray_origin(point: Vec3, normal: Vec3) -> Vec3 {
-    let offset_int = (INT_SCALE * normal).as_ivec3();
-    let nudge = |p: f32, o: i32| {
-        let o = if p < 0.0 { -o } else { o };
-        f32::from_bits((p.to_bits() as i32).wrapping_add(o) as u32)
+/// `point`, known within `error` (per axis) of its surface, moved off the surface
+/// to the side that the unit `normal` points to.
+#[inline(always)]
+pub fn offset_ray_origin(point: Vec3, error: Vec3, normal: Vec3) -> Vec3 {
+    let d = normal.abs().dot(error);
+    let offset = d * normal;
+    let moved = point + offset;
+    // Both neighbours, then a choice: selects rather than branches on the
+    // offset's sign, which varies unpredictably from point to point.
+    let away = |p: f32, o: f32| {
+        let (up, down) = (p.next_up(), p.next_down());
+        let up_or_p = if o > 0.0 { up } else { p };
+        if o < 0.0 {
+            down
+        } else {
+            up_or_p
+        }
     };
-    let p_int = Vec3::new(
-        nudge(point.x, offset_int.x),
-        nudge(point.y, offset_int.y),
-        nudge(point.z, offset_int.z),
-    );
-    let near_origin = point.abs().cmplt(Vec3::splat(ORIGIN));
-    Vec3::select(near_origin, point + FLOAT_SCALE * normal, p_int)
+    Vec3::new(
+        away(moved.x, offset.x),
+        away(moved.y, offset.y),
+        away(moved.z, offset.z),
+    )
 }
 
-/// [`offset_ray_origin`] for [`LANES`](crate::lanes::LANES) points at once, each lane bit for bit the
-/// scalar origin (the same integer nudge of the bits, the same small absolute
-/// offset near the world origin).
+/// [`offset_ray_origin`] for [`LANES`](crate::lanes::LANES) points at once, each
+/// lane bit for bit the scalar origin.
 #[inline]
-pub fn offset_ray_origins(point: &Vec3Lanes, normal: &Vec3Lanes) -> Vec3Lanes {
-    let axis = |p: F32Lanes, n: F32Lanes| {
-        // `as i32` per lane: truncation, NaN to 0, saturating.
-        let o = (F32Lanes::splat(INT_SCALE) * n).trunc_int();
-        let negative: I32Lanes = bytemuck::cast(lanes::lt(p, F32Lanes::ZERO));
-        let o = negative.select(-o, o);
-        let p_int: F32Lanes = bytemuck::cast(bytemuck::cast::<F32Lanes, I32Lanes>(p) + o);
-        let near_origin = lanes::lt(p.abs(), F32Lanes::splat(ORIGIN));
-        near_origin.select(p + F32Lanes::splat(FLOAT_SCALE) * n, p_int)
+pub fn offset_ray_origins(point: &Vec3Lanes, error: &Vec3Lanes, normal: &Vec3Lanes) -> Vec3Lanes {
+    let d = normal.abs().dot(error);
+    let offset = normal.scale(d);
+    let moved = *point + offset;
+    let away = |p: F32Lanes, o: F32Lanes| {
+        let down = lanes::lt(o, F32Lanes::ZERO).select(lanes::next_down(p), p);
+        lanes::gt(o, F32Lanes::ZERO).select(lanes::next_up(p), down)
     };
     Vec3Lanes {
-        x: axis(point.x, normal.x),
-        y: axis(point.y, normal.y),
-        z: axis(point.z, normal.z),
+        x: away(moved.x, offset.x),
+        y: away(moved.y, offset.y),
+        z: away(moved.z, offset.z),
     }
 }
 
@@ -67,34 +67,64 @@ fn outgoing_normal(hit: &Hit, direction: Vec3) -> Vec3 {
 
 /// A ray leaving `hit` along `direction`.
 pub fn spawn_ray(hit: &Hit, direction: Vec3) -> Ray {
-    let origin = offset_ray_origin(hit.point, outgoing_normal(hit, direction));
+    let origin = offset_ray_origin(hit.point, hit.error, outgoing_normal(hit, direction));
     Ray::new(origin, direction)
 }
 
-/// A ray from `hit` towards `target`, with the `t_max` to pass to occlusion
-/// queries: the direction is `target − origin`, so `t = 1` is the target itself,
-/// and `t_max = 1 − SHADOW_EPSILON` stops just short of it.
-pub fn spawn_ray_to(hit: &Hit, target: Vec3) -> (Ray, f32) {
-    let origin = offset_ray_origin(hit.point, outgoing_normal(hit, target - hit.point));
-    (Ray::new(origin, target - origin), 1.0 - SHADOW_EPSILON)
+/// A point a shadow ray aims at: a light's sample point, with the error bound of
+/// its computed position and the unit normal of the light's side the rays
+/// arrive on, or an exactly known point (a point light).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayTarget {
+    pub point: Vec3,
+    pub error: Vec3,
+    pub normal: Vec3,
+}
+
+impl RayTarget {
+    /// A point known exactly and on no surface: the ray ends at it.
+    pub fn exact(point: Vec3) -> Self {
+        Self {
+            point,
+            error: Vec3::ZERO,
+            normal: Vec3::ZERO,
+        }
+    }
+
+    /// Where a ray towards the target ends: the point moved off its surface
+    /// towards `normal` by its error bound (the point itself when exact).
+    #[inline]
+    pub fn end(&self) -> Vec3 {
+        offset_ray_origin(self.point, self.error, self.normal)
+    }
+}
+
+/// A shadow ray from `hit` towards `target`: from the offset origin to the
+/// target's offset [`end`](RayTarget::end), so that occlusion queries with
+/// `t_max = 1` test the open segment between the two surfaces and neither
+/// surface itself. The origin leaves on the side of `hit` that the target is on.
+pub fn spawn_ray_to(hit: &Hit, target: &RayTarget) -> Ray {
+    let normal = outgoing_normal(hit, target.point - hit.point);
+    let origin = offset_ray_origin(hit.point, hit.error, normal);
+    Ray::new(origin, target.end() - origin)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error_bounds::gamma;
     use crate::lanes::LANES;
 
     #[test]
     fn origins_in_lanes_are_the_scalar_origins_bit_for_bit() {
-        // Coordinates of every size and sign, zeros of both signs, values at the
-        // near-origin threshold, and normals along and across the axes.
+        // Coordinates of every size and sign, zeros of both signs, errors from
+        // zero up, and normals along and across the axes.
         let values = [
             0.0,
             -0.0,
             1e-30,
             -1e-30,
             0.03124,
-            0.03125,
             -0.03126,
             0.5,
             -2.0,
@@ -113,20 +143,24 @@ mod tests {
         ];
         let mut compared = 0;
         for (i, _) in values.iter().enumerate() {
-            let points: [Vec3; LANES] = std::array::from_fn(|k| {
-                let v = |j: usize| values[(i + j * 3 + k) % values.len()];
-                Vec3::new(v(0), v(1), v(2))
-            });
+            let v = |j: usize, k: usize| values[(i + j * 3 + k) % values.len()];
+            let points: [Vec3; LANES] =
+                std::array::from_fn(|k| Vec3::new(v(0, k), v(1, k), v(2, k)));
+            let errors: [Vec3; LANES] = std::array::from_fn(|k| gamma(k as u32) * points[k].abs());
             let ns: [Vec3; LANES] = std::array::from_fn(|k| normals[(i + k) % normals.len()]);
-            let lanes =
-                offset_ray_origins(&Vec3Lanes::from_lanes(points), &Vec3Lanes::from_lanes(ns));
+            let lanes = offset_ray_origins(
+                &Vec3Lanes::from_lanes(points),
+                &Vec3Lanes::from_lanes(errors),
+                &Vec3Lanes::from_lanes(ns),
+            );
             for k in 0..LANES {
-                let scalar = offset_ray_origin(points[k], ns[k]);
+                let scalar = offset_ray_origin(points[k], errors[k], ns[k]);
                 assert_eq!(
                     lanes.lane(k).to_array().map(f32::to_bits),
                     scalar.to_array().map(f32::to_bits),
-                    "{} along {}",
+                    "{} ± {} along {}",
                     points[k],
+                    errors[k],
                     ns[k]
                 );
                 compared += 1;
@@ -135,21 +169,58 @@ mod tests {
         assert_eq!(compared, LANES * values.len());
     }
 
+    /// The origin leaves the error box: along the normal by more than the
+    /// bound's extent `d`, and by not much more (one float per axis).
     #[test]
-    fn offset_moves_to_the_normal_side_and_scales_with_magnitude() {
+    fn the_offset_clears_the_error_bound_and_no_more() {
         for p in [
             Vec3::new(1.0, 2.0, 3.0),
             Vec3::new(-1000.0, 5000.0, -20000.0),
+            Vec3::new(1e-6, -3e-7, 0.0),
         ] {
-            let n = Vec3::new(0.0, 1.0, 0.0);
-            let o = offset_ray_origin(p, n);
-            assert!(o.y > p.y);
-            assert_eq!((o.x, o.z), (p.x, p.z));
-            // 256 ULPs: relative offset about 256 * 2^-23 of the coordinate.
-            let rel = (o.y - p.y) / p.y.abs();
-            assert!(rel > 1e-5 && rel < 1e-4, "relative offset {rel}");
+            let error = gamma(7) * p.abs();
+            for n in [Vec3::Y, Vec3::new(0.6, 0.0, -0.8), -Vec3::X] {
+                let o = offset_ray_origin(p, error, n);
+                let d = n.abs().dot(error);
+                let along = (o.as_dvec3() - p.as_dvec3()).dot(n.as_dvec3());
+                assert!(along > d as f64, "{p} along {n}: {along} <= {d}");
+                let ulp = p.abs().max_element().next_up() - p.abs().max_element();
+                assert!(along <= (d + 2.0 * ulp) as f64, "{p} along {n}: {along}");
+            }
         }
-        let tiny = offset_ray_origin(Vec3::ZERO, -Vec3::Z);
-        assert_eq!(tiny, Vec3::new(0.0, 0.0, -FLOAT_SCALE));
+        // Even with no error, the origin moves by one float (not at all along an
+        // axis the normal has no component on).
+        let o = offset_ray_origin(Vec3::new(1.0, 0.0, 2.0), Vec3::splat(1e-30), -Vec3::Z);
+        assert_eq!(o, Vec3::new(1.0, 0.0, 2f32.next_down()));
+    }
+
+    #[test]
+    fn an_exact_target_is_the_end_of_its_ray_and_a_surface_one_stops_short() {
+        let hit = Hit {
+            t: 1.0,
+            point: Vec3::new(0.0, 0.0, 0.0),
+            error: Vec3::splat(1e-7),
+            geometric_normal: Vec3::Y,
+            shading_normal: Vec3::Y,
+            uv: glam::Vec2::ZERO,
+            dpdu: Vec3::X,
+            dpdv: Vec3::Z,
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
+            front_face: true,
+            shape: 0,
+            primitive: 0,
+        };
+        let light = Vec3::new(0.3, 5.0, -0.2);
+        let ray = spawn_ray_to(&hit, &RayTarget::exact(light));
+        assert_eq!(ray.origin + ray.direction, light);
+        assert!(ray.origin.y > 0.0);
+        let on_light = RayTarget {
+            point: light,
+            error: gamma(7) * Vec3::splat(5.0),
+            normal: -Vec3::Y,
+        };
+        let short = spawn_ray_to(&hit, &on_light);
+        assert!((short.origin + short.direction).y < light.y);
     }
 }

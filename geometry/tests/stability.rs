@@ -4,14 +4,14 @@
 //! spans at least a thousandth of its distance from the origin).
 //!
 //! - A ray aimed at a sphere's centre from outside always hits it.
-//! - A hit point lies on its surface closer than the offset of a spawned ray's
-//!   origin: the offset origin is on the side of the surface it was moved to,
-//!   for either side.
+//! - A hit point lies within its error bound of the exact surface (measured in
+//!   f64), and the offset origin of a spawned ray is on the side of the surface
+//!   it was moved to, for either side.
 //! - A ray spawned from a hit towards a point on the outgoing side (a light)
 //!   never hits that surface again.
 
 use glam::Vec3;
-use glint_geometry::{offset_ray_origin, spawn_ray_to, Hit, Parallelogram, Ray, Sphere};
+use glint_geometry::{offset_ray_origin, spawn_ray_to, Hit, Parallelogram, Ray, RayTarget, Sphere};
 use proptest::prelude::*;
 
 /// A scale from the list the stability work names, and a translation of up to
@@ -88,7 +88,13 @@ fn wall_and_ray() -> impl Strategy<Value = (Parallelogram, Ray)> {
 /// How far the offset origin of `hit` (moved along `normal`) lies from it,
 /// along `normal`.
 fn offset_distance(hit: &Hit, normal: Vec3) -> f32 {
-    (offset_ray_origin(hit.point, normal) - hit.point).dot(normal)
+    (offset_ray_origin(hit.point, hit.error, normal) - hit.point).dot(normal)
+}
+
+/// The extent of `hit`'s error bound along its normal: how far off the exact
+/// surface its point may be.
+fn error_along_normal(hit: &Hit) -> f64 {
+    hit.geometric_normal.abs().dot(hit.error) as f64
 }
 
 proptest! {
@@ -111,12 +117,14 @@ proptest! {
         let t = sphere.hit_distance(&ray, f32::INFINITY).unwrap();
         let hit = sphere.surface_at(&ray, t);
         let n = hit.geometric_normal;
-        let outside = offset_ray_origin(hit.point, n);
-        let inside = offset_ray_origin(hit.point, -n);
+        let outside = offset_ray_origin(hit.point, hit.error, n);
+        let inside = offset_ray_origin(hit.point, hit.error, -n);
         let c = sphere.center();
         prop_assert!(outside.distance(c) > sphere.radius(), "outside {} at {}", outside.distance(c), sphere.radius());
         prop_assert!(inside.distance(c) < sphere.radius(), "inside {} at {}", inside.distance(c), sphere.radius());
         prop_assert!(offset_distance(&hit, n) > 0.0);
+        let off = (hit.point.as_dvec3() - c.as_dvec3()).length() - sphere.radius() as f64;
+        prop_assert!(off.abs() <= error_along_normal(&hit), "{off} off, bound {}", error_along_normal(&hit));
     }
 
     #[test]
@@ -125,8 +133,13 @@ proptest! {
         let hit = wall.surface_at(&ray, t);
         let n = hit.geometric_normal;
         let height = |p: Vec3| (p - wall.center()).dot(n);
-        prop_assert!(height(offset_ray_origin(hit.point, n)) > 0.0);
-        prop_assert!(height(offset_ray_origin(hit.point, -n)) < 0.0);
+        prop_assert!(height(offset_ray_origin(hit.point, hit.error, n)) > 0.0);
+        prop_assert!(height(offset_ray_origin(hit.point, hit.error, -n)) < 0.0);
+        // The exact plane through the wall's corner, in f64.
+        let (e1, e2) = wall.edges();
+        let exact_normal = e1.as_dvec3().cross(e2.as_dvec3()).normalize();
+        let off = (hit.point.as_dvec3() - wall.origin().as_dvec3()).dot(exact_normal);
+        prop_assert!(off.abs() <= error_along_normal(&hit), "{off} off, bound {}", error_along_normal(&hit));
     }
 
     #[test]
@@ -137,8 +150,8 @@ proptest! {
         let n = hit.geometric_normal;
         let towards = if light.dot(n) > 0.05 { light } else { (light + n * (0.05 - light.dot(n) + 0.01)).normalize() };
         let target = hit.point + towards * sphere.radius() * far;
-        let (shadow, t_max) = spawn_ray_to(&hit, target);
-        prop_assert_eq!(sphere.hit_distance(&shadow, t_max), None);
+        let shadow = spawn_ray_to(&hit, &RayTarget::exact(target));
+        prop_assert_eq!(sphere.hit_distance(&shadow, 1.0), None);
     }
 
     #[test]
@@ -149,7 +162,7 @@ proptest! {
         // Either side: a two-sided wall is lit from both.
         let towards = if light.dot(n).abs() > 0.01 { light } else { (light + n * 0.02).normalize() };
         let target = hit.point + towards * wall.edges().0.length() * far;
-        let (shadow, t_max) = spawn_ray_to(&hit, target);
-        prop_assert_eq!(wall.hit_distance(&shadow, t_max), None);
+        let shadow = spawn_ray_to(&hit, &RayTarget::exact(target));
+        prop_assert_eq!(wall.hit_distance(&shadow, 1.0), None);
     }
 }

@@ -25,7 +25,6 @@ use glam::Vec2;
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{
     offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayLanes, Shape, SurfaceLanes,
-    SHADOW_EPSILON,
 };
 use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial};
 use glint_texture::{TexCoord, Texture};
@@ -148,6 +147,8 @@ struct ShadedLanes<'a> {
     /// The lanes holding a point (bit k for lane k).
     lanes: u32,
     point: Vec3Lanes,
+    /// The error bound of `point` ([`glint_geometry::Hit::error`]).
+    error: Vec3Lanes,
     geometric_normal: Vec3Lanes,
     /// The geometric normals on the viewer's side.
     ng: Vec3Lanes,
@@ -161,6 +162,7 @@ impl<'a> ShadedLanes<'a> {
             .set(k, material, p.kd, p.ks, p.n, p.v, p.has_specular);
         self.lanes |= 1 << k;
         self.point.set_lane(k, p.hit.point);
+        self.error.set_lane(k, p.hit.error);
         self.geometric_normal.set_lane(k, p.hit.geometric_normal);
         self.ng.set_lane(k, p.ng);
     }
@@ -214,6 +216,7 @@ impl<'a> ShadedLanes<'a> {
         *radiance = Vec3Lanes::select(lanes::from_bits(hit_lanes), &ambient, radiance);
         self.lanes = hit_lanes;
         self.point = surface.point;
+        self.error = surface.error;
         self.geometric_normal = surface.normal;
         self.ng = ng;
         true
@@ -253,30 +256,25 @@ impl<'a> ShadedLanes<'a> {
             traced,
             specular,
         );
-        let visible = traced & !self.blocked(scene, &position, &towards, traced);
+        let ends = light.shadow_ends(&position);
+        let visible = traced & !self.blocked(scene, &ends, &towards, traced);
         Vec3Lanes::select(lanes::from_bits(visible), &reflected, &Vec3Lanes::default())
     }
 
     /// The `traced` lanes whose shadow ray, from the point (offset to the side
-    /// `towards` leaves on) to `position`, is blocked.
-    fn blocked(
-        &self,
-        scene: &Scene,
-        position: &Vec3Lanes,
-        towards: &Vec3Lanes,
-        traced: u32,
-    ) -> u32 {
+    /// `towards` leaves on) to `end` (a light point off its surface), is blocked.
+    fn blocked(&self, scene: &Scene, end: &Vec3Lanes, towards: &Vec3Lanes, traced: u32) -> u32 {
         let from_back = lanes::lt(towards.dot(&self.geometric_normal), F32Lanes::ZERO);
         let outgoing =
             Vec3Lanes::select(from_back, &-self.geometric_normal, &self.geometric_normal);
-        let origin = offset_ray_origins(&self.point, &outgoing);
+        let origin = offset_ray_origins(&self.point, &self.error, &outgoing);
         let rays = RayLanes {
             origin,
-            direction: *position - origin,
+            direction: *end - origin,
         };
         scene
             .shapes
-            .any_hits_among(&Occluders::ALL, &rays, 1.0 - SHADOW_EPSILON, traced)
+            .any_hits_among(&Occluders::ALL, &rays, 1.0, traced)
     }
 }
 

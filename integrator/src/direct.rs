@@ -4,7 +4,7 @@ use crate::sampling::{DimensionPair, PixelSample, SamplePattern, MAX_JOINT};
 use crate::{Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::{
-    reflect_differential, spawn_ray, spawn_ray_to, Hit, Occluders, Ray, RayDifferential,
+    reflect_differential, spawn_ray, spawn_ray_to, Hit, Occluders, Ray, RayDifferential, RayTarget,
 };
 use glint_lighting::{AreaLight, Light, PhongMaterial};
 use glint_texture::TexCoord;
@@ -157,8 +157,9 @@ impl DirectIntegrator {
         for (index, light) in scene.lights.iter().enumerate() {
             radiance += match light {
                 Light::Point(p) => {
+                    let target = RayTarget::exact(p.position);
                     let reflected =
-                        point.unoccluded_reflection(scene, p.position, &Occluders::ALL, ctx);
+                        point.unoccluded_reflection(scene, &target, &Occluders::ALL, ctx);
                     p.color * reflected
                 }
                 Light::Area(area) => {
@@ -347,17 +348,17 @@ impl<'a> ShadingPoint<'a> {
 }
 
 impl ShadingPoint<'_> {
-    /// Phong reflection towards `v` of a unit light at `position`, or zero if the
+    /// Phong reflection towards `v` of a unit light at `target`, or zero if the
     /// light is behind the surface or a shadow ray finds it occluded (testing only
     /// `occluders`). The shadow ray is only traced when the light could contribute.
     pub(crate) fn unoccluded_reflection(
         &self,
         scene: &Scene,
-        position: Vec3,
+        target: &RayTarget,
         occluders: &Occluders,
         ctx: &mut SampleContext,
     ) -> Vec3 {
-        let Some(l) = (position - self.hit.point).try_normalize() else {
+        let Some(l) = (target.point - self.hit.point).try_normalize() else {
             return Vec3::ZERO;
         };
         if !self.above_surface(l) {
@@ -374,9 +375,9 @@ impl ShadingPoint<'_> {
             ctx.counters.skipped_zero_brdf += 1;
             return Vec3::ZERO;
         }
-        let (shadow, t_max) = spawn_ray_to(self.hit, position);
+        let shadow = spawn_ray_to(self.hit, target);
         ctx.counters.light_shadow_rays += 1;
-        if scene.shapes.any_hit_among(occluders, &shadow, t_max) {
+        if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
             Vec3::ZERO
         } else {
             reflected

@@ -17,7 +17,7 @@ use crate::direct::{SampleContext, ShadingPoint};
 use crate::{Scene, ShadingCounters};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
-use glint_geometry::{offset_ray_origin, Occluders, RayLanes, SHADOW_EPSILON};
+use glint_geometry::{offset_ray_origin, Occluders, RayLanes};
 use glint_lighting::AreaLight;
 
 /// From this many samples per light on, the samples are shaded in lanes; below
@@ -44,8 +44,8 @@ impl ShadingPoint<'_> {
         // A shadow ray leaves from the side of the surface its target is on: one of
         // two offset origins, the same for all of the point's samples.
         let origins = [
-            Vec3Lanes::splat(offset_ray_origin(point, normal)),
-            Vec3Lanes::splat(offset_ray_origin(point, -normal)),
+            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, normal)),
+            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, -normal)),
         ];
         let mut sum = Vec3::ZERO;
         for chunk in samples.chunks(LANES) {
@@ -71,12 +71,11 @@ impl ShadingPoint<'_> {
             let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);
             let shadow_rays = RayLanes {
                 origin,
-                direction: position - origin,
+                direction: light.shadow_ends(&position) - origin,
             };
-            let blocked =
-                scene
-                    .shapes
-                    .any_hits_among(occluders, &shadow_rays, 1.0 - SHADOW_EPSILON, traced);
+            let blocked = scene
+                .shapes
+                .any_hits_among(occluders, &shadow_rays, 1.0, traced);
             let visible = traced & !blocked;
             for k in 0..chunk.len() {
                 if lit >> k & 1 == 1 {
@@ -126,7 +125,8 @@ impl ShadingPoint<'_> {
         for &u in samples {
             let position = light.sample_point(u);
             if light.illuminates(position, self.hit.point) {
-                sum += self.unoccluded_reflection(scene, position, occluders, ctx);
+                let target = light.shadow_target(position);
+                sum += self.unoccluded_reflection(scene, &target, occluders, ctx);
             } else {
                 ctx.counters.skipped_behind_light += 1;
             }

@@ -1,6 +1,6 @@
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes};
-use glint_geometry::Parallelogram;
+use glint_geometry::{offset_ray_origins, Parallelogram, RayTarget};
 
 /// A rectangular (parallelogram) light of uniform color, emitting from its front side.
 ///
@@ -54,6 +54,29 @@ impl AreaLight {
         Vec3Lanes::splat(self.surface.origin())
             + Vec3Lanes::scaled_splat(e1, ux)
             + Vec3Lanes::scaled_splat(e2, uy)
+    }
+
+    /// What a shadow ray towards the light point `position` aims at: the point
+    /// with its error bound, to be left on the emitting side, so that the ray
+    /// ends just short of the light's own surface.
+    #[inline]
+    pub fn shadow_target(&self, position: Vec3) -> RayTarget {
+        RayTarget {
+            point: position,
+            error: self.surface.error_bound(),
+            normal: self.surface.normal(),
+        }
+    }
+
+    /// [`RayTarget::end`] of [`Self::shadow_target`] for each lane's light
+    /// point, bit for bit.
+    #[inline]
+    pub fn shadow_ends(&self, light_points: &Vec3Lanes) -> Vec3Lanes {
+        offset_ray_origins(
+            light_points,
+            &Vec3Lanes::splat(self.surface.error_bound()),
+            &Vec3Lanes::splat(self.surface.normal()),
+        )
     }
 
     /// [`Self::illuminates`] for [`LANES`](glint_geometry::lanes::LANES) light points at once: the mask of the

@@ -421,7 +421,8 @@ mod tests {
             for _ in 0..4 {
                 let (a, b) = (next(), next());
                 let target = light[0] + a * (light[1] - light[0]) + b * (light[3] - light[0]);
-                let (shadow, t_max) = crate::spawn_ray_to(&hit, target);
+                let shadow = crate::spawn_ray_to(&hit, &crate::RayTarget::exact(target));
+                let t_max = 1.0;
                 let expected = plain.any_hit(&shadow, t_max);
                 assert_eq!(list.any_hit_among(&occluders, &shadow, t_max), expected);
                 blocked += expected as u32;

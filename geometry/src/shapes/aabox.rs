@@ -1,5 +1,6 @@
 //! Axis-aligned boxes: the ray–box test and the per-face uv squares.
 
+use crate::error_bounds::gamma;
 use crate::{Hit, Parallelogram, Ray};
 use glam::{Vec2, Vec3};
 
@@ -8,6 +9,10 @@ use glam::{Vec2, Vec3};
 /// Each face carries its own uv square, upright as seen from outside the box: on the
 /// four side faces u runs to the viewer's right and v up (+y); on the top face v
 /// runs towards −z, on the bottom face towards +z (see `FACES`).
+///
+/// A hit point's face coordinate is the face's own, exactly; its other two are
+/// kept one float inside the box, so that a ray leaving a point on an edge
+/// leaves through the box's inside ([`crate::error_bounds`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AaBox {
     min: Vec3,
@@ -112,9 +117,16 @@ impl AaBox {
         dpdu[ua] = us * extent[ua];
         let mut dpdv = Vec3::ZERO;
         dpdv[va] = vs * extent[va];
+        let inner_min = Vec3::from_array(self.min.to_array().map(f32::next_up));
+        let inner_max = Vec3::from_array(self.max.to_array().map(f32::next_down));
+        let face_coordinate = point[axis];
+        // max then min, not clamp: a box a few floats wide has inner_min > inner_max.
+        point = point.max(inner_min).min(inner_max);
+        point[axis] = face_coordinate;
         Hit {
             t,
             point,
+            error: gamma(1) * point.abs(),
             geometric_normal: normal,
             shading_normal: normal,
             uv: 0.5 * (Vec2::new(us * q[ua], vs * q[va]) + Vec2::ONE),

@@ -1,5 +1,6 @@
 //! Indexed triangle meshes.
 
+use crate::error_bounds::gamma;
 use crate::triangle::WatertightRay;
 use crate::{Hit, Ray};
 use glam::{Affine3A, Mat3, Vec2, Vec3};
@@ -241,6 +242,7 @@ impl TriangleMesh {
         let tri = self.indices[i as usize];
         // The barycentric point is more accurate than o + t·d.
         let point = bary[0] * a + bary[1] * b + bary[2] * c;
+        let error = gamma(7) * ((bary[0] * a).abs() + (bary[1] * b).abs() + (bary[2] * c).abs());
         // Normalising the edges first keeps tiny (but hit) triangles from
         // underflowing to a zero cross product.
         let face = (b - a)
@@ -305,6 +307,7 @@ impl TriangleMesh {
         Some(Hit {
             t,
             point,
+            error,
             geometric_normal: face,
             shading_normal,
             uv,

@@ -1,6 +1,7 @@
 //! Parallelograms (the course's walls and area lights): the ray test and the
 //! uv mapping by edge coordinates.
 
+use crate::error_bounds::gamma;
 use crate::{Hit, Ray};
 use glam::{Vec2, Vec3};
 
@@ -9,6 +10,13 @@ use glam::{Vec2, Vec3};
 /// Its front side is the one `normal` points to; by default
 /// `normalize(edge1 × edge2)`. uv = (α, β), so `dpdu = edge1` and `dpdv = edge2`.
 /// A one-sided parallelogram is seen only from its front side.
+///
+/// The ray test counts a point as inside when its edge coordinates are within
+/// their rounding error of [0, 1] ([`Self::edge_margin`]), so that a ray aimed
+/// at the edge two walls share meets at least one of them. Hit points are kept
+/// inside the edges by twice their error bound (`pull`), so that a ray leaving
+/// a point on an edge cannot slip out through a wall that meets it there
+/// ([`crate::error_bounds`]); uv is not pulled.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Parallelogram {
     pub(super) origin: Vec3,
@@ -18,6 +26,16 @@ pub struct Parallelogram {
     pub(super) two_sided: bool,
     /// `(e1 × e2) / |e1 × e2|²`: turns cross products into the coordinates α, β.
     pub(super) w: Vec3,
+    /// The error bound of every point of the parallelogram, per axis.
+    pub(super) error: Vec3,
+    /// How far in (α, β) hit points are kept from the edges: twice the error
+    /// bound, in units of each edge, at most ½.
+    pub(super) pull: Vec2,
+    /// `‖origin‖∞ + ‖edge1‖∞ + ‖edge2‖∞`: the magnitudes the ray test rounds.
+    pub(super) extent: f32,
+    /// `(|e₂|, |e₁|) / |e₁ × e₂|`: how much α and β change per unit length
+    /// across the edges they measure from.
+    pub(super) coordinate_scale: Vec2,
 }
 
 impl Parallelogram {
@@ -30,6 +48,12 @@ impl Parallelogram {
         if area2.is_nan() || area2 <= 1e-12 * scale || !area2.is_finite() {
             return None;
         }
+        let error = gamma(7) * (origin.abs() + edge1.abs() + edge2.abs());
+        let reach = 2.0 * error.length();
+        let pull = Vec2::new(reach / edge1.length(), reach / edge2.length()).min(Vec2::splat(0.5));
+        let extent =
+            origin.abs().max_element() + edge1.abs().max_element() + edge2.abs().max_element();
+        let coordinate_scale = Vec2::new(edge2.length(), edge1.length()) / area2.sqrt();
         Some(Self {
             origin,
             edge1,
@@ -37,6 +61,10 @@ impl Parallelogram {
             normal: n.normalize(),
             two_sided,
             w: n / area2,
+            error,
+            pull,
+            extent,
+            coordinate_scale,
         })
     }
 
@@ -70,6 +98,11 @@ impl Parallelogram {
         let (o, e1, e2) = (self.origin, self.edge1, self.edge2);
         [o, o + e1, o + e1 + e2, o + e2]
     }
+    /// The bound on the rounding error of [`Self::point_at`] anywhere on the
+    /// parallelogram, per axis ([`crate::error_bounds`]).
+    pub fn error_bound(&self) -> Vec3 {
+        self.error
+    }
     /// The point with coordinates `(α, β)` ∈ `[0, 1]²`.
     pub fn point_at(&self, ab: Vec2) -> Vec3 {
         self.origin + ab.x * self.edge1 + ab.y * self.edge2
@@ -93,8 +126,23 @@ impl Parallelogram {
             return None;
         }
         let ab = self.coordinates(ray.at(t));
-        let inside = (0.0..=1.0).contains(&ab.x) && (0.0..=1.0).contains(&ab.y);
+        let inside = ab.cmpge(Vec2::ZERO).all() && ab.cmple(Vec2::ONE).all() || {
+            let margin = self.edge_margin(ray.origin);
+            ab.cmpge(-margin).all() && ab.cmple(Vec2::ONE + margin).all()
+        };
         inside.then_some(t)
+    }
+
+    /// How far outside [0, 1] the edge coordinates (α, β) of a hit of a ray
+    /// from `origin` may be and still count as inside: the bound on their
+    /// rounding error. The point `o + t·d` is within `γ₁₆(‖o‖∞ + extent)` of
+    /// the exact one (the plane's distance `t` and the point each round a
+    /// handful of times over these magnitudes; pbrt-v4 §6.8), turned into edge
+    /// coordinates by `coordinate_scale`.
+    #[inline]
+    pub fn edge_margin(&self, origin: Vec3) -> Vec2 {
+        let length = gamma(16) * (origin.abs().max_element() + self.extent);
+        length * self.coordinate_scale
     }
 
     #[inline]
@@ -102,7 +150,8 @@ impl Parallelogram {
         let uv = self.coordinates(ray.at(t)).clamp(Vec2::ZERO, Vec2::ONE);
         Hit {
             t,
-            point: self.point_at(uv),
+            point: self.point_at(uv.clamp(self.pull, Vec2::ONE - self.pull)),
+            error: self.error,
             geometric_normal: self.normal,
             shading_normal: self.normal,
             uv,

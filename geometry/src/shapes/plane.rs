@@ -1,6 +1,7 @@
 //! Infinite planes: the ray–plane test and the planar uv mapping that tiles
 //! texture to the horizon.
 
+use crate::error_bounds::gamma;
 use crate::{Hit, Ray};
 use glam::{Vec2, Vec3};
 
@@ -67,6 +68,7 @@ impl Plane {
         Hit {
             t,
             point,
+            error: gamma(5) * (point.abs() + self.point.abs()),
             geometric_normal: self.normal,
             shading_normal: self.normal,
             uv: Vec2::new(local.dot(self.tangent), local.dot(self.bitangent)) / self.tile,

@@ -8,9 +8,10 @@
 //! so a lane's verdict is bit for bit the scalar test's.
 
 use super::{Parallelogram, Sphere};
+use crate::error_bounds::gamma;
 use crate::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use crate::Ray;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// [`LANES`] rays, `origin + t·direction` in each lane.
 #[derive(Clone, Copy, Debug, Default)]
@@ -114,8 +115,25 @@ impl Parallelogram {
         }
         let t = Vec3Lanes::splat_sub(self.origin, &rays.origin).dot_splat(self.normal) / denom;
         let (alpha, beta) = self.coordinates_lanes(&rays.at(t));
-        let within = |x: F32Lanes| x.simd_ge(zero) & x.simd_le(one);
-        let hit = in_range(t, F32Lanes::splat(t_max)) & within(alpha) & within(beta) & !facing_away;
+        let candidates = in_range(t, F32Lanes::splat(t_max)) & !facing_away;
+        let unit = |x: F32Lanes| x.simd_ge(zero) & x.simd_le(one);
+        let inside = unit(alpha) & unit(beta);
+        // Within [0, 1] is within the margin too: the margin, which takes a few
+        // operations per lane, only decides lanes outside [0, 1].
+        let hit = if lanes::bits(candidates & !inside) == 0 {
+            candidates & inside
+        } else {
+            // `edge_margin` of each lane's origin.
+            let o = rays.origin.abs();
+            let length =
+                F32Lanes::splat(gamma(16)) * (o.x.max(o.y.max(o.z)) + F32Lanes::splat(self.extent));
+            let within = |x: F32Lanes, scale: f32| {
+                let margin = length * F32Lanes::splat(scale);
+                x.simd_ge(-margin) & x.simd_le(one + margin)
+            };
+            let (sa, sb) = (self.coordinate_scale.x, self.coordinate_scale.y);
+            candidates & within(alpha, sa) & within(beta, sb)
+        };
         (lanes::bits(hit), t)
     }
 }
@@ -126,6 +144,8 @@ impl Parallelogram {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SurfaceLanes {
     pub point: Vec3Lanes,
+    /// The error bound of `point`, per axis ([`crate::Hit::error`]).
+    pub error: Vec3Lanes,
     /// The geometric normal, which is also the shading normal on these shapes.
     pub normal: Vec3Lanes,
     pub u: F32Lanes,
@@ -148,6 +168,11 @@ impl Sphere {
     pub fn surface_points_lanes(&self, rays: &RayLanes, t: F32Lanes, lanes: u32) -> SurfaceLanes {
         let n = rays.at(t).sub_splat(self.center).normalize();
         let point = Vec3Lanes::splat_add(self.center, &n.scale(F32Lanes::splat(self.radius)));
+        // As `point_error`: γ₂|c| + |n|·(γ₆·r).
+        let error = Vec3Lanes::splat_add(
+            gamma(2) * self.center.abs(),
+            &n.abs().scale(F32Lanes::splat(gamma(6) * self.radius)),
+        );
         let (ny, nz, nx) = (n.y.to_array(), n.z.to_array(), n.x.to_array());
         let mut u = [0.0; LANES];
         let mut v = [0.0; LANES];
@@ -157,6 +182,7 @@ impl Sphere {
         }
         SurfaceLanes {
             point,
+            error,
             normal: n,
             u: F32Lanes::new(u),
             v: F32Lanes::new(v),
@@ -173,11 +199,16 @@ impl Parallelogram {
         // Vec2::clamp: max with the lower bound, then min with the upper.
         let (zero, one) = (F32Lanes::ZERO, F32Lanes::ONE);
         let (u, v) = (alpha.max(zero).min(one), beta.max(zero).min(one));
-        // origin + α·edge1 + β·edge2, as `point_at` rounds it.
-        let point = Vec3Lanes::splat_add(self.origin, &Vec3Lanes::scaled_splat(self.edge1, u))
-            + Vec3Lanes::scaled_splat(self.edge2, v);
+        // The point at (α, β) kept off the edges, as `surface_at` clamps them,
+        // then origin + α·edge1 + β·edge2, as `point_at` rounds it.
+        let (low, high) = (self.pull, Vec2::ONE - self.pull);
+        let alpha = u.max(F32Lanes::splat(low.x)).min(F32Lanes::splat(high.x));
+        let beta = v.max(F32Lanes::splat(low.y)).min(F32Lanes::splat(high.y));
+        let point = Vec3Lanes::splat_add(self.origin, &Vec3Lanes::scaled_splat(self.edge1, alpha))
+            + Vec3Lanes::scaled_splat(self.edge2, beta);
         SurfaceLanes {
             point,
+            error: Vec3Lanes::splat(self.error),
             normal: Vec3Lanes::splat(self.normal),
             u,
             v,
@@ -239,11 +270,12 @@ mod tests {
                 let bits = |v: Vec3| v.to_array().map(f32::to_bits);
                 let lane = |s: &SurfaceLanes| {
                     let uv = [s.u.as_array()[k], s.v.as_array()[k]].map(f32::to_bits);
-                    (bits(s.point.lane(k)), bits(s.normal.lane(k)), uv)
+                    let point = (bits(s.point.lane(k)), bits(s.error.lane(k)));
+                    (point, bits(s.normal.lane(k)), uv)
                 };
                 let scalar = |h: Hit| {
                     (
-                        bits(h.point),
+                        (bits(h.point), bits(h.error)),
                         bits(h.geometric_normal),
                         h.uv.to_array().map(f32::to_bits),
                     )

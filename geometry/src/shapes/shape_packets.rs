@@ -12,6 +12,7 @@
 
 use super::{Parallelogram, Sphere};
 use crate::counters::count;
+use crate::error_bounds::gamma;
 use crate::Ray;
 use glam::{BVec4A, Vec3, Vec4};
 
@@ -131,6 +132,9 @@ pub struct ParallelogramPacket {
     edge2: [Vec4; 3],
     normal: [Vec4; 3],
     w: [Vec4; 3],
+    /// Each lane's `extent` and `coordinate_scale`, for its `edge_margin`.
+    extent: Vec4,
+    coordinate_scale: [Vec4; 2],
     /// Lanes seen from their front side only.
     one_sided: BVec4A,
     /// Lanes in use.
@@ -145,6 +149,8 @@ impl ParallelogramPacket {
         edge2: [Vec4::NAN; 3],
         normal: [Vec4::NAN; 3],
         w: [Vec4::NAN; 3],
+        extent: Vec4::NAN,
+        coordinate_scale: [Vec4::NAN; 2],
         one_sided: BVec4A::FALSE,
         used: 0,
     };
@@ -156,6 +162,9 @@ impl ParallelogramPacket {
         set(&mut self.edge2, lane, p.edge2);
         set(&mut self.normal, lane, p.normal);
         set(&mut self.w, lane, p.w);
+        self.extent[lane] = p.extent;
+        self.coordinate_scale[0][lane] = p.coordinate_scale.x;
+        self.coordinate_scale[1][lane] = p.coordinate_scale.y;
         self.one_sided.set(lane, !p.two_sided);
         self.used = self.used.max(lane as u32 + 1);
     }
@@ -179,7 +188,21 @@ impl ParallelogramPacket {
         let local = sub(point, self.origin);
         let alpha = dot(self.w, cross(local, self.edge2));
         let beta = dot(self.w, cross(self.edge1, local));
-        let inside = alpha.cmpge(zero) & alpha.cmple(one) & beta.cmpge(zero) & beta.cmple(one);
+        let unit = |x: Vec4| x.cmpge(zero) & x.cmple(one);
+        let mut inside = unit(alpha) & unit(beta);
+        // Within [0, 1] is within the margin too: the margin only decides lanes
+        // outside [0, 1] (as in `Parallelogram::hit_distance_lanes`).
+        if (in_range & !facing_away & !inside).any() {
+            // Each lane's `edge_margin` for this ray.
+            let length = Vec4::splat(gamma(16))
+                * (Vec4::splat(ray.origin.abs().max_element()) + self.extent);
+            let within = |x: Vec4, scale: Vec4| {
+                let margin = length * scale;
+                x.cmpge(-margin) & x.cmple(one + margin)
+            };
+            inside =
+                within(alpha, self.coordinate_scale[0]) & within(beta, self.coordinate_scale[1]);
+        }
         let hits = in_range & inside & !facing_away;
         (hits.bitmask(), t)
     }

@@ -1,6 +1,7 @@
 //! Spheres: the ray–sphere test in its precision-improved form, and the
 //! spherical uv mapping with its derivatives.
 
+use crate::error_bounds::gamma;
 use crate::{Hit, Ray};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
@@ -93,6 +94,13 @@ impl Sphere {
         self.surface_frame(ray, t).0
     }
 
+    /// The error bound of the point `c + r·n` ([`crate::error_bounds`]):
+    /// `γ₂|c| + γ₆·r·|n|`.
+    #[inline]
+    pub(crate) fn point_error(&self, n: Vec3) -> Vec3 {
+        gamma(2) * self.center.abs() + n.abs() * (gamma(6) * self.radius)
+    }
+
     /// The uv of the point with unit normal `n`, with its polar angle θ (from
     /// +y) and azimuth φ (from +x towards −z, in [0, 2π)).
     #[inline]
@@ -115,6 +123,7 @@ impl Sphere {
         let hit = Hit {
             t,
             point,
+            error: self.point_error(n),
             geometric_normal: n,
             shading_normal: n,
             uv,

@@ -17,7 +17,7 @@
 
 use glam::Vec3;
 use glint_geometry::{
-    reflect, spawn_ray, spawn_ray_to, AaBox, Hit, Parallelogram, Ray, ShapeList, Sphere,
+    reflect, spawn_ray, spawn_ray_to, AaBox, Hit, Parallelogram, Ray, RayTarget, ShapeList, Sphere,
 };
 
 /// The scales every configuration is built at.
@@ -142,9 +142,9 @@ fn lit_and_mirrored(list: &ShapeList, ray: &Ray, light: Vec3, counts: &mut Count
         return;
     }
     if hit.geometric_normal.dot(light - hit.point) > 0.0 {
-        let (shadow, t_max) = spawn_ray_to(&hit, light);
+        let shadow = spawn_ray_to(&hit, &RayTarget::exact(light));
         counts.non_finite += u64::from(!shadow.origin.is_finite());
-        counts.acne += u64::from(list.any_hit(&shadow, t_max));
+        counts.acne += u64::from(list.any_hit(&shadow, 1.0));
     }
     let wo = -ray.direction.normalize();
     let mirror = spawn_ray(&hit, reflect(wo, hit.geometric_normal));
@@ -224,8 +224,8 @@ fn closed_box(at: Vec3, scale: f32, steps: &[f32], as_aabox: bool) -> Counts {
                     -hit.geometric_normal
                 };
                 if facing.dot(light - hit.point) > 0.0 {
-                    let (shadow, t_max) = spawn_ray_to(&hit, light);
-                    counts.leaks += u64::from(!list.any_hit(&shadow, t_max));
+                    let shadow = spawn_ray_to(&hit, &RayTarget::exact(light));
+                    counts.leaks += u64::from(!list.any_hit(&shadow, 1.0));
                 }
             }
         }

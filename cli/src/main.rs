@@ -11,7 +11,8 @@
 //! The command line is the clap parser [`Cli`]; each subcommand has a file of its
 //! own: `render` ([`render::RenderArgs`], [`render::render`]), `diff`
 //! ([`diff::DiffArgs`], [`diff::diff`]), `bench` ([`bench::BenchArgs`],
-//! [`bench::bench`]). [`main`] maps every
+//! [`bench::bench`]), `stress` ([`stress::StressArgs`], [`stress::stress`]).
+//! [`main`] maps every
 //! failure to its exit status; [`output`] checks output paths before any work.
 
 mod bench;
@@ -20,6 +21,7 @@ mod interrupt;
 mod output;
 mod render;
 mod stats;
+mod stress;
 
 use clap::builder::TypedValueParser;
 use clap::{Parser, Subcommand};
@@ -50,6 +52,9 @@ enum Command {
     /// Run time against error: sample patterns and filters over a ladder of
     /// budgets, measured against a reference (table, CSV, JSON, plot, heat maps)
     Bench(bench::BenchArgs),
+    /// Numerical stress: generated configurations at scales 1e-4 to 1e6,
+    /// counting shadow acne, light leaks and self-hits; exit status 1 if any
+    Stress(stress::StressArgs),
 }
 
 /// A failure and the exit status it maps to.
@@ -80,6 +85,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render::render(args),
         Command::Diff(args) => diff::diff(args),
         Command::Bench(args) => bench::bench(args),
+        Command::Stress(args) => stress::stress(args),
     })
     .unwrap_or(Err(Failure::Panicked));
     match result {

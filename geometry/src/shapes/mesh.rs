@@ -240,9 +240,11 @@ impl TriangleMesh {
         let [a, b, c] = self.corners(i);
         let (t, bary) = WatertightRay::new(ray).intersect(a, b, c, t_max)?;
         let tri = self.indices[i as usize];
-        // The barycentric point is more accurate than o + t·d.
-        let point = bary[0] * a + bary[1] * b + bary[2] * c;
+        // The barycentric point is more accurate than o + t·d; it is kept off
+        // the triangle's edges by twice its error bound (`pulled_inside`).
         let error = gamma(7) * ((bary[0] * a).abs() + (bary[1] * b).abs() + (bary[2] * c).abs());
+        let pulled = pulled_inside(bary, [a, b, c], error);
+        let point = pulled[0] * a + pulled[1] * b + pulled[2] * c;
         // Normalising the edges first keeps tiny (but hit) triangles from
         // underflowing to a zero cross product.
         let face = (b - a)
@@ -320,6 +322,27 @@ impl TriangleMesh {
             primitive: 0,
         })
     }
+}
+
+/// Barycentric coordinates `bary` of a point on the triangle `[a, b, c]`, moved
+/// inside so that the point lies at least twice the length of its error bound
+/// `error` from every edge (at most to the centroid): a point computed on an
+/// edge is, within rounding, on the neighbouring triangle too, and a ray
+/// leaving it across a concave edge (the inside of a closed box) or a convex
+/// one could meet that triangle at t ≈ 0 ([`crate::error_bounds`]). The
+/// distance from the edge opposite vertex `i` is `bᵢ · hᵢ`, with the height
+/// `hᵢ = 2·area / |opposite edge|`.
+fn pulled_inside(bary: [f32; 3], [a, b, c]: [Vec3; 3], error: Vec3) -> [f32; 3] {
+    let twice_area = (b - a).cross(c - a).length();
+    let reach = 2.0 * error.length();
+    let opposite = [(c - b).length(), (a - c).length(), (b - a).length()];
+    let least = opposite.map(|edge| (reach * edge / twice_area).min(1.0 / 3.0));
+    if !least.iter().all(|l| l.is_finite()) || (0..3).all(|i| bary[i] >= least[i]) {
+        return bary;
+    }
+    let raised: [f32; 3] = std::array::from_fn(|i| bary[i].max(least[i]));
+    let sum = raised[0] + raised[1] + raised[2];
+    raised.map(|x| x / sum)
 }
 
 #[cfg(test)]

@@ -4,21 +4,29 @@
 //! (closest hits, shadow rays from `spawn_ray_to`, reflection rays from
 //! `spawn_ray`), counting what must be zero:
 //!
-//! - **shadow acne**: a lit point whose shadow ray is blocked, where nothing
+//! - **shadow acne**: a lit point whose shadow ray is blocked where nothing
 //!   can block it (a floor alone under a light down to 0.01° above its
-//!   horizon; a sphere alone, lit where n·l > 0);
+//!   horizon; a lone sphere; a tiny sphere resting on a huge one; a closed
+//!   mesh lit from outside);
 //! - **light leaks**: from inside a closed box (six parallelograms meeting at
-//!   their edges, or one `AaBox`), a shadow ray that reaches a light outside,
-//!   or a camera ray that escapes, aimed at edges and corners included;
+//!   their edges, one `AaBox`, or a triangle mesh) or a closed icosahedron, a
+//!   shadow ray that reaches a light outside or a camera ray that escapes,
+//!   aimed exactly at edges, corners and shared vertices included;
 //! - **self-hits**: a reflection ray off a floor or a sphere that hits it again;
-//! - **non-finite** hit points, normals or spawned origins.
+//! - **off-surface** hit points: farther from the exact surface (computed in
+//!   f64) than the error bound the offsets assume (`Hit::error`);
+//! - **non-finite** hit points, normals or spawned origins, rays along a plane
+//!   seen exactly edge-on included.
 //!
+//! [`run`] builds the table, [`table`] prints it; `glint stress` is the command.
 //! Units: lengths in scene units; angles in degrees where named so.
 
-use glam::Vec3;
-use glint_geometry::{
-    reflect, spawn_ray, spawn_ray_to, AaBox, Hit, Parallelogram, Ray, RayTarget, ShapeList, Sphere,
-};
+mod closed;
+mod flat;
+mod spheres;
+
+use glam::{DVec3, Vec3};
+use glint_geometry::{reflect, spawn_ray, spawn_ray_to, Hit, Ray, RayTarget, ShapeList};
 
 /// The scales every configuration is built at.
 pub const SCALES: [f32; 6] = [1e-4, 1e-2, 1.0, 1e2, 1e4, 1e6];
@@ -33,13 +41,27 @@ pub struct Counts {
     pub acne: u64,
     pub leaks: u64,
     pub self_hits: u64,
+    pub off_surface: u64,
     pub non_finite: u64,
 }
 
 impl Counts {
     /// Whether every count that must be zero is.
     pub fn clean(&self) -> bool {
-        self.acne == 0 && self.leaks == 0 && self.self_hits == 0 && self.non_finite == 0
+        self.acne == 0
+            && self.leaks == 0
+            && self.self_hits == 0
+            && self.off_surface == 0
+            && self.non_finite == 0
+    }
+
+    fn add(&mut self, other: &Counts) {
+        self.rays += other.rays;
+        self.acne += other.acne;
+        self.leaks += other.leaks;
+        self.self_hits += other.self_hits;
+        self.off_surface += other.off_surface;
+        self.non_finite += other.non_finite;
     }
 }
 
@@ -52,20 +74,38 @@ pub struct Row {
     pub counts: Counts,
 }
 
+/// How many rays, and where they are aimed.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    /// Rays per side aimed at each configuration (a face of a box, a floor, a
+    /// sphere's disc).
+    pub grid: u32,
+    /// Whether the grid's first and last rays are aimed exactly at the edges,
+    /// where walls meet (else at the centres of `grid` equal cells).
+    pub joints: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            grid: 16,
+            joints: true,
+        }
+    }
+}
+
 /// Every configuration at every scale, each at the origin and moved away from
 /// it by up to 1e6 (as far as f32 resolves the configuration: 1000 times its
-/// size). `grid` is the number of rays per side aimed at each configuration
-/// (a face of a box, a floor, a sphere's disc); with `joints`, the grid's
-/// first and last rays are aimed exactly at the edges, where walls meet.
-pub fn run(grid: u32, joints: bool) -> Vec<Row> {
-    let steps = |n: u32| steps(n, joints);
+/// size).
+pub fn run(settings: Settings) -> Vec<Row> {
+    let steps = steps(settings.grid, settings.joints);
     let mut rows = Vec::new();
     for scale in SCALES {
         for offset in [0.0, (1e3 * scale).min(1e6)] {
             let at = Vec3::new(offset, -0.7 * offset, 0.4 * offset);
-            let mut row = |configuration: String, counts: Counts| {
+            let mut row = |configuration: &str, counts: Counts| {
                 rows.push(Row {
-                    configuration,
+                    configuration: configuration.to_string(),
                     scale,
                     offset,
                     counts,
@@ -73,17 +113,37 @@ pub fn run(grid: u32, joints: bool) -> Vec<Row> {
             };
             for degrees in GRAZING_DEGREES {
                 let name = format!("floor, light {degrees}° up");
-                row(name, floor(at, scale, degrees, &steps(grid)));
+                row(&name, flat::floor(at, scale, degrees, &steps));
             }
-            row("sphere".into(), sphere(at, scale, &steps(grid)));
+            row("plane seen edge-on", flat::edge_on(at, scale, &steps));
+            row("sphere", spheres::lone(at, scale, &steps));
             row(
-                "box of 6 walls".into(),
-                closed_box(at, scale, &steps(grid), false),
+                "tiny sphere on huge",
+                spheres::tiny_on_huge(at, scale, &steps),
             );
-            row("AaBox".into(), closed_box(at, scale, &steps(grid), true));
+            for kind in closed::BoxKind::ALL {
+                row(kind.name(), closed::closed_box(at, scale, &steps, kind));
+            }
+            row(
+                "icosahedron, inside",
+                closed::icosahedron_inside(at, scale, &steps),
+            );
+            row(
+                "icosahedron, outside",
+                closed::icosahedron_outside(at, scale, &steps),
+            );
         }
     }
     rows
+}
+
+/// The sum of every row's counts.
+pub fn total(rows: &[Row]) -> Counts {
+    let mut sum = Counts::default();
+    for r in rows {
+        sum.add(&r.counts);
+    }
+    sum
 }
 
 /// `n` values spread over [0, 1]: both ends included with `ends`, else the
@@ -98,41 +158,44 @@ fn steps(n: u32, ends: bool) -> Vec<f32> {
 }
 
 fn finite(hit: &Hit) -> bool {
-    hit.point.is_finite() && hit.geometric_normal.is_finite()
+    hit.point.is_finite() && hit.geometric_normal.is_finite() && hit.error.is_finite()
 }
 
-/// A one-sided floor of 20 × 20 scale units alone under a point light
-/// `degrees` above its horizon, seen from above at a grid of points: every
-/// point is lit, and a mirror ray off it meets nothing.
-fn floor(at: Vec3, scale: f32, degrees: f32, steps: &[f32]) -> Counts {
-    let mut list = ShapeList::new();
-    let half = 10.0 * scale;
-    let wall = Parallelogram::new(
-        at + Vec3::new(-half, 0.0, half),
-        Vec3::X * 2.0 * half,
-        Vec3::NEG_Z * 2.0 * half,
-        false,
-    )
-    .expect("a floor");
-    list.push(wall.facing(Vec3::Y));
-    list.build_acceleration();
-    let elevation = degrees.to_radians();
-    let light = at + Vec3::new(elevation.cos(), elevation.sin(), 0.3).normalize() * 100.0 * scale;
-    let eye = at + Vec3::new(-3.0, 8.0, 5.0) * scale;
-    let mut counts = Counts::default();
-    for &u in steps {
-        for &v in steps {
-            let target = at + Vec3::new(-0.9 + 1.8 * u, 0.0, -0.9 + 1.8 * v) * half;
-            lit_and_mirrored(&list, &Ray::new(eye, target - eye), light, &mut counts);
-        }
-    }
-    counts
+/// Whether `hit`'s point is farther from the exact surface than its error
+/// bound allows along the normal, given the point's exact signed distance
+/// from the surface (in f64).
+fn off_surface(hit: &Hit, distance: f64) -> bool {
+    let bound = hit.geometric_normal.abs().dot(hit.error) as f64;
+    distance.abs() > bound
 }
 
-/// Traces `ray` into `list`, where nothing can shadow a point from `light`
-/// on the side its normal points to, nor meet its mirror ray: counts a blocked
-/// shadow ray as acne, a hit of the mirror ray as a self-hit.
-fn lit_and_mirrored(list: &ShapeList, ray: &Ray, light: Vec3, counts: &mut Counts) {
+/// The exact signed distance of `p` from the plane through `q` with normal `n`.
+fn plane_distance(p: Vec3, q: DVec3, n: DVec3) -> f64 {
+    (p.as_dvec3() - q).dot(n.normalize())
+}
+
+/// What a configuration knows analytically about a surface point.
+struct Truth<D: Fn(&Hit) -> f64, L: Fn(&Hit) -> bool> {
+    /// The exact signed distance of the hit's point from its surface (f64).
+    distance: D,
+    /// Whether the point is lit wherever its normal faces the light (nothing
+    /// can shadow it there).
+    unshadowed: L,
+    /// Whether a mirror ray off any point meets nothing.
+    mirror_escapes: bool,
+}
+
+/// Traces `ray` into `list` and judges the hit by `truth`: counts a blocked
+/// shadow ray towards `light` as acne where the point is `unshadowed`, a hit
+/// of the mirror ray as a self-hit where mirror rays escape, and a point off
+/// the surface by more than its bound as off-surface.
+fn lit_and_mirrored<D: Fn(&Hit) -> f64, L: Fn(&Hit) -> bool>(
+    list: &ShapeList,
+    ray: &Ray,
+    light: Vec3,
+    truth: &Truth<D, L>,
+    counts: &mut Counts,
+) {
     counts.rays += 1;
     let Some(hit) = list.closest_hit(ray, f32::INFINITY) else {
         return;
@@ -141,108 +204,38 @@ fn lit_and_mirrored(list: &ShapeList, ray: &Ray, light: Vec3, counts: &mut Count
         counts.non_finite += 1;
         return;
     }
-    if hit.geometric_normal.dot(light - hit.point) > 0.0 {
+    counts.off_surface += u64::from(off_surface(&hit, (truth.distance)(&hit)));
+    if hit.geometric_normal.dot(light - hit.point) > 0.0 && (truth.unshadowed)(&hit) {
         let shadow = spawn_ray_to(&hit, &RayTarget::exact(light));
         counts.non_finite += u64::from(!shadow.origin.is_finite());
         counts.acne += u64::from(list.any_hit(&shadow, 1.0));
     }
-    let wo = -ray.direction.normalize();
-    let mirror = spawn_ray(&hit, reflect(wo, hit.geometric_normal));
-    counts.self_hits += u64::from(list.closest_hit(&mirror, f32::INFINITY).is_some());
-}
-
-/// A sphere alone, lit from one side: no point with n·l > 0 is shadowed, and no
-/// mirror ray off it hits it again.
-fn sphere(at: Vec3, scale: f32, steps: &[f32]) -> Counts {
-    let mut list = ShapeList::new();
-    list.push(Sphere::new(at, scale).expect("a sphere"));
-    list.build_acceleration();
-    let light = at + Vec3::new(3.0, 4.0, 2.0) * 10.0 * scale;
-    let eye = at + Vec3::new(0.5, 1.0, 6.0) * scale;
-    let mut counts = Counts::default();
-    for &u in steps {
-        for &v in steps {
-            // Across the disc the sphere covers, out to its silhouette.
-            let target = at + Vec3::new(-1.0 + 2.0 * u, -1.0 + 2.0 * v, 0.0) * scale;
-            lit_and_mirrored(&list, &Ray::new(eye, target - eye), light, &mut counts);
-        }
+    if truth.mirror_escapes {
+        let wo = -ray.direction.normalize();
+        let mirror = spawn_ray(&hit, reflect(wo, hit.geometric_normal));
+        counts.self_hits += u64::from(list.closest_hit(&mirror, f32::INFINITY).is_some());
     }
-    counts
-}
-
-/// A closed cube of side 2·scale, as six two-sided walls meeting at their
-/// edges or as one `AaBox`, seen from inside, with a light outside: every
-/// camera ray hits a wall, and every shadow ray traced (from a wall the light
-/// is in front of, seen from inside) is blocked by another. Rays are aimed at
-/// `steps` × `steps` points over each face.
-fn closed_box(at: Vec3, scale: f32, steps: &[f32], as_aabox: bool) -> Counts {
-    let mut list = ShapeList::new();
-    let (lo, hi) = (at - Vec3::splat(scale), at + Vec3::splat(scale));
-    if as_aabox {
-        list.push(AaBox::new(lo, hi).expect("a box"));
-    } else {
-        let s = 2.0 * scale;
-        for (origin, e1, e2) in [
-            (lo, Vec3::X * s, Vec3::Y * s),
-            (lo, Vec3::Y * s, Vec3::Z * s),
-            (lo, Vec3::Z * s, Vec3::X * s),
-            (hi, Vec3::NEG_X * s, Vec3::NEG_Y * s),
-            (hi, Vec3::NEG_Y * s, Vec3::NEG_Z * s),
-            (hi, Vec3::NEG_Z * s, Vec3::NEG_X * s),
-        ] {
-            list.push(Parallelogram::new(origin, e1, e2, true).expect("a wall"));
-        }
-    }
-    list.build_acceleration();
-    let light = at + Vec3::new(7.0, 5.0, -6.0) * scale;
-    let eye = at + Vec3::new(0.1, -0.2, 0.15) * scale;
-    let mut counts = Counts::default();
-    for face in 0..6 {
-        let (axis, sign) = (face % 3, if face < 3 { -1.0 } else { 1.0 });
-        for &u in steps {
-            for &v in steps {
-                let mut p = [0.0; 3];
-                p[axis] = sign;
-                p[(axis + 1) % 3] = -1.0 + 2.0 * u;
-                p[(axis + 2) % 3] = -1.0 + 2.0 * v;
-                let target = at + Vec3::from(p) * scale;
-                let ray = Ray::new(eye, target - eye);
-                counts.rays += 1;
-                let Some(hit) = list.closest_hit(&ray, f32::INFINITY) else {
-                    counts.leaks += 1;
-                    continue;
-                };
-                if !finite(&hit) {
-                    counts.non_finite += 1;
-                    continue;
-                }
-                // As the integrator does: a light behind the wall as seen from
-                // the viewer's side is below the horizon, and gets no shadow ray.
-                let facing = if hit.geometric_normal.dot(ray.direction) < 0.0 {
-                    hit.geometric_normal
-                } else {
-                    -hit.geometric_normal
-                };
-                if facing.dot(light - hit.point) > 0.0 {
-                    let shadow = spawn_ray_to(&hit, &RayTarget::exact(light));
-                    counts.leaks += u64::from(!list.any_hit(&shadow, 1.0));
-                }
-            }
-        }
-    }
-    counts
 }
 
 /// The table of `rows`, in Markdown.
 pub fn table(rows: &[Row]) -> String {
     let mut out = String::from(
-        "| configuration | scale | offset | rays | acne | leaks | self-hits | non-finite |\n|---|---|---|---|---|---|---|---|\n",
+        "| configuration | scale | offset | rays | acne | leaks | self-hits | off-surface | non-finite |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let c = &r.counts;
         out += &format!(
-            "| {} | {:e} | {:e} | {} | {} | {} | {} | {} |\n",
-            r.configuration, r.scale, r.offset, c.rays, c.acne, c.leaks, c.self_hits, c.non_finite
+            "| {} | {:e} | {:e} | {} | {} | {} | {} | {} | {} |\n",
+            r.configuration,
+            r.scale,
+            r.offset,
+            c.rays,
+            c.acne,
+            c.leaks,
+            c.self_hits,
+            c.off_surface,
+            c.non_finite
         );
     }
     out
@@ -252,20 +245,45 @@ pub fn table(rows: &[Row]) -> String {
 mod tests {
     use super::*;
 
-    /// Off the joints (no ray aimed exactly where two walls meet), nothing
-    /// that must be zero is anything else, at any scale or offset.
+    /// With rays aimed at the joints too, nothing that must be zero is
+    /// anything else, at any scale or offset.
     #[test]
-    fn off_the_joints_every_count_is_zero() {
-        let rows = run(6, false);
+    fn every_count_is_zero_joints_included() {
+        let rows = run(Settings {
+            grid: 5,
+            joints: true,
+        });
         assert!(rows.iter().all(|r| r.counts.clean()), "{}", table(&rows));
-        let rays: u64 = rows.iter().map(|r| r.counts.rays).sum();
-        // 6 scales × 2 offsets × (4 floors and a sphere of 6², 2 boxes of 6 × 6²).
-        assert_eq!(rays, 12 * (5 * 36 + 2 * 6 * 36));
+        assert_eq!(rows.len(), 12 * 12);
+        assert!(total(&rows).rays > 12 * 1000, "{}", total(&rows).rays);
     }
 
     #[test]
     fn steps_span_the_unit_interval_with_or_without_its_ends() {
         assert_eq!(steps(3, true), [0.0, 0.5, 1.0]);
         assert_eq!(steps(2, false), [0.25, 0.75]);
+    }
+
+    #[test]
+    fn a_point_off_its_surface_by_more_than_its_bound_is_counted() {
+        let mut hit = Hit {
+            t: 1.0,
+            point: Vec3::new(0.0, 1e-6, 0.0),
+            error: Vec3::splat(1e-7),
+            geometric_normal: Vec3::Y,
+            shading_normal: Vec3::Y,
+            uv: glam::Vec2::ZERO,
+            dpdu: Vec3::X,
+            dpdv: Vec3::Z,
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
+            front_face: true,
+            shape: 0,
+            primitive: 0,
+        };
+        let d = plane_distance(hit.point, DVec3::ZERO, DVec3::Y);
+        assert!(off_surface(&hit, d));
+        hit.error = Vec3::splat(1e-5);
+        assert!(!off_surface(&hit, d));
     }
 }

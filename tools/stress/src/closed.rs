@@ -2,12 +2,9 @@
 //! icosahedron mesh, seen from inside (nothing may leak out) and from outside
 //! (nothing may shadow a lit point of a convex solid).
 
-use crate::{finite, off_surface, Counts};
+use crate::{finite, lit_and_mirrored, off_surface, Counts, Truth};
 use glam::{DVec3, Vec3};
-use glint_geometry::{
-    reflect, spawn_ray, spawn_ray_to, AaBox, Hit, Parallelogram, Ray, RayTarget, ShapeList,
-    TriangleMesh,
-};
+use glint_geometry::{spawn_ray_to, AaBox, Hit, Ray, RayTarget, ShapeList, TriangleMesh};
 
 /// How a closed box is built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,10 +65,8 @@ pub(crate) fn closed_box(at: Vec3, scale: f32, steps: &[f32], kind: BoxKind) -> 
             list.push(AaBox::new(lo, hi).expect("a box"));
         }
         BoxKind::Walls => {
-            for f in FACES {
-                let o = corners[f[0] as usize];
-                let (e1, e2) = (corners[f[1] as usize] - o, corners[f[3] as usize] - o);
-                list.push(Parallelogram::new(o, e1, e2, true).expect("a wall"));
+            for wall in AaBox::new(lo, hi).expect("a box").face_parallelograms() {
+                list.push(wall);
             }
         }
         BoxKind::Mesh => {
@@ -231,37 +226,22 @@ pub(crate) fn icosahedron_inside(at: Vec3, scale: f32, steps: &[f32]) -> Counts 
 
 /// From outside the convex icosahedron, rays at the same points: a point seen
 /// from the front whose normal faces the light is lit, and its mirror ray
-/// meets nothing.
+/// meets nothing. (A ray aimed exactly at a silhouette edge touches the face
+/// behind it as well, at the same point within rounding, and may report that
+/// one, whose mirror ray rightly goes in: only front hits are judged.)
 pub(crate) fn icosahedron_outside(at: Vec3, scale: f32, steps: &[f32]) -> Counts {
     let (list, vertices, faces) = icosahedron_list(at, scale);
     let eye = at + Vec3::new(2.0, 3.0, 4.0) * scale;
     let light = at + Vec3::new(-3.0, 4.0, 2.0) * 10.0 * scale;
+    let truth = Truth {
+        distance: |hit: &Hit| triangle_distance(&vertices, &faces, hit),
+        judged: |hit: &Hit| hit.front_face,
+        mirror_escapes: true,
+    };
     let mut counts = Counts::default();
     for target in face_targets(&vertices, &faces, steps) {
         let ray = Ray::new(eye, target - eye);
-        counts.rays += 1;
-        let Some(hit) = list.closest_hit(&ray, f32::INFINITY) else {
-            continue;
-        };
-        if !finite(&hit) {
-            counts.non_finite += 1;
-            continue;
-        }
-        let distance = triangle_distance(&vertices, &faces, &hit);
-        counts.off_surface += u64::from(off_surface(&hit, distance));
-        // A ray aimed exactly at a silhouette edge touches the face behind it
-        // as well, at the same point within rounding, and may report that one:
-        // its mirror ray then rightly goes inside. Only front hits are judged.
-        if !hit.front_face {
-            continue;
-        }
-        if hit.geometric_normal.dot(light - hit.point) > 0.0 {
-            let shadow = spawn_ray_to(&hit, &RayTarget::exact(light));
-            counts.acne += u64::from(list.any_hit(&shadow, 1.0));
-        }
-        let wo = -ray.direction.normalize();
-        let mirror = spawn_ray(&hit, reflect(wo, hit.geometric_normal));
-        counts.self_hits += u64::from(list.closest_hit(&mirror, f32::INFINITY).is_some());
+        lit_and_mirrored(&list, &ray, light, &truth, &mut counts);
     }
     counts
 }

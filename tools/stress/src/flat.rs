@@ -27,7 +27,7 @@ pub(crate) fn floor(at: Vec3, scale: f32, degrees: f32, steps: &[f32]) -> Counts
         distance: |hit: &glint_geometry::Hit| {
             plane_distance(hit.point, corner.as_dvec3(), DVec3::Y)
         },
-        unshadowed: |_: &glint_geometry::Hit| true,
+        judged: |_: &glint_geometry::Hit| true,
         mirror_escapes: true,
     };
     let mut counts = Counts::default();
@@ -61,7 +61,6 @@ pub(crate) fn edge_on(at: Vec3, scale: f32, steps: &[f32]) -> Counts {
             // Heights from −1e-2 to 1e-2 of the scale, 0 exactly in the middle.
             let signed = 2.0 * v - 1.0;
             let height = signed * 10f32.powf(-2.0 - 5.0 * (1.0 - signed.abs()));
-            let height = if signed == 0.0 { 0.0 } else { height };
             let eye = at + Vec3::new(-30.0 * scale, height * scale, (2.0 * u - 1.0) * half);
             let aim = at + Vec3::new(30.0 * scale, -height * scale, (1.0 - 2.0 * u) * half);
             counts.rays += 1;

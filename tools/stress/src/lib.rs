@@ -175,21 +175,21 @@ fn plane_distance(p: Vec3, q: DVec3, n: DVec3) -> f64 {
 }
 
 /// What a configuration knows analytically about a surface point.
-struct Truth<D: Fn(&Hit) -> f64, L: Fn(&Hit) -> bool> {
+pub(crate) struct Truth<D: Fn(&Hit) -> f64, L: Fn(&Hit) -> bool> {
     /// The exact signed distance of the hit's point from its surface (f64).
     distance: D,
-    /// Whether the point is lit wherever its normal faces the light (nothing
-    /// can shadow it there).
-    unshadowed: L,
-    /// Whether a mirror ray off any point meets nothing.
+    /// Whether the configuration's truth covers the hit: then it is lit
+    /// wherever its normal faces the light (nothing can shadow it there).
+    judged: L,
+    /// Whether a mirror ray off any judged point meets nothing.
     mirror_escapes: bool,
 }
 
 /// Traces `ray` into `list` and judges the hit by `truth`: counts a blocked
-/// shadow ray towards `light` as acne where the point is `unshadowed`, a hit
-/// of the mirror ray as a self-hit where mirror rays escape, and a point off
-/// the surface by more than its bound as off-surface.
-fn lit_and_mirrored<D: Fn(&Hit) -> f64, L: Fn(&Hit) -> bool>(
+/// shadow ray towards `light` as acne where the point is `judged`, a hit of
+/// the mirror ray of a judged point as a self-hit where mirror rays escape, and
+/// a point off the surface by more than its bound as off-surface.
+pub(crate) fn lit_and_mirrored<D: Fn(&Hit) -> f64, L: Fn(&Hit) -> bool>(
     list: &ShapeList,
     ray: &Ray,
     light: Vec3,
@@ -205,7 +205,10 @@ fn lit_and_mirrored<D: Fn(&Hit) -> f64, L: Fn(&Hit) -> bool>(
         return;
     }
     counts.off_surface += u64::from(off_surface(&hit, (truth.distance)(&hit)));
-    if hit.geometric_normal.dot(light - hit.point) > 0.0 && (truth.unshadowed)(&hit) {
+    if !(truth.judged)(&hit) {
+        return;
+    }
+    if hit.geometric_normal.dot(light - hit.point) > 0.0 {
         let shadow = spawn_ray_to(&hit, &RayTarget::exact(light));
         counts.non_finite += u64::from(!shadow.origin.is_finite());
         counts.acne += u64::from(list.any_hit(&shadow, 1.0));

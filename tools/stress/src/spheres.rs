@@ -20,7 +20,7 @@ pub(crate) fn lone(at: Vec3, scale: f32, steps: &[f32]) -> Counts {
     let eye = at + Vec3::new(0.5, 1.0, 6.0) * scale;
     let truth = Truth {
         distance: |hit: &Hit| sphere_distance(&sphere, hit),
-        unshadowed: |_: &Hit| true,
+        judged: |_: &Hit| true,
         mirror_escapes: true,
     };
     let mut counts = Counts::default();
@@ -58,7 +58,7 @@ pub(crate) fn tiny_on_huge(at: Vec3, scale: f32, steps: &[f32]) -> Counts {
             0 => sphere_distance(&tiny, hit),
             _ => sphere_distance(&huge, hit),
         },
-        unshadowed: |hit: &Hit| {
+        judged: |hit: &Hit| {
             let across = hit.point - at;
             hit.shape == 0 || Vec3::new(across.x, 0.0, across.z).length() >= 19.0 * r
         },

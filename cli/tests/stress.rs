@@ -12,14 +12,16 @@ fn a_small_stress_run_counts_nothing_and_exits_zero() {
     let out = stdout(&o);
     assert_eq!(o.status.code(), Some(0), "{out}");
     let rows: Vec<&str> = out.lines().filter(|l| l.starts_with("| ")).collect();
-    // The header, then 12 configurations at 6 scales, each at two offsets.
-    assert_eq!(rows.len(), 1 + 144, "{out}");
+    // The header, then 12 configurations and 3 shipped scenes at 6 scales,
+    // each at two offsets.
+    assert_eq!(rows.len(), 1 + 180, "{out}");
     for row in &rows[1..] {
         let counts: Vec<&str> = row.split('|').map(str::trim).skip(5).take(5).collect();
         assert_eq!(counts, ["0"; 5], "{row}");
     }
     assert!(out.contains("every count is zero"), "{out}");
     assert!(out.contains("icosahedron, inside") && out.contains("box of 6 walls"));
+    assert!(out.contains("| scene bunny |") && out.contains("| scene cornell-set1 |"));
     assert_eq!(
         std::fs::read_dir(dir.path()).unwrap().count(),
         0,

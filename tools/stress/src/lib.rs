@@ -18,11 +18,18 @@
 //! - **non-finite** hit points, normals or spawned origins, rays along a plane
 //!   seen exactly edge-on included.
 //!
+//! The shipped scenes (the Cornell box, the open bunny in it, the closed bunny
+//! on a plane) are scaled and moved the same way and judged pixel by pixel
+//! against themselves at scale 1 (see `scenes.rs`); each is also rendered as
+//! `glint render` renders it, its non-finite samples counted and the pixels
+//! that changed reported.
+//!
 //! [`run`] builds the table, [`table`] prints it; `glint stress` is the command.
 //! Units: lengths in scene units; angles in degrees where named so.
 
 mod closed;
 mod flat;
+mod scenes;
 mod spheres;
 
 use glam::{DVec3, Vec3};
@@ -34,6 +41,13 @@ pub const SCALES: [f32; 6] = [1e-4, 1e-2, 1.0, 1e2, 1e4, 1e6];
 /// Light elevations above a floor's horizon, in degrees.
 pub const GRAZING_DEGREES: [f32; 4] = [0.01, 0.1, 1.0, 30.0];
 
+/// Pixels across the shipped scenes' renders per ray of the grid's side.
+const SCENE_PIXELS_PER_GRID: u32 = 4;
+
+/// How far a pixel of a shipped scene's render may move from the render at
+/// scale 1 (linear radiance) before it counts as changed.
+pub const CHANGED: f32 = 1e-3;
+
 /// What one configuration counted.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Counts {
@@ -43,6 +57,11 @@ pub struct Counts {
     pub self_hits: u64,
     pub off_surface: u64,
     pub non_finite: u64,
+    /// For a shipped scene: pixels of its render that differ from the render
+    /// at scale 1 at the origin by more than [`CHANGED`] in a channel. Reported,
+    /// not required to be zero: rays within the rounding of an edge, a
+    /// silhouette or a mesh's crease may go either way far from the origin.
+    pub changed_pixels: Option<u64>,
 }
 
 impl Counts {
@@ -62,6 +81,9 @@ impl Counts {
         self.self_hits += other.self_hits;
         self.off_surface += other.off_surface;
         self.non_finite += other.non_finite;
+        if let Some(c) = other.changed_pixels {
+            self.changed_pixels = Some(self.changed_pixels.unwrap_or(0) + c);
+        }
     }
 }
 
@@ -99,6 +121,18 @@ impl Default for Settings {
 /// size).
 pub fn run(settings: Settings) -> Vec<Row> {
     let steps = steps(settings.grid, settings.joints);
+    let assets = tempfile::tempdir().expect("a temporary folder for the scenes' meshes");
+    let width = SCENE_PIXELS_PER_GRID * settings.grid;
+    let references: Vec<_> = scenes::SHIPPED
+        .iter()
+        .map(|s| {
+            let unit = s.load(assets.path(), 1.0, DVec3::ZERO, width);
+            (
+                scenes::Reference::new(&unit.scene),
+                scenes::rendered(&unit).film,
+            )
+        })
+        .collect();
     let mut rows = Vec::new();
     for scale in SCALES {
         for offset in [0.0, (1e3 * scale).min(1e6)] {
@@ -132,6 +166,14 @@ pub fn run(settings: Settings) -> Vec<Row> {
                 "icosahedron, outside",
                 closed::icosahedron_outside(at, scale, &steps),
             );
+            for (shipped, (reference, film)) in scenes::SHIPPED.iter().zip(&references) {
+                let scene = shipped.load(assets.path(), scale as f64, at.as_dvec3(), width);
+                let mut counts = scenes::judge(&scene.scene, reference, scale);
+                let out = scenes::rendered(&scene);
+                counts.non_finite += out.stats.shading.nonfinite_samples;
+                counts.changed_pixels = Some(scenes::changed_pixels(&out.film, film, CHANGED));
+                row(shipped.name, counts);
+            }
         }
     }
     rows
@@ -223,13 +265,13 @@ pub(crate) fn lit_and_mirrored<D: Fn(&Hit) -> f64, L: Fn(&Hit) -> bool>(
 /// The table of `rows`, in Markdown.
 pub fn table(rows: &[Row]) -> String {
     let mut out = String::from(
-        "| configuration | scale | offset | rays | acne | leaks | self-hits | off-surface | non-finite |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
+        "| configuration | scale | offset | rays | acne | leaks | self-hits | off-surface | non-finite | changed pixels |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let c = &r.counts;
         out += &format!(
-            "| {} | {:e} | {:e} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {:e} | {:e} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.configuration,
             r.scale,
             r.offset,
@@ -238,7 +280,8 @@ pub fn table(rows: &[Row]) -> String {
             c.leaks,
             c.self_hits,
             c.off_surface,
-            c.non_finite
+            c.non_finite,
+            c.changed_pixels.map_or("–".to_string(), |n| n.to_string())
         );
     }
     out
@@ -257,7 +300,7 @@ mod tests {
             joints: true,
         });
         assert!(rows.iter().all(|r| r.counts.clean()), "{}", table(&rows));
-        assert_eq!(rows.len(), 12 * 12);
+        assert_eq!(rows.len(), 15 * 12);
         assert!(total(&rows).rays > 12 * 1000, "{}", total(&rows).rays);
     }
 

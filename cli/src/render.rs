@@ -125,6 +125,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         mut scene,
         mut settings,
         timings,
+        assets,
         ..
     } = glint_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
     apply_overrides(args, &mut settings);
@@ -142,9 +143,13 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         .validate()
         .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
 
+    let fingerprint = || fingerprint(args, &assets, &settings, scene.camera.resolution());
     let partial = match args.resume {
         true => {
-            Some(PartialFilm::load(&output).map_err(|e| Failure::Input(format!("--resume: {e}")))?)
+            let partial =
+                PartialFilm::load(&output).map_err(|e| Failure::Input(format!("--resume: {e}")))?;
+            check_same_render(&output, &partial, &fingerprint()?)?;
+            Some(partial)
         }
         false => None,
     };
@@ -185,7 +190,14 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
             .exit_status()
             .expect("only a signal stops a render early");
         let _writing = interrupts.writing();
-        return Err(write_partial(&output, film, rendered.finished, status));
+        let fingerprint = fingerprint()?;
+        return Err(write_partial(
+            &output,
+            film,
+            rendered.finished,
+            fingerprint,
+            status,
+        ));
     }
     let write_start = std::time::Instant::now();
     {
@@ -242,10 +254,15 @@ fn write_partial(
     output: &Path,
     film: glint_camera::Film,
     finished: Vec<bool>,
+    fingerprint: String,
     status: u8,
 ) -> Failure {
     let total = finished.len();
-    let partial = PartialFilm { film, finished };
+    let partial = PartialFilm {
+        film,
+        finished,
+        fingerprint: Some(fingerprint),
+    };
     let done = partial.finished_count();
     if let Err(e) = partial.save(output) {
         return Failure::Other(format!(
@@ -283,6 +300,59 @@ fn output_path(args: &RenderArgs) -> Result<PathBuf, Failure> {
     ImageFormat::from_path(&path).map_err(|e| Failure::Input(e.to_string()))?;
     crate::output::check_writable(&path)?;
     Ok(path)
+}
+
+/// A name for everything a render's pixels depend on: a BLAKE3 hash of the
+/// scene file and every asset it read (their bytes), the render settings that
+/// change pixels (not the thread count nor `--stats`), the resolution and the
+/// texture filter override. An interrupted render stores it in its partial
+/// EXR; `--resume` continues only a render with the same one.
+fn fingerprint(
+    args: &RenderArgs,
+    assets: &[PathBuf],
+    settings: &RenderSettings,
+    resolution: UVec2,
+) -> Result<String, Failure> {
+    let mut hasher = blake3::Hasher::new();
+    let mut add = |bytes: &[u8]| {
+        hasher.update(&(bytes.len() as u64).to_le_bytes());
+        hasher.update(bytes);
+    };
+    for path in std::iter::once(&args.scene).chain(assets) {
+        let bytes = std::fs::read(path)
+            .map_err(|e| Failure::Input(format!("{}: cannot read: {e}", path.display())))?;
+        add(&bytes);
+    }
+    let pixels_depend_on = RenderSettings {
+        threads: None,
+        stats: false,
+        ..settings.clone()
+    };
+    add(format!(
+        "{pixels_depend_on:?} {resolution} {:?}",
+        args.texture_filter
+    )
+    .as_bytes());
+    Ok(format!("blake3 {}", hasher.finalize().to_hex()))
+}
+
+/// Refuses to resume a partial render of another scene or other settings
+/// (whose finished pixels would not be this render's).
+fn check_same_render(output: &Path, partial: &PartialFilm, expected: &str) -> Result<(), Failure> {
+    match partial.fingerprint.as_deref() {
+        Some(f) if f == expected => Ok(()),
+        Some(_) => Err(Failure::Input(format!(
+            "--resume: {} was rendered from another scene, other assets or other \
+             settings than this command's (its fingerprint differs): resuming would mix \
+             two images; run the command that wrote it, or render again without --resume",
+            output.display()
+        ))),
+        None => Err(Failure::Input(format!(
+            "--resume: {} does not record the scene and settings it was rendered with \
+             (it was not written by an interrupted glint render); render again without --resume",
+            output.display()
+        ))),
+    }
 }
 
 fn apply_overrides(args: &RenderArgs, settings: &mut RenderSettings) {

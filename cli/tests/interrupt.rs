@@ -97,6 +97,20 @@ fn ctrl_c_writes_the_finished_pixels_and_resume_completes_them_bit_for_bit() {
         done < 64 * 64,
         "{done} pixels: the render was not cut short"
     );
+    // Other settings (another seed; another mirror depth, though this scene
+    // has no mirror) make another render: refused, the partial file left as
+    // it was.
+    let before = std::fs::read(dir.path().join("out.exr")).unwrap();
+    for other in [["--seed", "7"], ["--max-depth", "2"]] {
+        let mut a = args(spp, "out.exr");
+        a.extend(["--resume", other[0], other[1]].map(str::to_owned));
+        let refused = glint(
+            &a.iter().map(String::as_str).collect::<Vec<_>>(),
+            dir.path(),
+        );
+        common::assert_input_error(&refused, "its fingerprint differs");
+        assert_eq!(std::fs::read(dir.path().join("out.exr")).unwrap(), before);
+    }
     let resumed = glint(
         &[args(spp, "out.exr"), vec!["--resume".to_owned()]]
             .concat()
@@ -168,5 +182,15 @@ fn resume_refuses_what_is_not_a_partial_render() {
         Some(0)
     );
     common::assert_input_error(&run("done.exr"), "no coverage (alpha) channel");
+    let unnamed = glint_camera::PartialFilm {
+        film: glint_camera::Film::new(glam::UVec2::new(64, 64)),
+        finished: vec![false; 64 * 64],
+        fingerprint: None,
+    };
+    unnamed.save(&dir.path().join("unnamed.exr")).unwrap();
+    common::assert_input_error(
+        &run("unnamed.exr"),
+        "does not record the scene and settings",
+    );
     common::assert_input_error(&run("out.png"), "a partial render is an OpenEXR file");
 }

@@ -1,18 +1,28 @@
 //! A partly rendered film: what an interrupted render writes, and what a
 //! resumed one reads back. In OpenEXR the coverage is the alpha channel (1 for
 //! a rendered pixel, 0 for one not reached), so viewers show the unfinished
-//! pixels as transparent; the colour channels are the film's, 32-bit float.
+//! pixels as transparent; the colour channels are the film's, 32-bit float. A
+//! text naming the render (its fingerprint) goes in the header, as the string
+//! attribute [`FINGERPRINT_ATTRIBUTE`].
 
 use super::read::decode;
 use super::{Film, FilmError, ImageFormat};
 use glam::Vec3;
 use std::path::Path;
 
+/// The OpenEXR header attribute that holds a partial film's fingerprint.
+pub const FINGERPRINT_ATTRIBUTE: &str = "glintRender";
+
 /// A film and, per pixel (row-major from the top left), whether it was rendered.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PartialFilm {
     pub film: Film,
     pub finished: Vec<bool>,
+    /// What was being rendered, in a text of the writer's choosing (Glint's
+    /// command line hashes the scene, its assets and the settings), so that a
+    /// resumed render can check it continues the same one. Printable ASCII;
+    /// only OpenEXR keeps it.
+    pub fingerprint: Option<String>,
 }
 
 impl PartialFilm {
@@ -34,22 +44,43 @@ impl PartialFilm {
             }
             return film.save(path);
         }
-        let (w, h) = (self.film.resolution().x, self.film.resolution().y);
-        let data = self
-            .film
-            .pixels()
-            .iter()
-            .zip(&self.finished)
-            .flat_map(|(p, &done)| [p.x, p.y, p.z, if done { 1.0 } else { 0.0 }])
-            .collect();
-        let image = image::Rgba32FImage::from_raw(w, h, data).expect("buffer matches resolution");
+        use exr::prelude::{
+            AttributeValue, Encoding, Image, Layer, LayerAttributes, SpecificChannels, Text, Vec2,
+            WritableImage,
+        };
+        let width = self.film.resolution().x as usize;
+        let (pixels, finished) = (self.film.pixels(), &self.finished);
+        let rgba = SpecificChannels::rgba(|at: Vec2<usize>| {
+            let i = at.y() * width + at.x();
+            let (p, alpha) = (pixels[i], if finished[i] { 1.0f32 } else { 0.0 });
+            (p.x, p.y, p.z, alpha)
+        });
+        let mut attributes = LayerAttributes::default();
+        if let Some(fingerprint) = &self.fingerprint {
+            let printable = fingerprint
+                .bytes()
+                .all(|b| b.is_ascii_graphic() || b == b' ');
+            let text = Text::new_or_none(fingerprint)
+                .filter(|_| printable)
+                .ok_or_else(|| FilmError::Encode {
+                    path: path.to_path_buf(),
+                    message: "the render's fingerprint is not printable ASCII".into(),
+                })?;
+            attributes.other.insert(
+                Text::from(FINGERPRINT_ATTRIBUTE),
+                AttributeValue::Text(text),
+            );
+        }
+        let size = (width, self.film.resolution().y as usize);
+        let image = Image::from_layer(Layer::new(size, attributes, Encoding::FAST_LOSSLESS, rgba));
         let io_err = |source| FilmError::Io {
             path: path.to_path_buf(),
             source,
         };
         crate::write_atomically(path, io_err, |out| {
             image
-                .write_to(out, image::ImageFormat::OpenExr)
+                .write()
+                .to_buffered(out)
                 .map_err(|e| FilmError::Encode {
                     path: path.to_path_buf(),
                     message: e.to_string(),
@@ -85,8 +116,27 @@ impl PartialFilm {
             *pixel = Vec3::new(p.0[0], p.0[1], p.0[2]);
             finished.push(p.0[3] == 1.0);
         }
-        Ok(Self { film, finished })
+        let fingerprint = read_fingerprint(path).map_err(fail)?;
+        Ok(Self {
+            film,
+            finished,
+            fingerprint,
+        })
     }
+}
+
+/// The fingerprint in the header of the OpenEXR file at `path`, if any.
+fn read_fingerprint(path: &Path) -> Result<Option<String>, String> {
+    use exr::prelude::{AttributeValue, Text};
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
+    let key = Text::from(FINGERPRINT_ATTRIBUTE);
+    Ok(meta
+        .headers
+        .iter()
+        .find_map(|h| match h.own_attributes.other.get(&key) {
+            Some(AttributeValue::Text(t)) => Some(t.to_string()),
+            _ => None,
+        }))
 }
 
 #[cfg(test)]
@@ -100,7 +150,11 @@ mod tests {
             *p = Vec3::new(k as f32 * 0.37, -1.5e-7, f32::MAX / (k + 1) as f32);
         }
         let finished = (0..15).map(|k| k % 3 != 1).collect();
-        PartialFilm { film, finished }
+        PartialFilm {
+            film,
+            finished,
+            fingerprint: Some("scene 0123abcd, 16 spp".into()),
+        }
     }
 
     #[test]
@@ -111,6 +165,24 @@ mod tests {
         original.save(&path).unwrap();
         assert_eq!(PartialFilm::load(&path).unwrap(), original);
         assert_eq!(original.finished_count(), 10);
+    }
+
+    #[test]
+    fn exr_keeps_the_fingerprint_or_its_absence() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("partial.exr");
+        let mut original = partial();
+        original.fingerprint = None;
+        original.save(&path).unwrap();
+        assert_eq!(PartialFilm::load(&path).unwrap().fingerprint, None);
+        original.fingerprint = Some("scène".into());
+        let e = original.save(&path).unwrap_err().to_string();
+        assert!(e.contains("not printable ASCII"), "{e}");
+        assert_eq!(
+            PartialFilm::load(&path).unwrap().fingerprint,
+            None,
+            "a failed write leaves the file as it was"
+        );
     }
 
     #[test]

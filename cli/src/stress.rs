@@ -10,7 +10,7 @@ use glint_stress::{run, table, total, Row, Settings};
 
 #[derive(Args)]
 #[command(
-    after_help = "Builds every configuration (floors under lights down to 0.01° above the \
+    after_help = "Builds every configuration (floors under lights, and seen, down to 0.01° above the \
                   horizon, planes seen edge-on, a lone sphere, a tiny sphere on a huge one, \
                   closed boxes of walls, an AaBox, a box mesh and an icosahedron seen from \
                   inside and outside) at scales 1e-4 to 1e6, at the origin and up to 1e6 \

@@ -12,9 +12,9 @@ fn a_small_stress_run_counts_nothing_and_exits_zero() {
     let out = stdout(&o);
     assert_eq!(o.status.code(), Some(0), "{out}");
     let rows: Vec<&str> = out.lines().filter(|l| l.starts_with("| ")).collect();
-    // The header, then 12 configurations and 3 shipped scenes at 6 scales,
+    // The header, then 15 configurations and 3 shipped scenes at 6 scales,
     // each at two offsets.
-    assert_eq!(rows.len(), 1 + 180, "{out}");
+    assert_eq!(rows.len(), 1 + 216, "{out}");
     for row in &rows[1..] {
         let counts: Vec<&str> = row.split('|').map(str::trim).skip(5).take(5).collect();
         assert_eq!(counts, ["0"; 5], "{row}");

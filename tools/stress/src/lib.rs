@@ -6,8 +6,8 @@
 //!
 //! - **shadow acne**: a lit point whose shadow ray is blocked where nothing
 //!   can block it (a floor alone under a light down to 0.01° above its
-//!   horizon; a lone sphere; a tiny sphere resting on a huge one; a closed
-//!   mesh lit from outside);
+//!   horizon, or seen from as low; a lone sphere; a tiny sphere resting on a
+//!   huge one; a closed mesh lit from outside);
 //! - **light leaks**: from inside a closed box (six parallelograms meeting at
 //!   their edges, one `AaBox`, or a triangle mesh) or a closed icosahedron, a
 //!   shadow ray that reaches a light outside or a camera ray that escapes,
@@ -38,7 +38,8 @@ use glint_geometry::{reflect, spawn_ray, spawn_ray_to, Hit, Ray, RayTarget, Shap
 /// The scales every configuration is built at.
 pub const SCALES: [f32; 6] = [1e-4, 1e-2, 1.0, 1e2, 1e4, 1e6];
 
-/// Light elevations above a floor's horizon, in degrees.
+/// Light elevations above a floor's horizon, in degrees (the first three
+/// are also the elevations a floor is seen from).
 pub const GRAZING_DEGREES: [f32; 4] = [0.01, 0.1, 1.0, 30.0];
 
 /// Pixels across the shipped scenes' renders per ray of the grid's side.
@@ -147,7 +148,15 @@ pub fn run(settings: Settings) -> Vec<Row> {
             };
             for degrees in GRAZING_DEGREES {
                 let name = format!("floor, light {degrees}° up");
-                row(&name, flat::floor(at, scale, degrees, &steps));
+                row(
+                    &name,
+                    flat::floor(at, scale, degrees, flat::View::Above, &steps),
+                );
+            }
+            for degrees in &GRAZING_DEGREES[..3] {
+                let name = format!("floor, seen {degrees}° up");
+                let view = flat::View::Grazing(*degrees);
+                row(&name, flat::floor(at, scale, 30.0, view, &steps));
             }
             row("plane seen edge-on", flat::edge_on(at, scale, &steps));
             row("sphere", spheres::lone(at, scale, &steps));
@@ -300,7 +309,7 @@ mod tests {
             joints: true,
         });
         assert!(rows.iter().all(|r| r.counts.clean()), "{}", table(&rows));
-        assert_eq!(rows.len(), 15 * 12);
+        assert_eq!(rows.len(), 18 * 12);
         assert!(total(&rows).rays > 12 * 1000, "{}", total(&rows).rays);
     }
 

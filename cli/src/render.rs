@@ -143,12 +143,14 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         .validate()
         .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
 
-    let fingerprint = || fingerprint(args, &assets, &settings, scene.camera.resolution());
+    // Taken now, of the bytes just loaded: a scene edited during the render
+    // must not label its partial image.
+    let render_id = fingerprint(args, &assets, &settings, scene.camera.resolution())?;
     let partial = match args.resume {
         true => {
             let partial =
                 PartialFilm::load(&output).map_err(|e| Failure::Input(format!("--resume: {e}")))?;
-            check_same_render(&output, &partial, &fingerprint()?)?;
+            check_same_render(&output, &partial, scene.camera.resolution(), &render_id)?;
             Some(partial)
         }
         false => None,
@@ -167,14 +169,8 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         stop: Some(interrupts.stop()),
         resume: partial.as_ref(),
     };
-    let rendered = glint_integrator::render_with(&scene, &settings, &on_tile, control).map_err(
-        |e| match e {
-            glint_integrator::SettingsError::ResumeResolution { .. } => {
-                Failure::Input(format!("--resume: {}: {e}", output.display()))
-            }
-            e => Failure::Other(e.to_string()),
-        },
-    )?;
+    let rendered = glint_integrator::render_with(&scene, &settings, &on_tile, control)
+        .map_err(|e| Failure::Other(e.to_string()))?;
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
@@ -190,12 +186,11 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
             .exit_status()
             .expect("only a signal stops a render early");
         let _writing = interrupts.writing();
-        let fingerprint = fingerprint()?;
         return Err(write_partial(
             &output,
             film,
             rendered.finished,
-            fingerprint,
+            render_id,
             status,
         ));
     }
@@ -302,11 +297,11 @@ fn output_path(args: &RenderArgs) -> Result<PathBuf, Failure> {
     Ok(path)
 }
 
-/// A name for everything a render's pixels depend on: a BLAKE3 hash of the
-/// scene file and every asset it read (their bytes), the render settings that
-/// change pixels (not the thread count nor `--stats`), the resolution and the
-/// texture filter override. An interrupted render stores it in its partial
-/// EXR; `--resume` continues only a render with the same one.
+/// A name for everything a render's pixels depend on: a BLAKE3 hash of Glint's
+/// version, the scene file and every asset it read (their bytes), the render
+/// settings that change pixels (not the thread count nor `--stats`), the
+/// resolution and the texture filter override. An interrupted render stores it
+/// in its partial EXR; `--resume` continues only a render with the same one.
 fn fingerprint(
     args: &RenderArgs,
     assets: &[PathBuf],
@@ -318,6 +313,7 @@ fn fingerprint(
         hasher.update(&(bytes.len() as u64).to_le_bytes());
         hasher.update(bytes);
     };
+    add(env!("CARGO_PKG_VERSION").as_bytes());
     for path in std::iter::once(&args.scene).chain(assets) {
         let bytes = std::fs::read(path)
             .map_err(|e| Failure::Input(format!("{}: cannot read: {e}", path.display())))?;
@@ -336,9 +332,25 @@ fn fingerprint(
     Ok(format!("blake3 {}", hasher.finalize().to_hex()))
 }
 
-/// Refuses to resume a partial render of another scene or other settings
+/// Refuses to resume a partial render of another size, scene or settings
 /// (whose finished pixels would not be this render's).
-fn check_same_render(output: &Path, partial: &PartialFilm, expected: &str) -> Result<(), Failure> {
+fn check_same_render(
+    output: &Path,
+    partial: &PartialFilm,
+    resolution: UVec2,
+    expected: &str,
+) -> Result<(), Failure> {
+    let film = partial.film.resolution();
+    if film != resolution {
+        return Err(Failure::Input(format!(
+            "--resume: {}: the partial image is {}x{} pixels, this render {}x{}",
+            output.display(),
+            film.x,
+            film.y,
+            resolution.x,
+            resolution.y
+        )));
+    }
     match partial.fingerprint.as_deref() {
         Some(f) if f == expected => Ok(()),
         Some(_) => Err(Failure::Input(format!(

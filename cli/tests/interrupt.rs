@@ -98,25 +98,54 @@ fn ctrl_c_writes_the_finished_pixels_and_resume_completes_them_bit_for_bit() {
         "{done} pixels: the render was not cut short"
     );
     // Other settings (another seed; another mirror depth, though this scene
-    // has no mirror) make another render: refused, the partial file left as
-    // it was.
+    // has no mirror), an edited scene or another size make another render:
+    // refused, the partial file left as it was.
     let before = std::fs::read(dir.path().join("out.exr")).unwrap();
-    for other in [["--seed", "7"], ["--max-depth", "2"]] {
+    let edited = dir.path().join("edited.toml");
+    let text = std::fs::read_to_string(scene("cornell-set1")).unwrap();
+    std::fs::write(
+        &edited,
+        text.replacen("ambient = [0.1", "ambient = [0.2", 1),
+    )
+    .unwrap();
+    let refusals = [
+        (vec!["--seed", "7"], "its fingerprint differs"),
+        (vec!["--max-depth", "2"], "its fingerprint differs"),
+        (vec![], "its fingerprint differs"),
+        (
+            vec![],
+            "the partial image is 64x64 pixels, this render 32x64",
+        ),
+    ];
+    for (i, (other, expected)) in refusals.into_iter().enumerate() {
         let mut a = args(spp, "out.exr");
-        a.extend(["--resume", other[0], other[1]].map(str::to_owned));
+        match i {
+            2 => a[1] = edited.display().to_string(),
+            3 => a[3] = "32x64".to_owned(), // after --resolution
+            _ => {}
+        }
+        a.push("--resume".to_owned());
+        a.extend(other.iter().map(|s| s.to_string()));
         let refused = glint(
             &a.iter().map(String::as_str).collect::<Vec<_>>(),
             dir.path(),
         );
-        common::assert_input_error(&refused, "its fingerprint differs");
+        common::assert_input_error(&refused, expected);
         assert_eq!(std::fs::read(dir.path().join("out.exr")).unwrap(), before);
     }
+    std::fs::remove_file(&edited).unwrap();
+    // The thread count and --stats change no pixel: not part of the render.
     let resumed = glint(
-        &[args(spp, "out.exr"), vec!["--resume".to_owned()]]
-            .concat()
-            .iter()
-            .map(String::as_str)
-            .collect::<Vec<_>>(),
+        &[
+            args(spp, "out.exr"),
+            ["--resume", "--threads", "1", "--stats"]
+                .map(str::to_owned)
+                .to_vec(),
+        ]
+        .concat()
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>(),
         dir.path(),
     );
     assert_eq!(resumed.status.code(), Some(0), "{}", stderr(&resumed));

@@ -175,13 +175,20 @@ mod tests {
         original.fingerprint = None;
         original.save(&path).unwrap();
         assert_eq!(PartialFilm::load(&path).unwrap().fingerprint, None);
+        original.fingerprint = Some("a".into());
+        original.save(&path).unwrap();
+        let written = std::fs::read(&path).unwrap();
         original.fingerprint = Some("scène".into());
         let e = original.save(&path).unwrap_err().to_string();
         assert!(e.contains("not printable ASCII"), "{e}");
         assert_eq!(
-            PartialFilm::load(&path).unwrap().fingerprint,
-            None,
+            std::fs::read(&path).unwrap(),
+            written,
             "a failed write leaves the file as it was"
+        );
+        assert_eq!(
+            PartialFilm::load(&path).unwrap().fingerprint.as_deref(),
+            Some("a")
         );
     }
 

@@ -8,7 +8,7 @@
 //! and mirror ray should meet the same surfaces as at scale 1. Rounding moves
 //! what a ray meets only near an edge or a silhouette, so the reference judges a
 //! ray only where it is **robust**: four copies of it moved sideways by 1e-3 of
-//! the camera's distance to its target meet the same surface (or all miss).
+//! the camera's distance to the scene meet the same surface (or all miss).
 
 use crate::{finite, Counts};
 use glam::{DVec3, Vec2, Vec3};
@@ -54,8 +54,10 @@ pub(crate) const SHIPPED: [ShippedScene; 3] = [
 const LIGHT_GRID: [f32; 3] = [1.0 / 6.0, 0.5, 5.0 / 6.0];
 
 /// How far the reference moves a ray sideways to call it robust, as a fraction
-/// of the camera's distance to its target: far beyond the rounding of a scene
-/// moved 1000 times its size from the origin (a few 1e-6 of its size).
+/// of the camera's distance to the first surface along its central ray (3.6 to
+/// 20 scale units in the shipped scenes): beyond the rounding of a scene moved
+/// 1000 scale units from the origin (6e-5 of a unit per coordinate), and of the
+/// ray offsets there (a few 1e-4 of a unit).
 const ROBUST_SHIFT: f32 = 1e-3;
 
 impl ShippedScene {
@@ -157,7 +159,7 @@ pub(crate) fn transformed(toml: &str, scale: f64, offset: DVec3, width: u32) -> 
         .expect("[render] is a table");
     let [w, h] = match render.get("resolution") {
         Some(Value::Array(r)) => [number(&r[0]), number(&r[1])],
-        _ => [800.0, 600.0],
+        _ => [512.0, 512.0], // the format's default
     };
     let height = (width as f64 * h / w).round().max(1.0) as i64;
     render.insert(
@@ -298,10 +300,13 @@ fn truth(scene: &Scene, ray: &Ray, shift: f32, lights: &[LightPoint]) -> Option<
             blocked: Vec::new(),
         });
     };
-    let emitter = matches!(scene.surface_of(&hit), SurfaceKind::Emitter(_));
+    // A camera ray that meets a light sees its radiance: no shadow rays.
+    let lights = match scene.surface_of(&hit) {
+        SurfaceKind::Emitter(_) => &[][..],
+        SurfaceKind::Material(_) => lights,
+    };
     let blocked = lights
         .iter()
-        .filter(|_| !emitter)
         .map(|p| {
             let shadow = shadow_ray(&hit, ray.direction, p)?;
             let verdicts: Vec<bool> = std::iter::once(shadow)
@@ -414,8 +419,9 @@ fn judge_pixel(
             continue;
         }
         let blocker = scene.shapes.closest_hit(&shadow, 1.0);
-        // The integrator tests only the shapes that can lie between the point
-        // and an area light (never the point's own shape nor the light's).
+        // From a few light samples up, the integrator tests only the shapes
+        // that can lie between the point and an area light (leaving out the
+        // point's own shape and the light's where they are flat or convex).
         let culled = match &scene.lights[p.light] {
             Light::Area(a) => scene.shapes.occluders_towards(
                 hit.point,
@@ -510,6 +516,45 @@ mod tests {
             (number(&resolution[0]), number(&resolution[1])),
             (40.0, 30.0)
         );
+    }
+
+    #[test]
+    fn every_placed_table_is_transformed() {
+        let text = r#"
+            [camera]
+            position = [0, 0, 5]
+            look_at = [0, 0, 0]
+            fov = 40
+            [[box]]
+            min = [-1, -1, -1]
+            max = [1, 2, 3]
+            [[point_light]]
+            position = [4, 5, 6]
+            [[sphere]]
+            center = [1, 1, 1]
+            radius = 0.5
+            [[parallelogram]]
+            origin = [0, 0, 0]
+            edge1 = [1, 0, 0]
+            edge2 = [0, 1, 0]
+        "#;
+        let doc = table(&transformed(text, 2.0, DVec3::new(10.0, 0.0, 0.0), 64));
+        let first = |name: &str, key: &str| -> Vec<f64> {
+            let t = doc[name].as_array().unwrap()[0].as_table().unwrap();
+            match &t[key] {
+                toml::Value::Array(a) => a.iter().map(number).collect(),
+                v => vec![number(v)],
+            }
+        };
+        assert_eq!(first("box", "min"), [8.0, -2.0, -2.0]);
+        assert_eq!(first("box", "max"), [12.0, 4.0, 6.0]);
+        assert_eq!(first("point_light", "position"), [18.0, 10.0, 12.0]);
+        assert_eq!(first("sphere", "center"), [12.0, 2.0, 2.0]);
+        assert_eq!(first("sphere", "radius"), [1.0]);
+        assert_eq!(first("parallelogram", "origin"), [10.0, 0.0, 0.0]);
+        assert_eq!(first("parallelogram", "edge2"), [0.0, 2.0, 0.0]);
+        let resolution = doc["render"]["resolution"].as_array().unwrap();
+        assert_eq!(number(&resolution[1]), 64.0, "512 x 512 by default");
     }
 
     #[test]

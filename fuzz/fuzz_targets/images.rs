@@ -1,6 +1,8 @@
 //! Any bytes as an image file, the format chosen by the first byte (PNG, JPEG,
-//! Radiance HDR, OpenEXR, PFM): the texture loader and `Film::load` each give an
-//! image or an error, never a panic, and refuse absurd sizes before allocating.
+//! Radiance HDR, OpenEXR, PFM): the texture loader, `Film::load` and
+//! `PartialFilm::load` (what `--resume` reads: an EXR's pixels, coverage and
+//! header) each give an image or an error, never a panic, and refuse absurd
+//! sizes before allocating.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -21,4 +23,5 @@ fuzz_target!(|data: &[u8]| {
     std::fs::write(&path, bytes).unwrap();
     let _ = glint_texture::load_image(&path);
     let _ = glint_camera::Film::load(&path);
+    let _ = glint_camera::PartialFilm::load(&path);
 });

@@ -10,9 +10,10 @@ pub enum TextureFilter {
     /// Bilinear interpolation at full resolution: smooth magnification, aliases
     /// under minification.
     Bilinear,
-    /// Bilinear lookups in the two pyramid levels whose texel size brackets the
-    /// footprint's larger extent, blended (Williams 1983): isotropic, so it blurs
-    /// footprints that are long and thin.
+    /// Bilinear lookups in the two pyramid levels whose texel size brackets
+    /// half the footprint's larger extent (never less than its smaller one),
+    /// blended (Williams 1983): isotropic, so it blurs footprints that are long
+    /// and thin.
     #[default]
     Trilinear,
     /// Elliptically weighted average over the footprint's ellipse (Heckbert 1989,
@@ -168,11 +169,16 @@ fn to_st(tc: &TexCoord) -> (Vec2, Vec2, Vec2) {
     )
 }
 
-/// The footprint's extent for an isotropic filter: its longer axis, so that
-/// minification never aliases (the cost is blur across the shorter axis).
+/// The footprint's extent for an isotropic filter: half its longer axis, but
+/// never less than its shorter one. A bilinear lookup in a box-filtered level
+/// already spreads over about twice that level's texel, so a level whose
+/// texel is the whole footprint blurs twice too much; one level finer (half
+/// the longer axis) matches the pixel's box filter, and no finer than the
+/// shorter axis keeps a squashed footprint from aliasing along it.
 #[inline]
 fn footprint_width(dst0: Vec2, dst1: Vec2) -> f32 {
-    dst0.length().max(dst1.length())
+    let (a, b) = (dst0.length(), dst1.length());
+    (0.5 * a.max(b)).max(a.min(b))
 }
 
 #[cfg(test)]

@@ -71,7 +71,8 @@ impl ShippedScene {
         offset: DVec3,
         width: u32,
     ) -> SceneDescription {
-        for (path, text) in self.meshes {
+        // Written once per folder: every scale and offset reads the same files.
+        for (path, text) in self.meshes.iter().filter(|(p, _)| !dir.join(p).exists()) {
             let file = dir.join(path);
             std::fs::create_dir_all(file.parent().expect("a mesh path has a folder"))
                 .expect("the temporary folder takes the meshes");

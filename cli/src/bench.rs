@@ -5,7 +5,9 @@ use crate::{named, progress_bar, Failure};
 use clap::Args;
 use glam::UVec2;
 use glint_bench::budget::{parse_counts, parse_durations, sample_ladder, Ladder};
-use glint_bench::strategy::{combine, parse_samplers, parse_texture_filters};
+use glint_bench::strategy::{
+    combine, parse_light_strategies, parse_samplers, parse_texture_filters,
+};
 use glint_bench::{BenchConfig, BenchError, Progress, ReferenceChoice, RegionChoice};
 use glint_metrics::Region;
 use glint_texture::TextureFilter;
@@ -38,6 +40,13 @@ pub(crate) struct BenchArgs {
     /// [default: each texture's own]
     #[arg(long, value_name = "LIST")]
     texture_filters: Option<String>,
+
+    /// Physical shading: light strategies to compare (each with every sampler
+    /// and filter), comma-separated: solid-angle or area, each optionally with
+    /// +mis (multiple importance sampling of glossy lobes), e.g.
+    /// solid-angle+mis,solid-angle,area+mis,area [default: the scene's]
+    #[arg(long, value_name = "LIST")]
+    light_strategies: Option<String>,
 
     /// Camera samples per pixel at each step of the ladder, comma-separated
     #[arg(long, value_name = "LIST", default_value = "1,4,16,64,256")]
@@ -197,6 +206,12 @@ fn config(args: &BenchArgs) -> Result<BenchConfig, Failure> {
         }
         None => Vec::new(),
     };
+    let lights = match &args.light_strategies {
+        Some(list) => {
+            parse_light_strategies(list).map_err(|e| input(format!("--light-strategies: {e}")))?
+        }
+        None => Vec::new(),
+    };
     let light = parse_counts("--light-samples", &args.light_samples, 1).map_err(input)?;
     let environment = match &args.environment_samples {
         Some(list) => parse_counts("--environment-samples", list, 0).map_err(input)?,
@@ -242,7 +257,7 @@ fn config(args: &BenchArgs) -> Result<BenchConfig, Failure> {
     };
     Ok(BenchConfig {
         scene: args.scene.clone(),
-        strategies: combine(&samplers, &filters),
+        strategies: combine(&samplers, &filters, &lights),
         ladder,
         repeat: args.repeat as usize,
         region,

@@ -11,12 +11,14 @@
 //! The command line is the clap parser [`Cli`]; each subcommand has a file of its
 //! own: `render` ([`render::RenderArgs`], [`render::render`]), `diff`
 //! ([`diff::DiffArgs`], [`diff::diff`]), `bench` ([`bench::BenchArgs`],
-//! [`bench::bench`]), `stress` ([`stress::StressArgs`], [`stress::stress`]).
+//! [`bench::bench`]), `stress` ([`stress::StressArgs`], [`stress::stress`]),
+//! `export` ([`export::ExportArgs`], [`export::export`]).
 //! [`main`] maps every
 //! failure to its exit status; [`output`] checks output paths before any work.
 
 mod bench;
 mod diff;
+mod export;
 mod interrupt;
 mod output;
 mod render;
@@ -55,6 +57,9 @@ enum Command {
     /// Numerical stress: generated configurations at scales 1e-4 to 1e6,
     /// counting shadow acne, light leaks and self-hits; exit status 1 if any
     Stress(stress::StressArgs),
+    /// Write a scene for another renderer: --mitsuba, Mitsuba 3's XML with
+    /// its meshes, images and environment map beside it
+    Export(export::ExportArgs),
 }
 
 /// A failure and the exit status it maps to.
@@ -86,6 +91,7 @@ fn main() -> ExitCode {
         Command::Diff(args) => diff::diff(args),
         Command::Bench(args) => bench::bench(args),
         Command::Stress(args) => stress::stress(args),
+        Command::Export(args) => export::export(args),
     })
     .unwrap_or(Err(Failure::Panicked));
     match result {

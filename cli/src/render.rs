@@ -6,7 +6,7 @@ use crate::{named, progress_bar, Failure};
 use clap::Args;
 use glam::UVec2;
 use glint_camera::{ImageFormat, PartialFilm};
-use glint_integrator::{Aov, RenderControl, RenderSettings, SamplePattern};
+use glint_integrator::{Aov, AreaSampling, RenderControl, RenderSettings, SamplePattern};
 use glint_scene::SceneDescription;
 use glint_texture::TextureFilter;
 use std::path::{Path, PathBuf};
@@ -60,6 +60,18 @@ pub(crate) struct RenderArgs {
     /// patterns, grid needing a square count
     #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
     environment_sampler: Option<SamplePattern>,
+
+    /// Physical shading: how area lights are sampled (overrides
+    /// render.area_sampling): auto (by solid angle where a light subtends more
+    /// than 1 sr, else by area), solid-angle (uniform over the solid angle a
+    /// rectangular light subtends) or area (uniform over its area)
+    #[arg(long, value_name = "STRATEGY", value_parser = named(&AreaSampling::NAMES, AreaSampling::from_name))]
+    area_sampling: Option<AreaSampling>,
+
+    /// Physical shading: sample area lights only, without combining them with
+    /// samples of glossy lobes by multiple importance sampling (sets render.mis = false)
+    #[arg(long)]
+    no_mis: bool,
 
     /// Seed of every random stream (overrides render.seed)
     #[arg(long, value_name = "N")]
@@ -382,6 +394,12 @@ fn apply_overrides(args: &RenderArgs, settings: &mut RenderSettings) {
     }
     if let Some(seed) = args.seed {
         settings.seed = seed;
+    }
+    if let Some(strategy) = args.area_sampling {
+        settings.area_sampling = strategy;
+    }
+    if args.no_mis {
+        settings.mis = false;
     }
     if let Some(depth) = args.max_depth {
         settings.max_depth = depth;

@@ -37,6 +37,7 @@ impl StatsReport<'_> {
                 "shadow_to_lights": sh.light_shadow_rays,
                 "shadow_to_environment": sh.environment_shadow_rays,
                 "reflection": sh.reflection_rays,
+                "towards_lobe_samples": sh.brdf_rays,
                 "environment_lookups": sh.environment_lookups,
             },
             "light_samples": sh.light_samples,
@@ -78,13 +79,13 @@ impl StatsReport<'_> {
         let s = self.stats;
         let sh = &s.shading;
         let q = &s.queries;
-        let rays = s.camera_rays + s.shadow_rays + s.reflection_rays;
+        let rays = s.rays();
         let per_ray = |n: u64| n as f64 / rays.max(1) as f64;
         let mut lines = vec![
             "render statistics".to_string(),
             format!(
-                "  rays            {} camera, {} shadow to lights, {} shadow to the environment, {} reflection",
-                s.camera_rays, sh.light_shadow_rays, sh.environment_shadow_rays, sh.reflection_rays
+                "  rays            {} camera, {} shadow to lights, {} shadow to the environment, {} reflection, {} towards lobe samples",
+                s.camera_rays, sh.light_shadow_rays, sh.environment_shadow_rays, sh.reflection_rays, sh.brdf_rays
             ),
             format!(
                 "                  {} environment lookups by rays leaving the scene",

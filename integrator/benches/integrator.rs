@@ -145,6 +145,8 @@ fn li(c: &mut Criterion) {
             environment_samples: 0,
             environment_pattern: SamplePattern::Sobol,
             max_depth: 4,
+            area_sampling: glint_lighting::AreaSampling::Auto,
+            mis: true,
         };
         let mut ctx = SampleContext::new(light_samples, 0);
         group.bench_function(format!("light_samples_{light_samples}"), |b| {

@@ -82,6 +82,7 @@ impl Aov {
                 SurfaceKind::Material(m) => m.reflectances(&texture_footprint(m, &hit, diff)).0,
                 SurfaceKind::Emitter(Light::Area(a)) => a.color,
                 SurfaceKind::Emitter(Light::Point(p)) => p.color,
+                SurfaceKind::Emitter(Light::Sphere(s)) => s.color,
             },
         }
     }

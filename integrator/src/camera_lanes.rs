@@ -26,7 +26,7 @@ use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{
     offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayLanes, Shape, SurfaceLanes,
 };
-use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial};
+use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial, ShadingModel};
 use glint_texture::{TexCoord, Texture};
 
 impl DirectIntegrator {
@@ -36,6 +36,7 @@ impl DirectIntegrator {
     /// footprints.
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
         self.light_samples == 1
+            && scene.shading == ShadingModel::Phong
             && scene.environment.is_none()
             && scene.lights.iter().all(|l| matches!(l, Light::Area(_)))
             && scene
@@ -440,6 +441,8 @@ mod tests {
                 environment_samples: 4,
                 environment_pattern: SamplePattern::Sobol,
                 max_depth: 4,
+                area_sampling: glint_lighting::AreaSampling::Auto,
+                mis: true,
             };
             assert!(integrator.shades_first_hits_in_lanes(&scene));
             let resolution = scene.camera.resolution();
@@ -525,6 +528,8 @@ mod tests {
             environment_samples: 0,
             environment_pattern: SamplePattern::Sobol,
             max_depth: 4,
+            area_sampling: glint_lighting::AreaSampling::Auto,
+            mis: true,
         };
         assert!(integrator(1).shades_first_hits_in_lanes(&scene));
         // Several light samples: those are the lanes (`light_samples`).

@@ -27,6 +27,9 @@ pub struct ShadingCounters {
     pub skipped_behind_light: u64,
     /// Light samples with no shadow ray: the BRDF reflects nothing that way.
     pub skipped_zero_brdf: u64,
+    /// Rays towards directions drawn from a specular lobe, each checked for
+    /// the light it reaches (physical shading's multiple importance sampling).
+    pub brdf_rays: u64,
     /// Evaluations of a specular lobe (none for materials with ks = 0).
     pub specular_lobes: u64,
     /// Texture footprints computed from ray differentials (none for materials
@@ -46,6 +49,7 @@ impl std::ops::AddAssign for ShadingCounters {
         self.skipped_behind_surface += o.skipped_behind_surface;
         self.skipped_behind_light += o.skipped_behind_light;
         self.skipped_zero_brdf += o.skipped_zero_brdf;
+        self.brdf_rays += o.brdf_rays;
         self.specular_lobes += o.specular_lobes;
         self.footprints += o.footprints;
         self.nonfinite_samples += o.nonfinite_samples;

@@ -6,13 +6,13 @@ use glam::{Vec2, Vec3};
 use glint_geometry::{
     reflect_differential, spawn_ray, spawn_ray_to, Hit, Occluders, Ray, RayDifferential, RayTarget,
 };
-use glint_lighting::{AreaLight, Light, PhongMaterial};
+use glint_lighting::{AreaLight, AreaSampling, Light, PhongMaterial, ShadingModel};
 use glint_texture::TexCoord;
 
 /// From this many samples per area light on, each shading point first culls the
 /// shapes that cannot block its shadow rays to the light
 /// ([`glint_geometry::ShapeList::occluders_towards`]).
-const CULL_FROM_SAMPLES: u32 = 4;
+pub(crate) const CULL_FROM_SAMPLES: u32 = 4;
 
 /// The direct-lighting integrator of the course report (section 2.5), with the
 /// environment and mirror reflections of section 2.7.
@@ -31,6 +31,10 @@ pub struct DirectIntegrator {
     pub environment_samples: u32,
     pub environment_pattern: SamplePattern,
     pub max_depth: u32,
+    /// Physical shading: how area lights are sampled.
+    pub area_sampling: AreaSampling,
+    /// Physical shading: multiple importance sampling of glossy lobes.
+    pub mis: bool,
 }
 
 /// Reusable per-thread state: the current camera sample and its random stream,
@@ -76,6 +80,20 @@ impl SampleContext {
 }
 
 impl DirectIntegrator {
+    /// The integrator `settings` describe (their sample counts, patterns and
+    /// depth; the rest is the render loop's).
+    pub fn new(settings: &crate::RenderSettings) -> Self {
+        Self {
+            light_samples: settings.light_samples,
+            light_pattern: settings.light_pattern,
+            environment_samples: settings.environment_samples,
+            environment_pattern: settings.environment_pattern,
+            max_depth: settings.max_depth,
+            area_sampling: settings.area_sampling,
+            mis: settings.mis,
+        }
+    }
+
     /// Radiance arriving along `ray` (a camera ray, or a reflection ray `depth`
     /// reflections deep), whose footprint is given by the ray differentials `diff`.
     /// Light and environment samples come from the camera sample `ctx` was
@@ -114,6 +132,7 @@ impl DirectIntegrator {
         };
         let material = match scene.surface_of(&hit) {
             SurfaceKind::Emitter(Light::Area(area)) => return area.color,
+            SurfaceKind::Emitter(Light::Sphere(sphere)) => return sphere.color,
             SurfaceKind::Emitter(_) => return Vec3::ZERO,
             SurfaceKind::Material(m) => m,
         };
@@ -127,7 +146,10 @@ impl DirectIntegrator {
                 ctx.textures.record(material, &tc);
             }
             let point = ShadingPoint::new(&hit, material, ray, &tc);
-            self.shade(scene, &point, depth, ctx)
+            match scene.shading {
+                ShadingModel::Phong => self.shade(scene, &point, depth, ctx),
+                ShadingModel::Physical => self.shade_physical(scene, &point, depth, ctx),
+            }
         } else {
             Vec3::ZERO
         };
@@ -170,6 +192,9 @@ impl DirectIntegrator {
                     let pair = pairs.take(own, self.light_samples);
                     self.area_light(scene, point, index, area, pair, ctx)
                 }
+                // The course's model has no sphere lights: the scene file
+                // accepts them under physical shading only.
+                Light::Sphere(_) => Vec3::ZERO,
             };
         }
         if self.environment_samples > 0 {
@@ -218,7 +243,7 @@ impl DirectIntegrator {
     /// importance-sampled from the environment (the points of
     /// `environment_pattern` over [0, 1)² mapped to directions), for a shading
     /// point `depth` reflections deep.
-    fn environment_light(
+    pub(crate) fn environment_light(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
@@ -330,14 +355,14 @@ impl<'a> ShadingPoint<'a> {
     /// ray would leave into the surface and be blocked by the neighbouring
     /// triangles, leaving dark specks (the "shadow terminator" problem).
     #[inline]
-    fn above_surface(&self, l: Vec3) -> bool {
+    pub(crate) fn above_surface(&self, l: Vec3) -> bool {
         self.ng.dot(l) > 0.0
     }
 
     /// The BRDF times the cosine for light from direction `l`: the specular
     /// lobe only where `ks` is nonzero.
     #[inline]
-    fn brdf_cos(&self, l: Vec3, ctx: &mut SampleContext) -> Vec3 {
+    pub(crate) fn brdf_cos(&self, l: Vec3, ctx: &mut SampleContext) -> Vec3 {
         if self.has_specular {
             ctx.counters.specular_lobes += 1;
             self.material.brdf_cos(self.kd, self.ks, self.n, l, self.v)

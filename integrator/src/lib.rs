@@ -31,6 +31,7 @@ mod camera_lanes;
 pub mod counters;
 mod direct;
 mod light_samples;
+mod physical;
 mod render;
 pub mod sampling;
 mod scene;
@@ -38,6 +39,7 @@ mod scene;
 pub use aov::Aov;
 pub use counters::{LookupKind, ShadingCounters, TextureCounters};
 pub use direct::{DirectIntegrator, SampleContext};
+pub use glint_lighting::{AreaSampling, ShadingModel};
 pub use render::{
     camera_ray, render, render_with, RenderControl, RenderOutput, RenderSettings, RenderStats,
     SampleCount, SettingsError, MAX_SAMPLES, MAX_THREADS, TILE_SIZE,

@@ -6,6 +6,7 @@ use glam::{UVec2, Vec2, Vec3};
 use glint_camera::{Camera, Film, PartialFilm};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential, RayLanes};
+use glint_lighting::AreaSampling;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -53,6 +54,12 @@ pub struct RenderSettings {
     /// Gather the detailed counts of [`RenderStats`] (intersection tests, BVH
     /// visits, texture lookups by level); the image is the same either way.
     pub stats: bool,
+    /// Physical shading: how area lights are sampled.
+    pub area_sampling: AreaSampling,
+    /// Physical shading: combine light samples with as many samples of glossy
+    /// materials' specular lobes by multiple importance sampling (Veach's
+    /// power heuristic); off, area lights are sampled by light only.
+    pub mis: bool,
 }
 
 impl Default for RenderSettings {
@@ -69,6 +76,8 @@ impl Default for RenderSettings {
             environment_samples: 16,
             environment_pattern: SamplePattern::Sobol,
             stats: false,
+            area_sampling: AreaSampling::Auto,
+            mis: true,
         }
     }
 }
@@ -189,8 +198,10 @@ impl TileCounts {
 }
 
 impl RenderStats {
+    /// Every ray traced: camera, shadow, reflection, and the rays towards
+    /// directions drawn from specular lobes.
     pub fn rays(&self) -> u64 {
-        self.camera_rays + self.shadow_rays + self.reflection_rays
+        self.camera_rays + self.shadow_rays + self.reflection_rays + self.shading.brdf_rays
     }
 
     pub fn rays_per_second(&self) -> f64 {
@@ -269,13 +280,7 @@ fn render_on_current_pool(
 ) -> RenderOutput {
     let start = Instant::now();
     let resolution = scene.camera.resolution();
-    let integrator = DirectIntegrator {
-        light_samples: settings.light_samples,
-        light_pattern: settings.light_pattern,
-        environment_samples: settings.environment_samples,
-        environment_pattern: settings.environment_pattern,
-        max_depth: settings.max_depth,
-    };
+    let integrator = DirectIntegrator::new(settings);
     let (mut film, mut finished) = match control.resume {
         Some(partial) => (partial.film.clone(), partial.finished.clone()),
         None => (

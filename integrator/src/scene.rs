@@ -1,7 +1,9 @@
 use glam::Vec3;
 use glint_camera::Camera;
 use glint_geometry::{Hit, Shape, ShapeList, TriangleMesh};
-use glint_lighting::{AreaLight, EnvironmentLight, Light, PhongMaterial, PointLight};
+use glint_lighting::{
+    AreaLight, EnvironmentLight, Light, PhongMaterial, PointLight, ShadingModel, SphereLight,
+};
 use glint_texture::{Texture, TextureFilter};
 
 /// What a shape is to the integrator: a reflecting surface or an emitter.
@@ -41,6 +43,9 @@ pub struct Scene {
     /// Per light, the object of `shapes` that is its emitting surface
     /// (`u32::MAX` for a point light).
     pub light_objects: Vec<u32>,
+    /// How the lights' `color` and the materials are read: the course's Phong
+    /// model, or radiometric units ([`ShadingModel`]).
+    pub shading: ShadingModel,
 }
 
 impl Scene {
@@ -136,6 +141,7 @@ pub struct SceneBuilder {
     ambient: Vec3,
     environment: Option<EnvironmentLight>,
     mesh_materials: Vec<Vec<u32>>,
+    shading: ShadingModel,
 }
 
 impl SceneBuilder {
@@ -185,6 +191,22 @@ impl SceneBuilder {
         self
     }
 
+    /// How lights and materials are read (default: the course's Phong model).
+    pub fn shading(&mut self, shading: ShadingModel) -> &mut Self {
+        self.shading = shading;
+        self
+    }
+
+    /// Adds a spherical light (physical shading only), visible to camera rays
+    /// through its surface.
+    pub fn sphere_light(&mut self, light: SphereLight) -> &mut Self {
+        self.shapes.push(*light.surface());
+        self.surfaces
+            .push(Surface::Emitter(self.lights.len() as u32));
+        self.lights.push(Light::Sphere(light));
+        self
+    }
+
     pub fn ambient(&mut self, ambient: Vec3) -> &mut Self {
         self.ambient = ambient;
         self
@@ -228,6 +250,7 @@ impl SceneBuilder {
             ambient: self.ambient,
             environment: self.environment,
             mesh_materials: self.mesh_materials,
+            shading: self.shading,
         })
     }
 }

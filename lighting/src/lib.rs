@@ -24,23 +24,34 @@
 //!   environment's importance sampling.
 
 mod area_light;
+mod area_sampling;
+mod brdf_sampling;
 pub mod distribution;
 mod environment_light;
 mod material;
 mod phong_lanes;
 mod point_light;
+mod shading_model;
+mod sphere_light;
+mod spherical_rectangle;
 
 pub use area_light::AreaLight;
+pub use area_sampling::{AreaLightSampler, AreaSampling, LightSample, AUTO_SOLID_ANGLE_FROM};
 pub use environment_light::{EnvironmentLight, EnvironmentSample};
 pub use material::{PhongMaterial, SpecularLobe, UvTransform};
 pub use phong_lanes::PhongLanes;
 pub use point_light::PointLight;
+pub use shading_model::ShadingModel;
+pub use sphere_light::{SphereLight, SphereLightSample};
+pub use spherical_rectangle::SphericalRectangle;
 
 /// Every kind of light, as one enum (no virtual calls in the shading loop).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
     Point(PointLight),
     Area(AreaLight),
+    /// A sphere of radiance (physical shading only).
+    Sphere(SphereLight),
 }
 
 #[cfg(doctest)]

@@ -101,6 +101,12 @@ fn main() -> std::process::ExitCode {
     for (i, light) in s.lights.iter().enumerate() {
         match light {
             Light::Point(p) => println!("light #{i}: point at {}, color {}", p.position, p.color),
+            Light::Sphere(s) => println!(
+                "light #{i}: sphere centred at {}, radius {}, radiance {}",
+                s.surface().center(),
+                s.surface().radius(),
+                s.color
+            ),
             Light::Area(a) => println!(
                 "light #{i}: area centred at {}, normal {}, area {}, color {}",
                 a.surface().center(),

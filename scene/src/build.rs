@@ -11,7 +11,9 @@ use glint_camera::{Camera, CameraError};
 use glint_geometry::TriangleMesh;
 use glint_geometry::{AaBox, Parallelogram, Plane, Sphere};
 use glint_integrator::{RenderSettings, SampleCount, Scene, SceneBuilder, SettingsError};
-use glint_lighting::{AreaLight, EnvironmentLight, PhongMaterial, PointLight, UvTransform};
+use glint_lighting::{
+    AreaLight, EnvironmentLight, PhongMaterial, PointLight, ShadingModel, SphereLight, UvTransform,
+};
 use glint_texture::{
     load_image, Checkerboard, CubeMap, Environment, Image, ImageTexture, LatLongMap, Texture,
     TextureImage, MAX_IMAGE_TEXELS,
@@ -230,18 +232,55 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         }
         builder.mesh(mesh, triangle_materials);
     }
-    for p in &file.point_light {
+    let shading = file.shading.0;
+    builder.shading(shading);
+    for (i, p) in file.point_light.iter().enumerate() {
+        let field = format!("point_light[{i}]");
+        let power = LightPower {
+            shading,
+            table: p.span(),
+            color: p.get_ref().color.as_ref(),
+            physical: p.get_ref().intensity.as_ref(),
+            physical_key: "intensity",
+            physical_unit: "W/sr",
+            kind: "a point light",
+        };
         builder.point_light(PointLight {
-            position: p.position.0,
-            color: p.color.0,
+            position: p.get_ref().position.0,
+            color: power.value(&field)?,
         });
     }
     for (i, a) in file.area_light.iter().enumerate() {
         let field = format!("area_light[{i}]");
-        let light = AreaLight::new(a.center.0, a.edge1.get_ref().0, a.edge2.0, a.color.0)
+        let power = LightPower {
+            shading,
+            table: a.span(),
+            color: a.get_ref().color.as_ref(),
+            physical: a.get_ref().radiance.as_ref(),
+            physical_key: "radiance",
+            physical_unit: "W/(sr·m²)",
+            kind: "an area light",
+        };
+        let color = power.value(&field)?;
+        let a = a.get_ref();
+        let light = AreaLight::new(a.center.0, a.edge1.get_ref().0, a.edge2.0, color)
             .ok_or_else(|| no_area(&field, &a.edge1))?;
         let front = front_side(&field, light.surface().normal(), a.normal.as_ref())?;
         builder.area_light(light.facing(front));
+    }
+    for (i, s) in file.sphere_light.iter().enumerate() {
+        if shading != ShadingModel::Physical {
+            return Err(Problem::new(
+                s.span(),
+                format!("sphere_light[{i}]"),
+                "sphere lights are for shading = \"physical\"; the course's model \
+                 (shading = \"phong\", the default) has point and area lights only",
+            ));
+        }
+        let s = s.get_ref();
+        let light = SphereLight::new(s.center.0, s.radius.0, s.radiance.0)
+            .expect("radius read as positive");
+        builder.sphere_light(light);
     }
     builder.ambient(file.ambient.0);
     if let Some(env) = &file.environment {
@@ -313,6 +352,68 @@ fn regions(file: &SceneFile) -> Result<Vec<(String, [u32; 4])>, Problem> {
         .collect()
 }
 
+/// A light's strength as the scene's shading model reads it: the course's
+/// `color` (default white) under `"phong"`, a radiometric key (`intensity`,
+/// `radiance`) under `"physical"`, where it is required. Each key is refused
+/// under the other model, so that a light is never read in the wrong units.
+struct LightPower<'a> {
+    shading: ShadingModel,
+    table: std::ops::Range<usize>,
+    color: Option<&'a Spanned<crate::values::Color>>,
+    physical: Option<&'a Spanned<crate::values::Color>>,
+    physical_key: &'static str,
+    physical_unit: &'static str,
+    /// "a point light" or "an area light", for messages.
+    kind: &'static str,
+}
+
+impl LightPower<'_> {
+    fn value(&self, field: &str) -> Result<Vec3, Problem> {
+        let key = self.physical_key;
+        match self.shading {
+            ShadingModel::Phong => {
+                if let Some(value) = self.physical {
+                    return Err(Problem::new(
+                        value.span(),
+                        format!("{field}.{key}"),
+                        format!(
+                            "`{key}` is for shading = \"physical\"; this scene uses the \
+                             course's model (shading = \"phong\", the default), whose lights \
+                             take a `color`"
+                        ),
+                    ));
+                }
+                Ok(self.color.map_or(Vec3::ONE, |c| c.get_ref().0))
+            }
+            ShadingModel::Physical => {
+                if let Some(color) = self.color {
+                    return Err(Problem::new(
+                        color.span(),
+                        format!("{field}.color"),
+                        format!(
+                            "with shading = \"physical\" a light's strength is its `{key}` \
+                             (in {}), not a `color`",
+                            self.physical_unit
+                        ),
+                    ));
+                }
+                match self.physical {
+                    Some(value) => Ok(value.get_ref().0),
+                    None => Err(Problem::new(
+                        self.table.clone(),
+                        format!("{field}.{key}"),
+                        format!(
+                            "missing `{key}`: with shading = \"physical\" {} needs one \
+                             (in {}, per channel)",
+                            self.kind, self.physical_unit
+                        ),
+                    )),
+                }
+            }
+        }
+    }
+}
+
 fn no_area(field: &str, edge1: &Spanned<crate::values::Point>) -> Problem {
     Problem::new(
         edge1.span(),
@@ -358,6 +459,8 @@ fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> {
         environment_samples: *render.environment_samples.get_ref(),
         environment_pattern: render.environment_sampler.get_ref().0,
         stats: false,
+        area_sampling: render.area_sampling.0,
+        mis: render.mis,
     };
     settings.validate().map_err(|e| {
         // Point at the count if the file set it, else at its sampler.

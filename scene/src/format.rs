@@ -11,6 +11,9 @@ use toml::Spanned;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
+    /// `"phong"` (the course's model) or `"physical"` (radiometric units).
+    #[serde(default)]
+    pub shading: Shading,
     /// Ambient light added as `ambient · kd` at every shaded point.
     #[serde(default = "black")]
     pub ambient: Color,
@@ -33,9 +36,11 @@ pub struct SceneFile {
     #[serde(default)]
     pub mesh: Vec<MeshTable>,
     #[serde(default)]
-    pub point_light: Vec<PointLightTable>,
+    pub point_light: Vec<Spanned<PointLightTable>>,
     #[serde(default)]
-    pub area_light: Vec<AreaLightTable>,
+    pub area_light: Vec<Spanned<AreaLightTable>>,
+    #[serde(default)]
+    pub sphere_light: Vec<Spanned<SphereLightTable>>,
     /// Named rectangles of the image, `[x0, y0, x1, y1]` in pixels of the render
     /// resolution (x1, y1 excluded), for `glint bench --region NAME`.
     #[serde(default)]
@@ -80,6 +85,10 @@ pub struct RenderTable {
     pub max_depth: Spanned<u32>,
     pub environment_samples: Spanned<u32>,
     pub environment_sampler: Spanned<Pattern>,
+    /// Physical shading: how area lights are sampled.
+    pub area_sampling: AreaSamplingName,
+    /// Physical shading: multiple importance sampling of glossy lobes.
+    pub mis: bool,
 }
 
 /// The environment: exactly one of `color`, `cube_map`, `latlong`.
@@ -118,6 +127,8 @@ impl Default for RenderTable {
             max_depth: Spanned::new(0..0, settings.max_depth),
             environment_samples: Spanned::new(0..0, settings.environment_samples),
             environment_sampler: Spanned::new(0..0, Pattern(settings.environment_pattern)),
+            area_sampling: AreaSamplingName(settings.area_sampling),
+            mis: settings.mis,
         }
     }
 }
@@ -295,8 +306,10 @@ pub struct BoxTable {
 #[serde(deny_unknown_fields)]
 pub struct PointLightTable {
     pub position: Point,
-    #[serde(default = "white")]
-    pub color: Color,
+    /// The course's light colour (`shading = "phong"` only; default white).
+    pub color: Option<Spanned<Color>>,
+    /// Radiant intensity in W/sr per channel (`shading = "physical"` only).
+    pub intensity: Option<Spanned<Color>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -307,8 +320,21 @@ pub struct AreaLightTable {
     pub edge2: Point,
     /// Which side emits; must be perpendicular to both edges.
     pub normal: Option<Spanned<Direction>>,
-    #[serde(default = "white")]
-    pub color: Color,
+    /// The course's light colour (`shading = "phong"` only; default white).
+    pub color: Option<Spanned<Color>>,
+    /// Emitted radiance of the front face, W/(sr·m²) per channel
+    /// (`shading = "physical"` only).
+    pub radiance: Option<Spanned<Color>>,
+}
+
+/// A sphere emitting `radiance` from its surface (`shading = "physical"` only).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereLightTable {
+    pub center: Point,
+    pub radius: Positive,
+    /// Emitted radiance, W/(sr·m²) per channel.
+    pub radiance: Color,
 }
 
 /// A triangle mesh read from an OBJ file, placed by a transform.

@@ -23,6 +23,7 @@
 mod build;
 mod error;
 mod format;
+pub mod mitsuba;
 mod obj;
 mod values;
 

@@ -3,7 +3,7 @@
 
 use glam::{UVec2, Vec3};
 use glint_integrator::SamplePattern;
-use glint_lighting::SpecularLobe;
+use glint_lighting::{AreaSampling, ShadingModel, SpecularLobe};
 use glint_texture::{TextureFilter, WrapMode};
 use serde::de::{self, Deserialize, Deserializer, Visitor};
 use std::fmt;
@@ -208,6 +208,16 @@ impl<'de> Deserialize<'de> for Pattern {
     }
 }
 
+/// An area-light sampling name: `"solid-angle"` or `"area"`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AreaSamplingName(pub AreaSampling);
+
+impl<'de> Deserialize<'de> for AreaSamplingName {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        named(d, &AreaSampling::NAMES, AreaSampling::from_name).map(AreaSamplingName)
+    }
+}
+
 /// A specular lobe name: `"phong"` or `"blinn-phong"`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lobe(pub SpecularLobe);
@@ -220,6 +230,21 @@ impl<'de> Deserialize<'de> for Lobe {
             _ => None,
         })
         .map(Lobe)
+    }
+}
+
+/// A shading model name: `"phong"` or `"physical"`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Shading(pub ShadingModel);
+
+impl<'de> Deserialize<'de> for Shading {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        named(d, &["phong", "physical"], |n| match n {
+            "phong" => Some(ShadingModel::Phong),
+            "physical" => Some(ShadingModel::Physical),
+            _ => None,
+        })
+        .map(Shading)
     }
 }
 

@@ -75,6 +75,13 @@ fn each_kind_of_bad_input_has_its_own_message() {
         ("empty region", format!("{CAMERA}[render]\nresolution = [64, 32]\n[regions]\nfloor = [10, 20, 10, 30]\n")),
         ("region past the image", format!("{CAMERA}[render]\nresolution = [64, 32]\n[regions]\nfloor = [0, 0, 64, 33]\n")),
         ("negative region corner", format!("{CAMERA}[regions]\nfloor = [-1, 0, 4, 4]\n")),
+        ("unknown shading model", format!("shading = \"pbr\"\n{CAMERA}")),
+        ("intensity in the course's model", format!("{CAMERA}[[point_light]]\nposition = [0, 1, 0]\nintensity = [5, 5, 5]\n")),
+        ("color in physical shading", format!("shading = \"physical\"\n{CAMERA}[[point_light]]\nposition = [0, 1, 0]\ncolor = [1, 1, 1]\n")),
+        ("physical area light without radiance", format!("shading = \"physical\"\n{CAMERA}[[area_light]]\ncenter = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, 1]\n")),
+        ("negative radiance", format!("shading = \"physical\"\n{CAMERA}[[area_light]]\ncenter = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, 1]\nradiance = [1, -1, 1]\n")),
+        ("sphere light in the course's model", format!("{CAMERA}[[sphere_light]]\ncenter = [0, 0, 0]\nradius = 1\nradiance = [1, 1, 1]\n")),
+        ("unknown area sampling", format!("{CAMERA}[render]\narea_sampling = \"cosine\"\n")),
     ];
     let mut report = String::new();
     for (name, body) in &cases {

@@ -179,3 +179,47 @@ fn environment_16x16_render_snapshot() {
     });
     insta::assert_snapshot!(pixel_table(&film));
 }
+
+/// A 16×16 render of the physical Cornell box (grid patterns, 4 spp, 4 light
+/// samples), every pixel's RGB locked to five significant digits.
+#[test]
+fn cornell_physical_16x16_render_snapshot() {
+    let d = load(&scene_path("cornell-physical")).unwrap();
+    let film = render_at(&d, 16, 16, |s| {
+        (s.spp, s.pixel_pattern) = (4, SamplePattern::Grid);
+        (s.light_samples, s.light_pattern) = (4, SamplePattern::Grid);
+    });
+    insta::assert_snapshot!(pixel_table(&film));
+}
+
+/// A 24×12 render of the glossy spheres (multiple importance sampling of
+/// lobes, two lights), locked the same way.
+#[test]
+fn physical_glossy_24x12_render_snapshot() {
+    let d = load(&scene_path("physical-glossy")).unwrap();
+    let film = render_at(&d, 24, 12, |s| {
+        (s.spp, s.pixel_pattern) = (4, SamplePattern::Grid);
+        (s.light_samples, s.light_pattern) = (4, SamplePattern::Grid);
+    });
+    insta::assert_snapshot!(pixel_table(&film));
+}
+
+/// Physical shading, with its lobe samples and random light samples, is
+/// bit-identical for any thread count too.
+#[test]
+fn physical_scene_renders_bit_identically_on_1_and_4_threads() {
+    let d = load(&scene_path("physical-glossy")).unwrap();
+    let at = |threads| {
+        let film = render_at(&d, 48, 24, |s| {
+            (s.spp, s.light_samples) = (2, 3);
+            s.light_pattern = SamplePattern::Random;
+            s.threads = Some(threads);
+        });
+        let bits = film
+            .pixels()
+            .iter()
+            .flat_map(|p| p.to_array().map(f32::to_bits));
+        bits.collect::<Vec<u32>>()
+    };
+    assert_eq!(at(1), at(4));
+}

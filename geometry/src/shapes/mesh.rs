@@ -143,6 +143,22 @@ impl TriangleMesh {
         !self.normals.is_empty()
     }
 
+    /// The vertex positions.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// The per-vertex shading normals (empty when the mesh has none).
+    pub fn normals(&self) -> &[Vec3] {
+        &self.normals
+    }
+
+    /// The per-vertex texture coordinates (empty when the mesh has none: a hit's
+    /// uv is then its barycentric `(b1, b2)`).
+    pub fn uvs(&self) -> &[Vec2] {
+        &self.uvs
+    }
+
     /// The three corners of triangle `i`.
     #[inline]
     pub fn corners(&self, i: u32) -> [Vec3; 3] {

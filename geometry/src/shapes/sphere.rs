@@ -94,6 +94,18 @@ impl Sphere {
         self.surface_frame(ray, t).0
     }
 
+    /// The point `c + r·n` of the unit normal `n` as a ray's target: with its
+    /// error bound and its outward normal, so that a ray from outside ends
+    /// just short of the surface ([`crate::RayTarget::end`]).
+    #[inline]
+    pub fn target_at(&self, n: Vec3) -> crate::RayTarget {
+        crate::RayTarget {
+            point: self.center + self.radius * n,
+            error: self.point_error(n),
+            normal: n,
+        }
+    }
+
     /// The error bound of the point `c + r·n` ([`crate::error_bounds`]):
     /// `γ₂|c| + γ₆·r·|n|`.
     #[inline]

@@ -40,6 +40,10 @@ pub enum DimensionPair {
     /// shading points `depth` mirror reflections deep (0: the camera ray's hit).
     /// Camera sample `s` with `m` light samples takes points `s·m` to `s·m + m − 1`.
     Light { light: u32, depth: u32 },
+    /// Directions drawn from the BRDF towards the light at index `light`, for
+    /// shading points `depth` mirror reflections deep (physical shading's
+    /// multiple importance sampling); taken as [`Self::Light`]'s points are.
+    Brdf { light: u32, depth: u32 },
     /// Environment directions for shading points `depth` mirror reflections deep;
     /// camera sample `s` with `m` environment samples takes points `s·m` to
     /// `s·m + m − 1`.
@@ -66,6 +70,7 @@ impl DimensionPair {
             Self::Pixel => 0,
             Self::Light { light, depth: d } => 1 | depth(d) | (light as u64) << 32,
             Self::Environment { depth: d } => 2 | depth(d),
+            Self::Brdf { light, depth: d } => 3 | depth(d) | (light as u64) << 32,
             // The pixel's own sequence (other dimensions of it).
             Self::Joint { .. } => Self::Pixel.id(),
         }

@@ -1,8 +1,9 @@
 //! Strategies: what a bench compares. A strategy fixes where samples fall (the
 //! pixel, light and environment sample patterns) and, optionally, how every image
-//! texture is filtered; everything else comes from the scene file.
+//! texture is filtered and how physical shading samples area lights; everything
+//! else comes from the scene file.
 
-use glint_integrator::{RenderSettings, SamplePattern, Scene};
+use glint_integrator::{AreaSampling, RenderSettings, SamplePattern, Scene};
 use glint_texture::TextureFilter;
 
 /// One way of rendering the scene that the bench measures.
@@ -13,6 +14,35 @@ pub struct Strategy {
     pub environment: SamplePattern,
     /// Overrides the filtering of every image texture (`None`: each texture's own).
     pub texture_filter: Option<TextureChoice>,
+    /// Overrides how physical shading samples area lights (`None`: the scene's).
+    pub light_strategy: Option<LightStrategy>,
+}
+
+/// How physical shading samples area lights: the density of light samples,
+/// and whether glossy lobes are sampled too, combined by multiple importance
+/// sampling. Named `SAMPLING` or `SAMPLING+mis` (`area+mis`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LightStrategy {
+    pub sampling: AreaSampling,
+    pub mis: bool,
+}
+
+impl LightStrategy {
+    pub fn from_name(name: &str) -> Option<Self> {
+        let (sampling, mis) = match name.strip_suffix("+mis") {
+            Some(sampling) => (sampling, true),
+            None => (name, false),
+        };
+        Some(Self {
+            sampling: AreaSampling::from_name(sampling)?,
+            mis,
+        })
+    }
+
+    pub fn name(self) -> String {
+        let mis = if self.mis { "+mis" } else { "" };
+        format!("{}{mis}", self.sampling.name())
+    }
 }
 
 /// How a strategy filters image textures.
@@ -60,12 +90,14 @@ impl Strategy {
             light: pattern,
             environment: pattern,
             texture_filter: None,
+            light_strategy: None,
         }
     }
 
     /// The name the tables, files and plots use: `sobol` when one pattern places
     /// every sample, `PIXEL/LIGHT` or `PIXEL/LIGHT/ENVIRONMENT` otherwise, then
-    /// `+FILTER` when the texture filter is overridden.
+    /// `+FILTER` when the texture filter is overridden and `+LIGHTS` when the
+    /// light strategy is (`sobol+area+mis`).
     pub fn name(&self) -> String {
         let mut name = self.pixel.name().to_owned();
         if self.light != self.pixel || self.environment != self.light {
@@ -76,6 +108,9 @@ impl Strategy {
         }
         if let Some(filter) = self.texture_filter {
             name = format!("{name}+{}", filter.name());
+        }
+        if let Some(lights) = self.light_strategy {
+            name = format!("{name}+{}", lights.name());
         }
         name
     }
@@ -95,6 +130,10 @@ impl Strategy {
         settings.environment_pattern = self.environment;
         if let Some(choice) = self.texture_filter {
             choice.apply(scene);
+        }
+        if let Some(lights) = self.light_strategy {
+            settings.area_sampling = lights.sampling;
+            settings.mis = lights.mis;
         }
     }
 
@@ -131,12 +170,14 @@ pub fn parse_samplers(list: &str) -> Result<Vec<Strategy>, String> {
                 light,
                 environment: light,
                 texture_filter: None,
+                light_strategy: None,
             },
             [pixel, light, environment] => Strategy {
                 pixel,
                 light,
                 environment,
                 texture_filter: None,
+                light_strategy: None,
             },
             _ => {
                 return Err(format!(
@@ -170,21 +211,55 @@ pub fn parse_texture_filters(list: &str) -> Result<Vec<TextureChoice>, String> {
     Ok(filters)
 }
 
-/// Every sampler strategy with every texture filter (or with none, keeping each
-/// texture's own, when `filters` is empty).
-pub fn combine(samplers: &[Strategy], filters: &[TextureChoice]) -> Vec<Strategy> {
-    if filters.is_empty() {
-        return samplers.to_vec();
+/// Parses a list of light strategies (`solid-angle+mis,solid-angle,area+mis,area`).
+pub fn parse_light_strategies(list: &str) -> Result<Vec<LightStrategy>, String> {
+    let mut strategies = Vec::new();
+    for name in list.split(',').map(str::trim) {
+        let strategy = LightStrategy::from_name(name).ok_or_else(|| {
+            format!(
+                "unknown light strategy \"{name}\", expected one of {}, each \
+                 optionally followed by +mis",
+                AreaSampling::NAMES.join(", ")
+            )
+        })?;
+        if strategies.contains(&strategy) {
+            return Err(format!("light strategy \"{name}\" is listed twice"));
+        }
+        strategies.push(strategy);
     }
-    samplers
-        .iter()
-        .flat_map(|s| {
-            filters.iter().map(move |&f| Strategy {
-                texture_filter: Some(f),
-                ..*s
-            })
-        })
-        .collect()
+    Ok(strategies)
+}
+
+/// Every sampler strategy with every texture filter and every light strategy
+/// (an empty list keeps the scene's own).
+pub fn combine(
+    samplers: &[Strategy],
+    filters: &[TextureChoice],
+    lights: &[LightStrategy],
+) -> Vec<Strategy> {
+    let filters: Vec<Option<TextureChoice>> = if filters.is_empty() {
+        vec![None]
+    } else {
+        filters.iter().copied().map(Some).collect()
+    };
+    let lights: Vec<Option<LightStrategy>> = if lights.is_empty() {
+        vec![None]
+    } else {
+        lights.iter().copied().map(Some).collect()
+    };
+    let mut all = Vec::new();
+    for s in samplers {
+        for &texture_filter in &filters {
+            for &light_strategy in &lights {
+                all.push(Strategy {
+                    texture_filter,
+                    light_strategy,
+                    ..*s
+                });
+            }
+        }
+    }
+    all
 }
 
 #[cfg(test)]
@@ -205,9 +280,38 @@ mod tests {
                 TextureChoice::Filter(TextureFilter::Ewa),
                 TextureChoice::AnalyticCheckerboards,
             ],
+            &[],
         );
         assert_eq!(with_filter[0].name(), "sobol+ewa");
         assert_eq!(with_filter[1].name(), "sobol+analytic");
+        let lights = parse_light_strategies("solid-angle+mis, area").unwrap();
+        let with_lights = combine(&s[..2], &[], &lights);
+        let names: Vec<String> = with_lights.iter().map(Strategy::name).collect();
+        assert_eq!(
+            names,
+            [
+                "sobol+solid-angle+mis",
+                "sobol+area",
+                "stratified/random+solid-angle+mis",
+                "stratified/random+area"
+            ]
+        );
+        let mut settings = RenderSettings::default();
+        let camera = glint_camera::Camera::new(
+            glam::Vec3::Z,
+            glam::Vec3::ZERO,
+            glam::Vec3::Y,
+            45.0,
+            1.0,
+            glam::UVec2::ONE,
+        )
+        .unwrap();
+        let mut scene = glint_integrator::SceneBuilder::new().build(camera).unwrap();
+        with_lights[1].apply(&mut scene, &mut settings);
+        assert_eq!(
+            (settings.area_sampling, settings.mis),
+            (AreaSampling::Area, false)
+        );
         assert_eq!(
             parse_texture_filters("trilinear, analytic").unwrap(),
             [
@@ -231,6 +335,12 @@ mod tests {
         assert!(parse_texture_filters("ewa,box")
             .unwrap_err()
             .contains("box"));
+        assert!(parse_light_strategies("area,cosine+mis")
+            .unwrap_err()
+            .contains("\"cosine+mis\""));
+        assert!(parse_light_strategies("area+mis,area+mis")
+            .unwrap_err()
+            .contains("twice"));
     }
 
     #[test]

@@ -215,6 +215,8 @@ fn light_points(scene: &Scene) -> Vec<LightPoint> {
                     }
                 }
             }
+            // Sphere lights are physical shading's; the stressed scenes have none.
+            Light::Sphere(_) => {}
         }
     }
     points
@@ -429,7 +431,7 @@ fn judge_pixel(
                 &a.surface().corners(),
                 [hit.shape, scene.light_objects[p.light]],
             ),
-            Light::Point(_) => Occluders::ALL,
+            Light::Point(_) | Light::Sphere(_) => Occluders::ALL,
         };
         let blocked_as_rendered = scene.shapes.any_hit_among(&culled, &shadow, 1.0);
         flags.acne |= blocker

@@ -1,0 +1,334 @@
+//! Physical shading (`shading = "physical"`): radiometric lights and
+//! energy-conserving BRDFs, estimated with multiple importance sampling.
+//!
+//! At a surface point `x` seen from direction `v`, the reflected radiance is
+//!
+//! `L(x, v) = ambient·kd + Σ_point f(l, v)·cos θ·I/r² · V + Σ_area ∫_Ω f·L_e·cos θ·V dω + L_env`
+//!
+//! with `f = kd/π + ks·(normalised lobe)` ([`glint_lighting::PhongMaterial::brdf_cos`]), `I`
+//! a point light's intensity, `L_e` an area light's radiance (front side only)
+//! and `V` the visibility. The environment term is the same as in Phong
+//! shading (it is physical already).
+//!
+//! Each area light takes N light samples, drawn by area or solid angle
+//! ([`AreaSampling`](glint_lighting::AreaSampling)). On a glossy material
+//! (`ks ≠ 0`) it also takes N directions drawn from the specular lobe
+//! ([`glint_lighting::PhongMaterial::sample_specular`]), each traced to see whether it reaches
+//! the light, and the two are combined by multiple importance sampling with
+//! the power heuristic (Veach and Guibas 1995; Veach's thesis 1997, §9.2):
+//! a sample drawn by technique `a` with density `p_a`, where the other gives
+//! `p_b`, is weighted `p_a² / (p_a² + p_b²)` (equal sample counts). The weights
+//! of the two techniques sum to 1 for every direction, so the estimate is
+//! unbiased; light samples carry the diffuse term and broad lobes, lobe samples
+//! the sharp highlight of a large light, where light samples alone are noisy.
+//! On a purely diffuse material only the light is sampled (weight 1).
+
+use crate::direct::{PairAllocation, SampleContext, ShadingPoint, CULL_FROM_SAMPLES};
+use crate::sampling::DimensionPair;
+use crate::{DirectIntegrator, Scene};
+use glam::Vec3;
+use glint_geometry::{spawn_ray, spawn_ray_to, Occluders, RayTarget};
+use glint_lighting::{AreaLight, AreaLightSampler, Light, PointLight, SphereLight};
+
+impl DirectIntegrator {
+    /// The local shading of `point` in physical units, `depth` reflections deep.
+    pub(crate) fn shade_physical(
+        &self,
+        scene: &Scene,
+        point: &ShadingPoint,
+        depth: u32,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let mut radiance = scene.ambient * point.kd;
+        let mut pairs = PairAllocation::new(depth);
+        for (index, light) in scene.lights.iter().enumerate() {
+            radiance += match light {
+                Light::Point(p) => point.point_light(scene, p, ctx),
+                Light::Area(area) => {
+                    let own = DimensionPair::Light {
+                        light: index as u32,
+                        depth,
+                    };
+                    let pair = pairs.take(own, self.light_samples);
+                    self.physical_area_light(scene, point, index, area, pair, depth, ctx)
+                }
+                Light::Sphere(sphere) => {
+                    let own = DimensionPair::Light {
+                        light: index as u32,
+                        depth,
+                    };
+                    let pair = pairs.take(own, self.light_samples);
+                    self.physical_sphere_light(scene, point, index, sphere, pair, depth, ctx)
+                }
+            };
+        }
+        if self.environment_samples > 0 {
+            let pair = pairs.take(
+                DimensionPair::Environment { depth },
+                self.environment_samples,
+            );
+            radiance += self.environment_light(scene, point, pair, ctx);
+        }
+        radiance
+    }
+
+    /// The light `light` (at `index` of the scene's lights) reflects at
+    /// `point`: light samples from `pair`, and on a glossy material as many
+    /// specular-lobe samples, combined by the power heuristic.
+    #[allow(clippy::too_many_arguments)]
+    fn physical_area_light(
+        &self,
+        scene: &Scene,
+        point: &ShadingPoint,
+        index: usize,
+        light: &AreaLight,
+        pair: DimensionPair,
+        depth: u32,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let x = point.hit.point;
+        let n = self.light_samples;
+        ctx.counters.light_samples += u64::from(n);
+        // The light is flat: a point behind it is behind every point of it.
+        if !light.illuminates(light.surface().center(), x) {
+            ctx.counters.skipped_behind_light += u64::from(n);
+            return Vec3::ZERO;
+        }
+        let sampler = light.sampler(x, self.area_sampling);
+        let mis = self.mis && point.has_specular;
+        let mut samples = std::mem::take(&mut ctx.light_points);
+        let sobol = ctx.sample.sobol_points(pair, n);
+        self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+        let occluders = if n >= CULL_FROM_SAMPLES {
+            scene.shapes.occluders_towards(
+                x,
+                &light.surface().corners(),
+                [point.hit.shape, scene.light_objects[index]],
+            )
+        } else {
+            Occluders::ALL
+        };
+        let mut sum = Vec3::ZERO;
+        for &u in &samples {
+            let s = sampler.sample(u);
+            sum += point.light_sample(scene, &sampler, s.point, s.pdf, mis, &occluders, ctx);
+        }
+        if mis {
+            let brdf_pair = DimensionPair::Brdf {
+                light: index as u32,
+                depth,
+            };
+            let sobol = ctx.sample.sobol_points(brdf_pair, n);
+            self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+            let object = scene.light_objects[index];
+            for &u in &samples {
+                let Some(l) = point.material.sample_specular(point.n, point.v, u) else {
+                    continue;
+                };
+                sum += point.lobe_sample(scene, |y| sampler.pdf(y), object, l, ctx);
+            }
+        }
+        ctx.light_points = samples;
+        light.color * sum / n as f32
+    }
+}
+
+impl DirectIntegrator {
+    /// The spherical light `light` (at `index` of the scene's lights) reflects
+    /// at `point`: directions uniform over its cone, and on a glossy material
+    /// as many specular-lobe samples, combined by the power heuristic.
+    #[allow(clippy::too_many_arguments)]
+    fn physical_sphere_light(
+        &self,
+        scene: &Scene,
+        point: &ShadingPoint,
+        index: usize,
+        light: &SphereLight,
+        pair: DimensionPair,
+        depth: u32,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let x = point.hit.point;
+        let n = self.light_samples;
+        ctx.counters.light_samples += u64::from(n);
+        let pdf = light.pdf(x);
+        if pdf == 0.0 {
+            // Inside the sphere: it lights nothing there.
+            ctx.counters.skipped_behind_light += u64::from(n);
+            return Vec3::ZERO;
+        }
+        let mis = self.mis && point.has_specular;
+        let mut samples = std::mem::take(&mut ctx.light_points);
+        let sobol = ctx.sample.sobol_points(pair, n);
+        self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+        let mut sum = Vec3::ZERO;
+        for &u in &samples {
+            if let Some(s) = light.sample(x, u) {
+                sum += point.cone_sample(scene, &s.target, s.pdf, mis, ctx);
+            }
+        }
+        if mis {
+            let brdf_pair = DimensionPair::Brdf {
+                light: index as u32,
+                depth,
+            };
+            let sobol = ctx.sample.sobol_points(brdf_pair, n);
+            self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+            let object = scene.light_objects[index];
+            for &u in &samples {
+                let Some(l) = point.material.sample_specular(point.n, point.v, u) else {
+                    continue;
+                };
+                sum += point.lobe_sample(scene, |_| pdf, object, l, ctx);
+            }
+        }
+        ctx.light_points = samples;
+        light.color * sum / n as f32
+    }
+}
+
+/// Veach's power heuristic (β = 2) for a sample drawn with density `a` where
+/// the other technique has density `b`: `a² / (a² + b²)`, written so that
+/// neither square overflows.
+#[inline]
+pub(crate) fn power_heuristic(a: f32, b: f32) -> f32 {
+    if a <= 0.0 {
+        return 0.0;
+    }
+    let ratio = b / a;
+    1.0 / (1.0 + ratio * ratio)
+}
+
+impl ShadingPoint<'_> {
+    /// `f · cos θ · I / r²` of a point light, or zero behind the surface or in
+    /// shadow.
+    fn point_light(&self, scene: &Scene, light: &PointLight, ctx: &mut SampleContext) -> Vec3 {
+        let d = light.position - self.hit.point;
+        let distance2 = d.length_squared();
+        let Some(l) = d.try_normalize() else {
+            return Vec3::ZERO;
+        };
+        let Some(f) = self.reflection_towards(l, ctx) else {
+            return Vec3::ZERO;
+        };
+        ctx.counters.light_shadow_rays += 1;
+        let shadow = spawn_ray_to(self.hit, &RayTarget::exact(light.position));
+        if scene.shapes.any_hit_among(&Occluders::ALL, &shadow, 1.0) {
+            return Vec3::ZERO;
+        }
+        light.color * f / distance2
+    }
+
+    /// One light sample's `f · cos θ · V · w / p` at the point `y` on the light
+    /// drawn with solid-angle density `pdf`, `w` its power-heuristic weight
+    /// against the specular lobe's density (1 without `mis`).
+    #[allow(clippy::too_many_arguments)]
+    fn light_sample(
+        &self,
+        scene: &Scene,
+        sampler: &AreaLightSampler,
+        y: Vec3,
+        pdf: f32,
+        mis: bool,
+        occluders: &Occluders,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return Vec3::ZERO;
+        }
+        let Some(l) = (y - self.hit.point).try_normalize() else {
+            return Vec3::ZERO;
+        };
+        let Some(f) = self.reflection_towards(l, ctx) else {
+            return Vec3::ZERO;
+        };
+        ctx.counters.light_shadow_rays += 1;
+        let shadow = spawn_ray_to(self.hit, &sampler.light().shadow_target(y));
+        if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
+            return Vec3::ZERO;
+        }
+        let weight = if mis {
+            power_heuristic(pdf, self.material.specular_pdf(self.n, l, self.v))
+        } else {
+            1.0
+        };
+        f * (weight / pdf)
+    }
+
+    /// One sample of a sphere light's cone: [`Self::light_sample`] towards
+    /// the point `target` of the sphere.
+    fn cone_sample(
+        &self,
+        scene: &Scene,
+        target: &RayTarget,
+        pdf: f32,
+        mis: bool,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let Some(l) = (target.point - self.hit.point).try_normalize() else {
+            return Vec3::ZERO;
+        };
+        let Some(f) = self.reflection_towards(l, ctx) else {
+            return Vec3::ZERO;
+        };
+        ctx.counters.light_shadow_rays += 1;
+        if scene
+            .shapes
+            .any_hit_among(&Occluders::ALL, &spawn_ray_to(self.hit, target), 1.0)
+        {
+            return Vec3::ZERO;
+        }
+        let weight = if mis {
+            power_heuristic(pdf, self.material.specular_pdf(self.n, l, self.v))
+        } else {
+            1.0
+        };
+        f * (weight / pdf)
+    }
+
+    /// One specular-lobe sample's `f · cos θ · V · w / p` towards the light
+    /// whose surface is scene object `object` and whose light sampling draws
+    /// the direction towards its point `y` with density `light_pdf(y)`: zero
+    /// unless the ray from the point along `l` reaches that light first.
+    fn lobe_sample(
+        &self,
+        scene: &Scene,
+        light_pdf: impl Fn(Vec3) -> f32,
+        object: u32,
+        l: Vec3,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let pdf = self.material.specular_pdf(self.n, l, self.v);
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return Vec3::ZERO;
+        }
+        let Some(f) = self.reflection_towards(l, ctx) else {
+            return Vec3::ZERO;
+        };
+        ctx.counters.brdf_rays += 1;
+        let ray = spawn_ray(self.hit, l);
+        // The light's surface is one-sided: a hit on it is a hit on its front.
+        match scene.shapes.closest_hit(&ray, f32::INFINITY) {
+            Some(hit) if hit.shape == object => {
+                f * (power_heuristic(pdf, light_pdf(hit.point)) / pdf)
+            }
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// `f(l, v) · cos θ` towards the unit direction `l`, or `None` (counted)
+    /// where no ray need be traced: `l` below the geometric surface, or a zero
+    /// BRDF.
+    fn reflection_towards(&self, l: Vec3, ctx: &mut SampleContext) -> Option<Vec3> {
+        if !self.above_surface(l) {
+            ctx.counters.skipped_behind_surface += 1;
+            return None;
+        }
+        let f = self.brdf_cos(l, ctx);
+        if f == Vec3::ZERO {
+            ctx.counters.skipped_zero_brdf += 1;
+            return None;
+        }
+        Some(f)
+    }
+}

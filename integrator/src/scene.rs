@@ -51,9 +51,12 @@ pub struct Scene {
 impl Scene {
     /// Whether anything reads a ray's differentials: a material whose textures
     /// filter over a footprint, or the environment (filtered by the ray's
-    /// angular width). Without either, camera rays are made without them.
+    /// angular width in Phong shading; physical shading reads it unfiltered).
+    /// Without either, camera rays are made without them.
     pub fn needs_differentials(&self) -> bool {
-        self.environment.is_some() || self.materials.iter().any(PhongMaterial::uses_footprint)
+        let filtered_environment =
+            self.environment.is_some() && self.shading == ShadingModel::Phong;
+        filtered_environment || self.materials.iter().any(PhongMaterial::uses_footprint)
     }
 
     /// The material or light at `hit`.

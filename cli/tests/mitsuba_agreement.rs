@@ -1,0 +1,58 @@
+//! Physical shading against Mitsuba 3, through `tools/mitsuba/agreement.py`:
+//! the physical Cornell box and the analytic area light, each exported with
+//! `glint export --mitsuba` and rendered by both with several seeds (the
+//! spheres under an HDR map take minutes, Mitsuba following the mirrors in
+//! Python: measured by hand, in tools/mitsuba/README.md). The script fails a
+//! scene whose image means differ by 0.3% or more, or whose relMSE between
+//! the two renderers exceeds their own noise by more than its tolerance
+//! (docs/physical-shading.md). Runs only where a Python with the `mitsuba`
+//! package is found (`GLINT_MITSUBA_VENV`, or `target/mitsuba-venv`); elsewhere
+//! it says so and passes.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The Python of a virtual environment where `import mitsuba` works.
+fn python_with_mitsuba() -> Option<PathBuf> {
+    let venv = std::env::var_os("GLINT_MITSUBA_VENV")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("target/mitsuba-venv"));
+    let python = venv.join("bin/python");
+    let imports = Command::new(&python)
+        .args(["-c", "import mitsuba"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    imports.then_some(python)
+}
+
+fn agreement(python: &Path, scene: &str, extra: &[&str]) {
+    let out = Command::new(python)
+        .arg(repo().join("tools/mitsuba/agreement.py"))
+        .arg(repo().join("scenes").join(scene))
+        .args(["--glint", env!("CARGO_BIN_EXE_glint")])
+        .args(extra)
+        .output()
+        .expect("python runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{scene}: Glint and Mitsuba 3 differ\n{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("| agree"), "{scene}: no verdict in\n{text}");
+}
+
+#[test]
+fn physical_scenes_agree_with_mitsuba() {
+    let Some(python) = python_with_mitsuba() else {
+        eprintln!("skipped: no Python with the mitsuba package (see tools/mitsuba/README.md)");
+        return;
+    };
+    let small = ["--seeds", "6", "--spp", "32", "--resolution", "48x48"];
+    agreement(&python, "cornell-physical.toml", &small);
+    agreement(&python, "analytic-area-light.toml", &small);
+}

@@ -108,7 +108,7 @@ mod tests {
         // A map whose radiance is a smooth function of direction: Mitsuba's
         // bilinear reading of the written image must agree with Glint's own
         // lookups (on texel centres exactly, between them to interpolation error,
-        // within 1e-3 at the 4x finer grid: it was 4e-3 at the map's own size).
+        // within 1e-3 at the 4x finer grid the export writes).
         let (w, h) = (64, 32);
         let image = Image::from_fn(w, h, |x, y| {
             let d = glint_texture::latlong_direction(glam::Vec2::new(

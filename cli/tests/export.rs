@@ -5,14 +5,11 @@
 //! exported scene, and seeing the same geometry and textures as Glint.
 
 mod common;
+use common::{python_with_mitsuba, repo};
 
 use common::{assert_input_error, glint, scene, stderr, stdout};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 /// Every shipped scene's name, sorted.
 fn shipped_scenes() -> Vec<String> {
@@ -321,19 +318,6 @@ fn help_documents_the_subcommand() {
 
 // ---------------------------------------------------------------------------
 // In Mitsuba itself, where it is installed.
-
-/// The Python of a virtual environment where `import mitsuba` works.
-fn python_with_mitsuba() -> Option<PathBuf> {
-    let venv = std::env::var_os("GLINT_MITSUBA_VENV")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join("target/mitsuba-venv"));
-    let python = venv.join("bin/python");
-    let imports = Command::new(&python)
-        .args(["-c", "import mitsuba"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    imports.then_some(python)
-}
 
 /// Loads the XML in `sys.argv[1]` and renders it (`scalar_rgb`); prints
 /// `finite MEAN` or `nonfinite COUNT`.

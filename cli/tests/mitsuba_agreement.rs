@@ -9,25 +9,11 @@
 //! package is found (`GLINT_MITSUBA_VENV`, or `target/mitsuba-venv`); elsewhere
 //! it says so and passes.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::{python_with_mitsuba, repo};
+
+use std::path::Path;
 use std::process::Command;
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// The Python of a virtual environment where `import mitsuba` works.
-fn python_with_mitsuba() -> Option<PathBuf> {
-    let venv = std::env::var_os("GLINT_MITSUBA_VENV")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join("target/mitsuba-venv"));
-    let python = venv.join("bin/python");
-    let imports = Command::new(&python)
-        .args(["-c", "import mitsuba"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    imports.then_some(python)
-}
 
 fn agreement(python: &Path, scene: &str, extra: &[&str]) {
     let out = Command::new(python)

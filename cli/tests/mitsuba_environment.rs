@@ -5,25 +5,10 @@
 //! `target/mitsuba-venv` as `tools/mitsuba/compare.sh` makes it); elsewhere it
 //! says so and passes.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::{python_with_mitsuba, repo};
+
 use std::process::Command;
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// The Python of a virtual environment where `import mitsuba` works.
-fn python_with_mitsuba() -> Option<PathBuf> {
-    let venv = std::env::var_os("GLINT_MITSUBA_VENV")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join("target/mitsuba-venv"));
-    let python = venv.join("bin/python");
-    let imports = Command::new(&python)
-        .args(["-c", "import mitsuba"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    imports.then_some(python)
-}
 
 /// The three ratios of a table cell such as `0.9995, 0.9995, 0.9994`.
 fn ratios(cell: &str) -> Vec<f64> {

@@ -28,7 +28,7 @@ use crate::sampling::DimensionPair;
 use crate::{DirectIntegrator, Scene};
 use glam::Vec3;
 use glint_geometry::{spawn_ray, spawn_ray_to, Occluders, RayTarget};
-use glint_lighting::{AreaLight, AreaLightSampler, Light, PointLight, SphereLight};
+use glint_lighting::{AreaLight, Light, PointLight, SphereLight};
 
 impl DirectIntegrator {
     /// The local shading of `point` in physical units, `depth` reflections deep.
@@ -111,24 +111,13 @@ impl DirectIntegrator {
         let mut sum = Vec3::ZERO;
         for &u in &samples {
             let s = sampler.sample(u);
-            sum += point.light_sample(scene, &sampler, s.point, s.pdf, mis, &occluders, ctx);
-        }
-        if mis {
-            let brdf_pair = DimensionPair::Brdf {
-                light: index as u32,
-                depth,
-            };
-            let sobol = ctx.sample.sobol_points(brdf_pair, n);
-            self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
-            let object = scene.light_objects[index];
-            for &u in &samples {
-                let Some(l) = point.material.sample_specular(point.n, point.v, u) else {
-                    continue;
-                };
-                sum += point.lobe_sample(scene, |y| sampler.pdf(y), object, l, ctx);
-            }
+            let target = light.shadow_target(s.point);
+            sum += point.light_sample(scene, &target, s.pdf, mis, &occluders, ctx);
         }
         ctx.light_points = samples;
+        if mis {
+            sum += self.lobe_samples(scene, point, index, depth, |y| sampler.pdf(y), ctx);
+        }
         light.color * sum / n as f32
     }
 }
@@ -164,26 +153,46 @@ impl DirectIntegrator {
         let mut sum = Vec3::ZERO;
         for &u in &samples {
             if let Some(s) = light.sample(x, u) {
-                sum += point.cone_sample(scene, &s.target, s.pdf, mis, ctx);
-            }
-        }
-        if mis {
-            let brdf_pair = DimensionPair::Brdf {
-                light: index as u32,
-                depth,
-            };
-            let sobol = ctx.sample.sobol_points(brdf_pair, n);
-            self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
-            let object = scene.light_objects[index];
-            for &u in &samples {
-                let Some(l) = point.material.sample_specular(point.n, point.v, u) else {
-                    continue;
-                };
-                sum += point.lobe_sample(scene, |_| pdf, object, l, ctx);
+                sum += point.light_sample(scene, &s.target, s.pdf, mis, &Occluders::ALL, ctx);
             }
         }
         ctx.light_points = samples;
+        if mis {
+            sum += self.lobe_samples(scene, point, index, depth, |_| pdf, ctx);
+        }
         light.color * sum / n as f32
+    }
+}
+
+impl DirectIntegrator {
+    /// The sum over `light_samples` directions drawn from `point`'s specular
+    /// lobe of [`ShadingPoint::lobe_sample`] towards the light at `index`,
+    /// whose own sampling has density `light_pdf(y)` towards its point `y`.
+    fn lobe_samples(
+        &self,
+        scene: &Scene,
+        point: &ShadingPoint,
+        index: usize,
+        depth: u32,
+        light_pdf: impl Fn(Vec3) -> f32,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let pair = DimensionPair::Brdf {
+            light: index as u32,
+            depth,
+        };
+        let mut samples = std::mem::take(&mut ctx.light_points);
+        let sobol = ctx.sample.sobol_points(pair, self.light_samples);
+        self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+        let object = scene.light_objects[index];
+        let mut sum = Vec3::ZERO;
+        for &u in &samples {
+            if let Some(l) = point.material.sample_specular(point.n, point.v, u) {
+                sum += point.lobe_sample(scene, &light_pdf, object, l, ctx);
+            }
+        }
+        ctx.light_points = samples;
+        sum
     }
 }
 
@@ -219,15 +228,14 @@ impl ShadingPoint<'_> {
         light.color * f / distance2
     }
 
-    /// One light sample's `f · cos θ · V · w / p` at the point `y` on the light
-    /// drawn with solid-angle density `pdf`, `w` its power-heuristic weight
-    /// against the specular lobe's density (1 without `mis`).
-    #[allow(clippy::too_many_arguments)]
+    /// One light sample's `f · cos θ · V · w / p` towards the point
+    /// `target` on a light, drawn with solid-angle density `pdf` (the shadow
+    /// ray testing only `occluders`), `w` its power-heuristic weight against
+    /// the specular lobe's density (1 without `mis`).
     fn light_sample(
         &self,
         scene: &Scene,
-        sampler: &AreaLightSampler,
-        y: Vec3,
+        target: &RayTarget,
         pdf: f32,
         mis: bool,
         occluders: &Occluders,
@@ -236,35 +244,6 @@ impl ShadingPoint<'_> {
         if !(pdf > 0.0 && pdf.is_finite()) {
             return Vec3::ZERO;
         }
-        let Some(l) = (y - self.hit.point).try_normalize() else {
-            return Vec3::ZERO;
-        };
-        let Some(f) = self.reflection_towards(l, ctx) else {
-            return Vec3::ZERO;
-        };
-        ctx.counters.light_shadow_rays += 1;
-        let shadow = spawn_ray_to(self.hit, &sampler.light().shadow_target(y));
-        if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
-            return Vec3::ZERO;
-        }
-        let weight = if mis {
-            power_heuristic(pdf, self.material.specular_pdf(self.n, l, self.v))
-        } else {
-            1.0
-        };
-        f * (weight / pdf)
-    }
-
-    /// One sample of a sphere light's cone: [`Self::light_sample`] towards
-    /// the point `target` of the sphere.
-    fn cone_sample(
-        &self,
-        scene: &Scene,
-        target: &RayTarget,
-        pdf: f32,
-        mis: bool,
-        ctx: &mut SampleContext,
-    ) -> Vec3 {
         let Some(l) = (target.point - self.hit.point).try_normalize() else {
             return Vec3::ZERO;
         };
@@ -272,10 +251,8 @@ impl ShadingPoint<'_> {
             return Vec3::ZERO;
         };
         ctx.counters.light_shadow_rays += 1;
-        if scene
-            .shapes
-            .any_hit_among(&Occluders::ALL, &spawn_ray_to(self.hit, target), 1.0)
-        {
+        let shadow = spawn_ray_to(self.hit, target);
+        if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
             return Vec3::ZERO;
         }
         let weight = if mis {
@@ -293,7 +270,7 @@ impl ShadingPoint<'_> {
     fn lobe_sample(
         &self,
         scene: &Scene,
-        light_pdf: impl Fn(Vec3) -> f32,
+        light_pdf: &impl Fn(Vec3) -> f32,
         object: u32,
         l: Vec3,
         ctx: &mut SampleContext,

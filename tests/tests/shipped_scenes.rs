@@ -153,19 +153,31 @@ fn cornell_set1_renders_the_course_picture() {
 #[test]
 fn shipped_scene_renders_bit_identically_on_1_and_4_threads() {
     let d = cornell(2);
-    let at = |threads| {
-        let film = render_at(&d, 48, 40, |s| {
-            (s.spp, s.light_samples) = (4, 3);
-            s.light_pattern = SamplePattern::Random;
-            s.threads = Some(threads);
-        });
-        let bits = film
-            .pixels()
-            .iter()
-            .flat_map(|p| p.to_array().map(f32::to_bits));
-        bits.collect::<Vec<u32>>()
-    };
-    assert_eq!(at(1), at(4));
+    assert_eq!(
+        bits_on_threads(&d, 48, 40, (4, 3), 1),
+        bits_on_threads(&d, 48, 40, (4, 3), 4)
+    );
+}
+
+/// The bits of every pixel of a `width × height` render with `(spp, light
+/// samples)`, random light samples, on `threads` threads.
+fn bits_on_threads(
+    d: &SceneDescription,
+    width: u32,
+    height: u32,
+    (spp, light_samples): (u32, u32),
+    threads: usize,
+) -> Vec<u32> {
+    let film = render_at(d, width, height, |s| {
+        (s.spp, s.light_samples) = (spp, light_samples);
+        s.light_pattern = SamplePattern::Random;
+        s.threads = Some(threads);
+    });
+    let bits = film
+        .pixels()
+        .iter()
+        .flat_map(|p| p.to_array().map(f32::to_bits));
+    bits.collect()
 }
 
 /// A 16×16 render of the environment scene (cube map, mirrors, environment light),
@@ -209,17 +221,8 @@ fn physical_glossy_24x12_render_snapshot() {
 #[test]
 fn physical_scene_renders_bit_identically_on_1_and_4_threads() {
     let d = load(&scene_path("physical-glossy")).unwrap();
-    let at = |threads| {
-        let film = render_at(&d, 48, 24, |s| {
-            (s.spp, s.light_samples) = (2, 3);
-            s.light_pattern = SamplePattern::Random;
-            s.threads = Some(threads);
-        });
-        let bits = film
-            .pixels()
-            .iter()
-            .flat_map(|p| p.to_array().map(f32::to_bits));
-        bits.collect::<Vec<u32>>()
-    };
-    assert_eq!(at(1), at(4));
+    assert_eq!(
+        bits_on_threads(&d, 48, 24, (2, 3), 1),
+        bits_on_threads(&d, 48, 24, (2, 3), 4)
+    );
 }

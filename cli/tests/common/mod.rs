@@ -51,3 +51,23 @@ pub fn assert_input_error(o: &Output, expected: &str) {
     assert!(!err.contains("panicked") && !err.contains("backtrace"));
     assert!(o.stdout.is_empty(), "stdout: {}", stdout(o));
 }
+
+/// The repository's root.
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The Python of a virtual environment where `import mitsuba` works
+/// (`GLINT_MITSUBA_VENV`, or `target/mitsuba-venv` as
+/// `tools/mitsuba/compare.sh` makes it); `None` where there is none.
+pub fn python_with_mitsuba() -> Option<PathBuf> {
+    let venv = std::env::var_os("GLINT_MITSUBA_VENV")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("target/mitsuba-venv"));
+    let python = venv.join("bin/python");
+    let imports = Command::new(&python)
+        .args(["-c", "import mitsuba"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    imports.then_some(python)
+}

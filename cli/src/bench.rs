@@ -42,8 +42,8 @@ pub(crate) struct BenchArgs {
     texture_filters: Option<String>,
 
     /// Physical shading: light strategies to compare (each with every sampler
-    /// and filter), comma-separated: solid-angle or area, each optionally with
-    /// +mis (multiple importance sampling of glossy lobes), e.g.
+    /// and filter), comma-separated: auto, solid-angle or area, each optionally
+    /// with +mis (multiple importance sampling of glossy lobes), e.g.
     /// solid-angle+mis,solid-angle,area+mis,area [default: the scene's]
     #[arg(long, value_name = "LIST")]
     light_strategies: Option<String>,

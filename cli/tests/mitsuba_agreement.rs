@@ -1,8 +1,9 @@
 //! Physical shading against Mitsuba 3, through `tools/mitsuba/agreement.py`:
-//! the physical Cornell box and the analytic area light, each exported with
-//! `glint export --mitsuba` and rendered by both with several seeds (the
-//! spheres under an HDR map take minutes, Mitsuba following the mirrors in
-//! Python: measured by hand, in tools/mitsuba/README.md). The script fails a
+//! the physical Cornell box, the analytic area light, and a diffuse and a
+//! mirror sphere under an HDR map (small, as Mitsuba follows the mirrors in
+//! Python; measured larger by hand, in docs/physical-shading.md), each
+//! exported with `glint export --mitsuba` and rendered by both with several
+//! seeds. The script fails a
 //! scene whose image means differ by 0.3% or more, or whose relMSE between
 //! the two renderers exceeds their own noise by more than its tolerance
 //! (docs/physical-shading.md). Runs only where a Python with the `mitsuba`
@@ -41,4 +42,6 @@ fn physical_scenes_agree_with_mitsuba() {
     let small = ["--seeds", "6", "--spp", "32", "--resolution", "48x48"];
     agreement(&python, "cornell-physical.toml", &small);
     agreement(&python, "analytic-area-light.toml", &small);
+    let wide = ["--seeds", "4", "--spp", "32", "--resolution", "64x32"];
+    agreement(&python, "physical-environment.toml", &wide);
 }

@@ -19,7 +19,8 @@
 //! a sample drawn by technique `a` with density `p_a`, where the other gives
 //! `p_b`, is weighted `p_a² / (p_a² + p_b²)` (equal sample counts). The weights
 //! of the two techniques sum to 1 for every direction, so the estimate is
-//! unbiased; light samples carry the diffuse term and broad lobes, lobe samples
+//! unbiased (for randomised point sets: the `grid` pattern's fixed cell
+//! centres make it a fixed quadrature, as for light samples alone); light samples carry the diffuse term and broad lobes, lobe samples
 //! the sharp highlight of a large light, where light samples alone are noisy.
 //! On a purely diffuse material only the light is sampled (weight 1).
 

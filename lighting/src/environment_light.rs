@@ -55,6 +55,16 @@ impl EnvironmentLight {
         &self.environment
     }
 
+    /// The turn about +y from the map's frame to the world's (radians).
+    pub fn rotation(&self) -> f32 {
+        self.rotation
+    }
+
+    /// The factor on the map's values (the scene's `intensity`).
+    pub fn scale(&self) -> f32 {
+        self.scale
+    }
+
     fn to_map(&self, d: Vec3) -> Vec3 {
         rotate_y(d, -self.rotation)
     }

@@ -95,9 +95,10 @@ impl PhongMaterial {
 
     /// The BRDF times the cosine, `f(l, v)·(n·l)`, for light from a distribution of
     /// directions (the environment): Lambert's `kd/π` and the energy-normalised
-    /// modified Phong lobe (Lafortune and Willems 1994), `ks·(s + 2)/2π·cos^s α`
-    /// (`(s + 8)/8π` for Blinn–Phong). A white diffuse surface under a white
-    /// environment of radiance 1 reflects exactly 1.
+    /// modified Phong lobe (Lafortune and Willems 1994), `ks·(s + 2)/2π·cos^s α`,
+    /// or Blinn–Phong's `ks·`[`blinn_phong_normalisation`]`·cos^s θh`. Each lobe's
+    /// albedo is `ks` at normal incidence and less elsewhere. A white diffuse
+    /// surface under a white environment of radiance 1 reflects exactly 1.
     #[inline]
     pub fn brdf_cos(&self, kd: Vec3, ks: Vec3, n: Vec3, l: Vec3, v: Vec3) -> Vec3 {
         let n_dot_l = n.dot(l);
@@ -106,7 +107,7 @@ impl PhongMaterial {
         }
         let norm = match self.lobe {
             SpecularLobe::Phong => (self.shininess + 2.0) / (2.0 * std::f32::consts::PI),
-            SpecularLobe::BlinnPhong => (self.shininess + 8.0) / (8.0 * std::f32::consts::PI),
+            SpecularLobe::BlinnPhong => blinn_phong_normalisation(self.shininess),
         };
         (kd * std::f32::consts::FRAC_1_PI + ks * norm * self.specular_lobe(n, l, v, n_dot_l))
             * n_dot_l
@@ -276,6 +277,15 @@ where
     }
 }
 
+/// The factor that makes the Blinn–Phong lobe `N·cos^s θh` (times `n·l`)
+/// reflect exactly all light at normal incidence,
+/// `N = (s + 2)(s + 4) / (8π·(2^(−s/2) + s))` (F. Giesen, "The Blinn-Phong
+/// normalization zoo", 2009). The common `(s + 8)/8π` approximates it from
+/// above: its albedo reaches 1.075 at `s = 8`, so it does not conserve energy.
+pub fn blinn_phong_normalisation(s: f32) -> f32 {
+    (s + 2.0) * (s + 4.0) / (8.0 * std::f32::consts::PI * ((-0.5 * s).exp2() + s))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -441,5 +451,52 @@ mod tests {
         let m = PhongMaterial::new(Vec3::ONE, 1.0);
         let out = m.reflect(Vec3::ONE, Vec3::ONE, Vec3::Y, -Vec3::Y, Vec3::Y);
         assert_eq!(out, Vec3::ZERO);
+    }
+
+    /// `∫ f(l, v)·(n·l) dl` over the hemisphere, by the midpoint rule in
+    /// `(θ, φ)` (fine enough for `s ≤ 64`: the lobe spans many cells).
+    fn albedo(m: &PhongMaterial, view_degrees: f32) -> f32 {
+        let (n, a) = (Vec3::Z, view_degrees.to_radians());
+        let v = Vec3::new(a.sin(), 0.0, a.cos());
+        let (rows, columns) = (600, 1200);
+        let (dt, dp) = (
+            std::f32::consts::FRAC_PI_2 / rows as f32,
+            std::f32::consts::TAU / columns as f32,
+        );
+        let mut sum = 0.0f64;
+        for i in 0..rows {
+            let t = (i as f32 + 0.5) * dt;
+            for j in 0..columns {
+                let p = (j as f32 + 0.5) * dp;
+                let l = Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+                let f = m.brdf_cos(Vec3::ZERO, Vec3::ONE, n, l, v).x;
+                sum += (f * t.sin() * dt * dp) as f64;
+            }
+        }
+        sum as f32
+    }
+
+    #[test]
+    fn normalised_lobes_reflect_at_most_all_light_and_all_of_it_head_on() {
+        for lobe in [SpecularLobe::Phong, SpecularLobe::BlinnPhong] {
+            for shininess in [1.0, 8.0, 64.0] {
+                let m = PhongMaterial {
+                    lobe,
+                    ..PhongMaterial::new(Vec3::ONE, shininess)
+                };
+                let head_on = albedo(&m, 0.0);
+                assert!(
+                    (head_on - 1.0).abs() < 2e-3,
+                    "{lobe:?} s={shininess}: {head_on}"
+                );
+                for view in [30.0, 60.0, 80.0] {
+                    let a = albedo(&m, view);
+                    assert!(a < head_on, "{lobe:?} s={shininess} at {view}°: {a}");
+                }
+            }
+        }
+        // The (s + 8)/8π approximation would give 1.075 at s = 8.
+        let approximation = (8.0 + 8.0) / (8.0 * std::f32::consts::PI);
+        assert!(approximation / blinn_phong_normalisation(8.0) > 1.07);
     }
 }

@@ -7,7 +7,7 @@
 /// | point light `color` | a colour, no falloff | intensity `I` (W/sr per channel), falloff `1/r²` |
 /// | area light `color` | a colour per light sample, no falloff | radiance `L_e` (W/(sr·m²)) of its front face |
 /// | diffuse term | `kd · n·l` | Lambert's BRDF `kd/π` |
-/// | specular term | `ks · lobe` | the normalised lobe, `ks·(s+2)/2π·cos^s α` (Phong) or `ks·(s+8)/8π·cos^s θh` (Blinn–Phong) |
+/// | specular term | `ks · lobe` | the normalised lobe, `ks·(s+2)/2π·cos^s α` (Phong) or `ks·(s+2)(s+4)/(8π(2^(−s/2)+s))·cos^s θh` (Blinn–Phong, Giesen 2009) |
 /// | area lights | the average of N light samples | light and BRDF sampling with multiple importance sampling |
 ///
 /// The environment is physically normalised in both models; a camera ray

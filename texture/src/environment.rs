@@ -204,6 +204,14 @@ impl LatLongMap {
         self.image.image()
     }
 
+    /// Level 0 read bilinearly at lat-long coordinates `uv` (longitude wraps,
+    /// and past a pole the filter continues on the other side of it): the
+    /// radiance of [`LatLongMap::radiance`] with width 0.
+    #[inline]
+    pub fn bilinear(&self, uv: Vec2) -> Vec3 {
+        latlong_bilinear(self.image.image(), uv)
+    }
+
     /// Radiance towards `d`, filtered over a cone of angular width `width`: the
     /// level whose texels span `width` along the meridian (`π/H` at level 0), so
     /// `log2(width·H/π)`. Towards the poles a texel narrows across (`2π·sin θ/W`)

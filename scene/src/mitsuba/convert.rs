@@ -747,12 +747,14 @@ impl<'a> Converter<'a> {
                     _ => "the lat-long map",
                 };
                 self.shapes.comment(&format!(
-                    "{what} with its rotation and intensity, resampled onto Mitsuba's lat-long \
-                     grid (rows on the poles, u = 0 looking down -z): identity to_world, scale 1"
+                    "{what} with its intensity, on Mitsuba's lat-long grid (rows on the \
+                     poles); to_world turns it by its rotation plus half a turn (Mitsuba's \
+                     u = 0 looks down -z, Glint's u = 1/2)"
                 ));
                 self.shapes.open("emitter", &[("type", "envmap")]);
                 self.shapes
                     .string("filename", &format!("{}/{file}", self.assets));
+                self.shapes.matrix("to_world", environment::to_world(light));
                 self.shapes.close("emitter");
             }
         }

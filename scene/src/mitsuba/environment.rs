@@ -1,77 +1,107 @@
 //! The environment as Mitsuba 3's `envmap`: a lat-long image on Mitsuba's own
-//! texel grid, filled with Glint's radiance in each texel's direction.
+//! texel grid whose bilinear interpolation is exactly Glint's radiance.
 //!
 //! Mitsuba reads a lat-long map with `u = atan2(d.x, −d.z)/2π`,
-//! `v = acos(d.y)/π` (in the emitter's frame), column `i` of `W` centred at
-//! `u = (i + ½)/W`, and, unlike Glint, its first and last rows on the poles:
-//! row `j` of `H` at `θ = j·π/(H − 1)` (Glint centres rows in their bands,
-//! `θ = (j + ½)·π/H`). Glint's `u = ½` looks down −z where Mitsuba's `u = 0`
-//! does. Rather than turning the map, each texel of the image written here is
-//! Glint's radiance ([`EnvironmentLight::radiance`], level 0, bilinear) in the
-//! direction Mitsuba gives that texel, with the identity `to_world`: the map's
-//! rotation and intensity are in the image, and Mitsuba's bilinear
-//! interpolation between texels reproduces Glint's radiance function (exactly
-//! on the texels; columns fall on Glint's own texel centres when the rotation
-//! is a whole number of texels and the width even). This is what
-//! `tools/mitsuba/envmap.py` does for the diffuse-sphere comparison. A cube
-//! map is sampled the same way onto a `4N × 2N` lat-long image (`N` its face
-//! size).
+//! `v = acos(d.y)/π` in the emitter's frame, column `i` of `W` centred at
+//! `u = (i + ½)/W` and, unlike Glint, its first and last rows on the poles:
+//! row `j` of `H′` at `v = j/(H′ − 1)` (Glint centres rows in their bands,
+//! `v = (k + ½)/H`). Glint's own lookup is bilinear between texel centres, so
+//! its radiance is bilinear in `(u, v)` inside each cell of its texel centres
+//! and has kinks on their lines. Mitsuba's interpolation of values taken on
+//! its grid reproduces that function exactly when every kink lies on a grid
+//! line: then each of Mitsuba's cells lies inside one of Glint's, where a
+//! bilinear function is its own bilinear interpolant. Hence
+//!
+//! - the emitter's `to_world` turns by the map's rotation plus half a turn,
+//!   so that Mitsuba's `u` is Glint's (Glint's `u = ½` looks down −z, where
+//!   Mitsuba's `u = 0` does), and the columns are the map's own `W`;
+//! - the image has `2H + 1` rows: row `2k + 1` at `v = (k + ½)/H` is Glint's
+//!   row `k`, row `2k` on the line between rows `k − 1` and `k`, and rows `0`
+//!   and `2H` on the poles, where Glint's filter continues across the pole;
+//! - the map's intensity is in the image (Mitsuba's `scale` stays 1).
+//!
+//! Each texel is Glint's radiance (level 0, bilinear) at its `(u, v)`. An
+//! earlier export sampled Glint's radiance in the directions of a 4× finer
+//! grid with the rows on Mitsuba's positions; its interpolation error left the
+//! background of `physical-environment.toml` seen directly at 2.4 times the two
+//! renderers' noise. A cube map has no such alignment: it is sampled in the
+//! directions of a `4N × 2N` lat-long grid (`N` its face size), an
+//! approximation that grows finer with `N`.
 
-use glam::{UVec2, Vec3};
+use glam::{UVec2, Vec2, Vec3};
 use glint_camera::Film;
 use glint_lighting::EnvironmentLight;
 use glint_texture::Environment;
 use std::f32::consts::{PI, TAU};
 
-/// How far from the poles the first and last rows are read (radians): at the
-/// pole itself every column's direction is the same, but Glint's radiance
-/// near a pole depends on the meridian it is approached along.
+/// How far from the poles a cube map's first and last rows are read
+/// (radians): at the pole itself every column's direction is the same.
 const POLE_OFFSET: f32 = 1e-5;
 
-/// How many texels of the image for Mitsuba a lat-long map's texel becomes,
-/// along each axis. Mitsuba's bilinear interpolation of texels on its own grid
-/// (rows on the poles) only approximates Glint's bilinear function between the
-/// kinks of Glint's grid (rows centred in their bands), and the error shrinks
-/// with a finer grid: at the map's own size, the background of
-/// `physical-environment.toml` seen directly differed from Glint's, pixel by
-/// pixel, by 3.5 times the two renderers' noise (the means agreeing to
-/// 0.002%).
-const LATLONG_UPSAMPLING: u32 = 4;
-
-/// The size of the lat-long image for Mitsuba: [`LATLONG_UPSAMPLING`] times
-/// the map's own for a lat-long map, `4N × 2N` for a cube map of face size
-/// `N`; `None` for a constant.
+/// The size of the lat-long image for Mitsuba: `W × (2H + 1)` for a `W × H`
+/// lat-long map, `4N × 2N` for a cube map of face size `N`; `None` for a
+/// constant.
 pub(super) fn image_size(environment: &Environment) -> Option<UVec2> {
     match environment {
         Environment::Constant(_) => None,
-        Environment::LatLong(map) => {
-            Some(LATLONG_UPSAMPLING * UVec2::new(map.image().width(), map.image().height()))
-        }
+        Environment::LatLong(map) => Some(UVec2::new(
+            map.image().width(),
+            2 * map.image().height() + 1,
+        )),
         Environment::CubeMap(cube) => Some(UVec2::new(4 * cube.size(), 2 * cube.size())),
     }
 }
 
-/// The direction of texel `(i, j)` of a `size` lat-long image as Mitsuba's
-/// `envmap` reads it (identity `to_world`).
-pub(super) fn mitsuba_direction(i: u32, j: u32, size: UVec2) -> Vec3 {
-    let phi = TAU * (i as f32 + 0.5) / size.x as f32;
-    let theta = if size.y > 1 {
-        (PI * j as f32 / (size.y - 1) as f32).clamp(POLE_OFFSET, PI - POLE_OFFSET)
+/// Mitsuba's `(u, v)` of texel `(i, j)` of a `size` lat-long image.
+fn mitsuba_uv(i: u32, j: u32, size: UVec2) -> Vec2 {
+    let v = if size.y > 1 {
+        j as f32 / (size.y - 1) as f32
     } else {
-        0.5 * PI
+        0.5
     };
+    Vec2::new((i as f32 + 0.5) / size.x as f32, v)
+}
+
+/// The direction of texel `(i, j)` of a `size` lat-long image in the emitter's
+/// frame, as Mitsuba's `envmap` reads it (rows on the poles kept
+/// [`POLE_OFFSET`] off them).
+pub(super) fn mitsuba_direction(i: u32, j: u32, size: UVec2) -> Vec3 {
+    let uv = mitsuba_uv(i, j, size);
+    let phi = TAU * uv.x;
+    let theta = (PI * uv.y).clamp(POLE_OFFSET, PI - POLE_OFFSET);
     let (sin_t, cos_t) = theta.sin_cos();
     let (sin_p, cos_p) = phi.sin_cos();
     Vec3::new(sin_t * sin_p, cos_t, -sin_t * cos_p)
 }
 
-/// The environment's radiance on Mitsuba's lat-long grid of `size` texels.
+/// The emitter's `to_world` (a 4×4 matrix, row by row): a turn about +y by the
+/// map's rotation plus half a turn, which puts Mitsuba's `u` on Glint's.
+pub(super) fn to_world(light: &EnvironmentLight) -> [[f32; 4]; 4] {
+    // R_y(rotation + π) = −R_y(rotation) in the xz plane.
+    let (s, c) = light.rotation().sin_cos();
+    [
+        [-c, 0.0, -s, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [s, 0.0, -c, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
+}
+
+/// The environment's radiance (times its intensity) on Mitsuba's lat-long grid
+/// of `size` texels, in the frame [`to_world`] turns into the world.
 pub(super) fn latlong_film(light: &EnvironmentLight, size: UVec2) -> Film {
     let mut film = Film::new(size);
     for j in 0..size.y {
         for i in 0..size.x {
-            let d = mitsuba_direction(i, j, size);
-            film.set_pixel(i, j, light.radiance(d, 0.0));
+            let radiance = match light.environment() {
+                Environment::LatLong(map) => map.bilinear(mitsuba_uv(i, j, size)),
+                // Glint's map frame is Mitsuba's emitter frame turned by π.
+                other => {
+                    let d = mitsuba_direction(i, j, size);
+                    other.radiance(Vec3::new(-d.x, d.y, -d.z), 0.0)
+                }
+            };
+            film.set_pixel(i, j, light.scale() * radiance);
         }
     }
     film
@@ -82,9 +112,13 @@ mod tests {
     use super::*;
     use glint_texture::{latlong_uv, Image, LatLongMap};
 
-    /// Mitsuba's reading of a lat-long image of `size` in direction `d`:
-    /// bilinear between texels on its grid (columns wrap, rows clamp).
-    fn mitsuba_lookup(film: &Film, d: Vec3) -> Vec3 {
+    /// Mitsuba's reading of a lat-long image in world direction `d`: into the
+    /// emitter's frame by the inverse of `to_world`, then bilinear between
+    /// texels on its grid (columns wrap, rows clamp).
+    fn mitsuba_lookup(film: &Film, to_world: [[f32; 4]; 4], d: Vec3) -> Vec3 {
+        // A rotation's inverse is its transpose.
+        let column = |c: usize| Vec3::new(to_world[0][c], to_world[1][c], to_world[2][c]);
+        let d = Vec3::new(column(0).dot(d), column(1).dot(d), column(2).dot(d));
         let size = film.resolution();
         let u = d.x.atan2(-d.z) / TAU;
         let v = d.y.clamp(-1.0, 1.0).acos() / PI;
@@ -103,38 +137,47 @@ mod tests {
         top.lerp(bottom, fy)
     }
 
+    /// Directions spread over the sphere (a Fibonacci lattice), poles included.
+    fn directions() -> impl Iterator<Item = Vec3> {
+        (0..2000)
+            .map(|k| {
+                let (a, b) = (k as f32 * 0.618_034, k as f32 * 0.414_214);
+                let z = 1.0 - 2.0 * b.fract();
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                Vec3::new(r * (TAU * a).cos(), z, r * (TAU * a).sin())
+            })
+            .chain([
+                Vec3::Y,
+                -Vec3::Y,
+                Vec3::new(0.0, 0.999_9, 0.014_1).normalize(),
+            ])
+    }
+
     #[test]
-    fn texels_hold_glints_radiance_where_mitsuba_puts_them() {
-        // A map whose radiance is a smooth function of direction: Mitsuba's
-        // bilinear reading of the written image must agree with Glint's own
-        // lookups (on texel centres exactly, between them to interpolation error,
-        // within 1e-3 at the 4x finer grid the export writes).
+    fn mitsubas_interpolation_of_the_image_is_glints_radiance() {
+        // Texels of unrelated values (the worst case for interpolation): with
+        // Glint's kinks on Mitsuba's grid lines the two agree to rounding. The
+        // earlier 4x grid with rows on Mitsuba's own positions differed by up
+        // to a third of the texels' range here.
         let (w, h) = (64, 32);
         let image = Image::from_fn(w, h, |x, y| {
-            let d = glint_texture::latlong_direction(glam::Vec2::new(
-                (x as f32 + 0.5) / w as f32,
-                (y as f32 + 0.5) / h as f32,
-            ));
-            Vec3::new(1.0 + d.x, 1.5 + d.y, 2.0 + 0.5 * d.z)
+            let hash = (x * 7919 + y * 104_729) % 1009;
+            Vec3::new(hash as f32 / 1009.0, 1.0 - hash as f32 / 2018.0, 0.25)
         });
-        for rotation_degrees in [0.0f32, 90.0, 37.0] {
+        for rotation_degrees in [0.0f32, 90.0, 37.0, -123.4] {
             let light = EnvironmentLight::new(
                 Environment::LatLong(LatLongMap::new(image.clone())),
                 rotation_degrees.to_radians(),
                 0.5,
             );
             let size = image_size(light.environment()).unwrap();
-            assert_eq!(size, LATLONG_UPSAMPLING * UVec2::new(w, h));
+            assert_eq!(size, UVec2::new(w, 2 * h + 1));
             let film = latlong_film(&light, size);
-            for k in 0..500 {
-                let (a, b) = (k as f32 * 0.618_034, k as f32 * 0.414_214);
-                let z = 1.0 - 2.0 * b.fract();
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                let d = Vec3::new(r * (TAU * a).cos(), z, r * (TAU * a).sin());
+            for d in directions() {
                 let glint = light.radiance(d, 0.0);
-                let mitsuba = mitsuba_lookup(&film, d);
+                let mitsuba = mitsuba_lookup(&film, to_world(&light), d);
                 assert!(
-                    (glint - mitsuba).abs().max_element() < 1e-3,
+                    (glint - mitsuba).abs().max_element() < 2e-4,
                     "rotation {rotation_degrees}: {d} (uv {}): Glint {glint}, Mitsuba {mitsuba}",
                     latlong_uv(d)
                 );
@@ -143,12 +186,34 @@ mod tests {
     }
 
     #[test]
-    fn rows_sit_on_the_poles_and_columns_at_their_centres() {
-        // Glint's u = ½ looks down −z; Mitsuba's u = 0 does.
+    fn odd_rows_are_the_maps_rows_and_columns_its_columns() {
+        let image = Image::from_fn(8, 4, |x, y| Vec3::splat((10 * y + x) as f32));
+        let light = EnvironmentLight::new(Environment::LatLong(LatLongMap::new(image)), 0.3, 2.0);
+        let film = latlong_film(&light, image_size(light.environment()).unwrap());
+        for (i, k) in [(0, 0), (5, 1), (7, 3)] {
+            let texel = film.pixel(i, 2 * k + 1);
+            assert!(
+                (texel - Vec3::splat(2.0 * (10 * k + i) as f32))
+                    .abs()
+                    .max_element()
+                    < 1e-4
+            );
+        }
+        // Between rows 1 and 2, the mean of the two.
+        assert!(
+            (film.pixel(3, 4) - Vec3::splat(2.0 * 18.0))
+                .abs()
+                .max_element()
+                < 1e-4
+        );
+    }
+
+    #[test]
+    fn rows_sit_on_the_poles_and_mitsubas_u_is_glints_after_half_a_turn() {
         let size = UVec2::new(8, 5);
         let d = mitsuba_direction(0, 2, size);
-        let uv = latlong_uv(d);
-        assert!((uv.x - (0.5 + 0.5 / 8.0)).abs() < 1e-6, "{uv}");
+        let uv = latlong_uv(Vec3::new(-d.x, d.y, -d.z));
+        assert!((uv.x - 0.5 / 8.0).abs() < 1e-6, "{uv}");
         assert!((uv.y - 0.5).abs() < 1e-6, "{uv}");
         assert!(mitsuba_direction(3, 0, size).y > 0.999_999);
         assert!(mitsuba_direction(3, 4, size).y < -0.999_999);
@@ -170,5 +235,8 @@ mod tests {
         // each times the intensity 2.
         assert_eq!(film.pixel(5, 0), Vec3::splat(6.0));
         assert_eq!(film.pixel(5, 7), Vec3::splat(8.0));
+        // Mitsuba's u = 0 column looks down +z in the map's frame (face pz, 5)
+        // once to_world has turned it by half a turn.
+        assert_eq!(film.pixel(0, 4), Vec3::splat(10.0));
     }
 }

@@ -1,6 +1,6 @@
 //! The pinhole camera of the course report (sections 2.1 and 2.2).
 
-use glam::{UVec2, Vec3};
+use glam::{UVec2, Vec2, Vec3};
 
 /// The f32 lanes of [`Camera::generate_rays_lanes`]: the type, and so the
 /// number of lanes, of `glint_geometry::lanes::F32Lanes` (the integrator,
@@ -126,15 +126,26 @@ impl Camera {
     /// y flipped so that raster-down is world-down. The film point is
     /// `position + f·forward + ndc.x·half_width·right + ndc.y·half_height·up`.
     pub fn generate_ray(&self, x: f32, y: f32) -> CameraRay {
+        let (_, on_film) = self.film_point(x, y);
+        CameraRay {
+            origin: self.position,
+            direction: on_film.normalize(),
+        }
+    }
+
+    /// Raster position `(x, y)` (pixels from the top left) in normalised device
+    /// coordinates (`[−1, 1]`, y up), and the point on the film it names,
+    /// relative to the eye in world space (report sections 2.1–2.2):
+    /// `f·forward + ndc_x·(w/2)·right + ndc_y·(h/2)·up`. The camera ray's
+    /// direction is that point normalised.
+    #[inline]
+    pub fn film_point(&self, x: f32, y: f32) -> (Vec2, Vec3) {
         let ndc_x = 2.0 * x / self.resolution.x as f32 - 1.0;
         let ndc_y = 1.0 - 2.0 * y / self.resolution.y as f32;
         let on_film = self.focal_length * self.forward
             + (ndc_x * self.half_width) * self.right
             + (ndc_y * self.half_height) * self.up;
-        CameraRay {
-            origin: self.position,
-            direction: on_film.normalize(),
-        }
+        (Vec2::new(ndc_x, ndc_y), on_film)
     }
 
     /// [`Self::generate_ray`] for [`LANES`] raster positions `(x[k], y[k])` at

@@ -18,6 +18,7 @@
 
 mod bench;
 mod diff;
+mod explain;
 mod export;
 mod interrupt;
 mod output;
@@ -60,6 +61,9 @@ enum Command {
     /// Write a scene for another renderer: --mitsuba, Mitsuba 3's XML with
     /// its meshes, images and environment map beside it
     Export(export::ExportArgs),
+    /// Every stage's numbers for one pixel: camera, intersection, texture,
+    /// lighting, film (text, or JSON with --json)
+    Explain(explain::ExplainArgs),
 }
 
 /// A failure and the exit status it maps to.
@@ -92,6 +96,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench::bench(args),
         Command::Stress(args) => stress::stress(args),
         Command::Export(args) => export::export(args),
+        Command::Explain(args) => explain::explain(args),
     })
     .unwrap_or(Err(Failure::Panicked));
     match result {
@@ -120,8 +125,16 @@ fn usage_error(e: clap::Error) -> ExitCode {
         return ExitCode::SUCCESS;
     }
     let rendered = e.render().to_string();
-    let first = rendered.lines().next().unwrap_or("invalid usage");
-    let problem = first.strip_prefix("error: ").unwrap_or(first);
+    let mut lines = rendered.lines();
+    let first = lines.next().unwrap_or("invalid usage");
+    let mut problem = first.strip_prefix("error: ").unwrap_or(first).to_owned();
+    // "the following required arguments were not provided:" names them on
+    // the next line.
+    if problem.ends_with(':') {
+        if let Some(next) = lines.next() {
+            problem = format!("{problem} {}", next.trim());
+        }
+    }
     eprintln!("glint: error: {problem} (see glint --help)");
     ExitCode::from(2)
 }

@@ -6,21 +6,66 @@ use crate::{named, progress_bar, Failure};
 use clap::Args;
 use glam::UVec2;
 use glint_camera::{ImageFormat, PartialFilm};
-use glint_integrator::{Aov, AreaSampling, RenderControl, RenderSettings, SamplePattern};
+use glint_integrator::{Aov, AreaSampling, Crop, RenderControl, RenderSettings, SamplePattern};
 use glint_scene::SceneDescription;
 use glint_texture::TextureFilter;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub(crate) struct RenderArgs {
-    /// The scene file (TOML; every key is described in docs/scene-format.md)
-    scene: PathBuf,
+    #[command(flatten)]
+    pub(crate) scene: SceneArgs,
 
     /// Output image; the extension picks the format: .png (8-bit sRGB),
     /// .exr or .pfm (linear 32-bit float). Default: SCENE-NAME.png in the
     /// current directory. Written atomically: a failed run leaves any existing file untouched.
     #[arg(short, long, value_name = "OUT")]
     output: Option<PathBuf>,
+
+    /// Render only this window of the image, half-open: columns x0..x1, rows
+    /// y0..y1 from the top (e.g. 100,50,164,114). The output is the window's
+    /// size, and its pixels are the same pixels of the whole render, bit for bit
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop)]
+    crop: Option<Crop>,
+
+    /// Worker threads [default: one per core]; the image is identical for any count
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+
+    /// Write this buffer instead of the shaded image: uv (surface coordinates),
+    /// mip-level (the level the diffuse texture is read at), normal, depth
+    /// (distance from the camera), albedo (filtered diffuse color),
+    /// reflection-depth (mirror reflections taken). Raw values in .exr/.pfm, false
+    /// color in .png (normals as 0.5·n + 0.5, uv as its fractional part, depth as
+    /// gray from near to far, MIP level and reflection depth as a blue-green-red ramp)
+    #[arg(long, value_name = "BUFFER", value_parser = named(&Aov::NAMES, Aov::from_name))]
+    aov: Option<Aov>,
+
+    /// At the end, print what the render did: rays by kind, intersection tests by
+    /// shape, BVH nodes and leaves visited, shadow rays skipped and why, texture
+    /// lookups by filter and MIP level, NaN/Inf samples dropped, time by phase, peak
+    /// memory. The image is the same with or without it
+    #[arg(long)]
+    stats: bool,
+
+    /// Write the same statistics as JSON to FILE (atomically); implies gathering
+    /// them (the schema is in docs/command-line.md)
+    #[arg(long, value_name = "FILE")]
+    stats_json: Option<PathBuf>,
+
+    /// Continue the interrupted render in OUT (an .exr whose alpha channel marks
+    /// the pixels finished): only the others are rendered, and with the same
+    /// scene and settings the image is the uninterrupted render's, bit for bit
+    #[arg(long)]
+    resume: bool,
+}
+
+/// The scene file and the settings that change its pixels, shared by the
+/// commands that render it (`render`, `explain`).
+#[derive(Args)]
+pub(crate) struct SceneArgs {
+    /// The scene file (TOML; every key is described in docs/scene-format.md)
+    scene: PathBuf,
 
     /// Camera samples per pixel (overrides render.spp)
     #[arg(long, value_name = "N")]
@@ -42,10 +87,6 @@ pub(crate) struct RenderArgs {
     /// grid needing a square count
     #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
     light_sampler: Option<SamplePattern>,
-
-    /// Worker threads [default: one per core]; the image is identical for any count
-    #[arg(long, value_name = "N")]
-    threads: Option<usize>,
 
     /// Most mirror reflections followed per camera ray (overrides render.max_depth)
     #[arg(long, value_name = "N")]
@@ -86,33 +127,6 @@ pub(crate) struct RenderArgs {
     /// the footprint), ewa (elliptically weighted average, anisotropic)
     #[arg(long, value_name = "FILTER", value_parser = named(&TextureFilter::NAMES, TextureFilter::from_name))]
     texture_filter: Option<TextureFilter>,
-
-    /// Write this buffer instead of the shaded image: uv (surface coordinates),
-    /// mip-level (the level the diffuse texture is read at), normal, depth
-    /// (distance from the camera), albedo (filtered diffuse color),
-    /// reflection-depth (mirror reflections taken). Raw values in .exr/.pfm, false
-    /// color in .png (normals as 0.5·n + 0.5, uv as its fractional part, depth as
-    /// gray from near to far, MIP level and reflection depth as a blue-green-red ramp)
-    #[arg(long, value_name = "BUFFER", value_parser = named(&Aov::NAMES, Aov::from_name))]
-    aov: Option<Aov>,
-
-    /// At the end, print what the render did: rays by kind, intersection tests by
-    /// shape, BVH nodes and leaves visited, shadow rays skipped and why, texture
-    /// lookups by filter and MIP level, NaN/Inf samples dropped, time by phase, peak
-    /// memory. The image is the same with or without it
-    #[arg(long)]
-    stats: bool,
-
-    /// Write the same statistics as JSON to FILE (atomically); implies gathering
-    /// them (the schema is in docs/command-line.md)
-    #[arg(long, value_name = "FILE")]
-    stats_json: Option<PathBuf>,
-
-    /// Continue the interrupted render in OUT (an .exr whose alpha channel marks
-    /// the pixels finished): only the others are rendered, and with the same
-    /// scene and settings the image is the uninterrupted render's, bit for bit
-    #[arg(long)]
-    resume: bool,
 }
 
 pub(crate) fn parse_resolution(text: &str) -> Result<UVec2, String> {
@@ -134,35 +148,43 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         crate::output::check_writable(json)?;
     }
     let SceneDescription {
-        mut scene,
+        scene,
         mut settings,
         timings,
         assets,
         ..
-    } = glint_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
-    apply_overrides(args, &mut settings);
+    } = args.scene.load()?;
+    if args.threads.is_some() {
+        settings.threads = args.threads;
+    }
+    if args.aov.is_some() {
+        settings.aov = args.aov;
+    }
     settings.stats = args.stats || args.stats_json.is_some();
-    if let Some(filter) = args.texture_filter {
-        scene.override_texture_filter(filter);
-    }
-    if let Some(resolution) = args.resolution {
-        scene.camera = scene
-            .camera
-            .with_resolution(resolution)
-            .map_err(|e| Failure::Input(format!("--resolution: {e}")))?;
-    }
     settings
         .validate()
         .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
+    if let Some(crop) = args.crop {
+        let size = scene.camera.resolution();
+        if crop.x1 > size.x || crop.y1 > size.y {
+            return Err(Failure::Input(format!(
+                "--crop: the window {},{},{},{} reaches past the {}x{} image",
+                crop.x0, crop.y0, crop.x1, crop.y1, size.x, size.y
+            )));
+        }
+    }
 
     // Taken now, of the bytes just loaded: a scene edited during the render
     // must not label its partial image.
+    let window = args
+        .crop
+        .map_or(scene.camera.resolution(), |crop| crop.size());
     let render_id = fingerprint(args, &assets, &settings, scene.camera.resolution())?;
     let partial = match args.resume {
         true => {
             let partial =
                 PartialFilm::load(&output).map_err(|e| Failure::Input(format!("--resume: {e}")))?;
-            check_same_render(&output, &partial, scene.camera.resolution(), &render_id)?;
+            check_same_render(&output, &partial, window, &render_id)?;
             Some(partial)
         }
         false => None,
@@ -180,6 +202,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
     let control = RenderControl {
         stop: Some(interrupts.stop()),
         resume: partial.as_ref(),
+        crop: args.crop,
     };
     let rendered = glint_integrator::render_with(&scene, &settings, &on_tile, control)
         .map_err(|e| Failure::Other(e.to_string()))?;
@@ -300,7 +323,7 @@ fn output_path(args: &RenderArgs) -> Result<PathBuf, Failure> {
     let path = match &args.output {
         Some(p) => p.clone(),
         None => {
-            let stem = args.scene.file_stem().unwrap_or("render".as_ref());
+            let stem = args.scene.scene.file_stem().unwrap_or("render".as_ref());
             Path::new(stem).with_extension("png")
         }
     };
@@ -326,7 +349,7 @@ fn fingerprint(
         hasher.update(bytes);
     };
     add(env!("CARGO_PKG_VERSION").as_bytes());
-    for path in std::iter::once(&args.scene).chain(assets) {
+    for path in std::iter::once(&args.scene.scene).chain(assets) {
         let bytes = std::fs::read(path)
             .map_err(|e| Failure::Input(format!("{}: cannot read: {e}", path.display())))?;
         add(&bytes);
@@ -337,8 +360,8 @@ fn fingerprint(
         ..settings.clone()
     };
     add(format!(
-        "{pixels_depend_on:?} {resolution} {:?}",
-        args.texture_filter
+        "{pixels_depend_on:?} {resolution} {:?} {:?}",
+        args.scene.texture_filter, args.crop
     )
     .as_bytes());
     Ok(format!("blake3 {}", hasher.finalize().to_hex()))
@@ -379,41 +402,73 @@ fn check_same_render(
     }
 }
 
-fn apply_overrides(args: &RenderArgs, settings: &mut RenderSettings) {
-    if let Some(spp) = args.spp {
-        settings.spp = spp;
+impl SceneArgs {
+    /// The scene file, loaded, with this command's overrides applied and its
+    /// settings checked.
+    pub(crate) fn load(&self) -> Result<SceneDescription, Failure> {
+        let mut description =
+            glint_scene::load(&self.scene).map_err(|e| Failure::Input(e.to_string()))?;
+        self.apply_overrides(&mut description.settings);
+        let scene = &mut description.scene;
+        if let Some(filter) = self.texture_filter {
+            scene.override_texture_filter(filter);
+        }
+        if let Some(resolution) = self.resolution {
+            scene.camera = scene
+                .camera
+                .with_resolution(resolution)
+                .map_err(|e| Failure::Input(format!("--resolution: {e}")))?;
+        }
+        description
+            .settings
+            .validate()
+            .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
+        Ok(description)
     }
-    if let Some(n) = args.light_samples {
-        settings.light_samples = n;
+
+    fn apply_overrides(&self, settings: &mut RenderSettings) {
+        let args = self;
+        if let Some(spp) = args.spp {
+            settings.spp = spp;
+        }
+        if let Some(n) = args.light_samples {
+            settings.light_samples = n;
+        }
+        if let Some(p) = args.sampler {
+            settings.pixel_pattern = p;
+        }
+        if let Some(p) = args.light_sampler {
+            settings.light_pattern = p;
+        }
+        if let Some(seed) = args.seed {
+            settings.seed = seed;
+        }
+        if let Some(strategy) = args.area_sampling {
+            settings.area_sampling = strategy;
+        }
+        if args.no_mis {
+            settings.mis = false;
+        }
+        if let Some(depth) = args.max_depth {
+            settings.max_depth = depth;
+        }
+        if let Some(n) = args.environment_samples {
+            settings.environment_samples = n;
+        }
+        if let Some(p) = args.environment_sampler {
+            settings.environment_pattern = p;
+        }
     }
-    if let Some(p) = args.sampler {
-        settings.pixel_pattern = p;
-    }
-    if let Some(p) = args.light_sampler {
-        settings.light_pattern = p;
-    }
-    if let Some(seed) = args.seed {
-        settings.seed = seed;
-    }
-    if let Some(strategy) = args.area_sampling {
-        settings.area_sampling = strategy;
-    }
-    if args.no_mis {
-        settings.mis = false;
-    }
-    if let Some(depth) = args.max_depth {
-        settings.max_depth = depth;
-    }
-    if let Some(n) = args.environment_samples {
-        settings.environment_samples = n;
-    }
-    if let Some(p) = args.environment_sampler {
-        settings.environment_pattern = p;
-    }
-    if args.threads.is_some() {
-        settings.threads = args.threads;
-    }
-    if args.aov.is_some() {
-        settings.aov = args.aov;
-    }
+}
+
+/// Parses `--crop X0,Y0,X1,Y1` (half-open, non-empty); whether it fits the
+/// image is checked once the scene is loaded.
+fn parse_crop(text: &str) -> Result<Crop, String> {
+    let r = glint_metrics::Region::parse(text)?;
+    Ok(Crop {
+        x0: r.x0,
+        y0: r.y0,
+        x1: r.x1,
+        y1: r.y1,
+    })
 }

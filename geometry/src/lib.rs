@@ -70,7 +70,9 @@ pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceD
 pub use hit::Hit;
 pub use offset::{offset_ray_origin, offset_ray_origins, spawn_ray, spawn_ray_to, RayTarget};
 pub use ray::Ray;
-pub use shape_list::{ClosestLanes, ObjectRef, Occluders, PrimitiveHit, ShapeList};
+pub use shape_list::{
+    ClosestExplained, ClosestLanes, ObjectRef, ObjectTest, Occluders, PrimitiveHit, ShapeList,
+};
 pub use shapes::{triangle, triangle_packet};
 pub use shapes::{
     AaBox, MeshError, Parallelogram, ParallelogramPacket, Plane, RayLanes, Shape, Sphere,

@@ -20,6 +20,7 @@
 use crate::direct::{PairAllocation, SampleContext, ShadingPoint};
 use crate::light_samples::count_lanes;
 use crate::sampling::{pixel_key, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern};
+use crate::trace::Tracer;
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::Vec2;
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
@@ -50,14 +51,14 @@ impl DirectIntegrator {
     /// have the closest hits `closest`: for each, what [`Self::li_at`] gives it
     /// alone (with [`SampleContext::begin_sample`] for that sample), bit for bit.
     /// Only for scenes where [`Self::shades_first_hits_in_lanes`] holds.
-    pub(crate) fn li_first_hits(
+    pub(crate) fn li_first_hits<T: Tracer>(
         &self,
         scene: &Scene,
         rays: &RayLanes,
         closest: &ClosestLanes,
         used: usize,
         first: PixelSample,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         debug_assert!(self.shades_first_hits_in_lanes(scene));
         let mut radiance = Vec3Lanes::default();
@@ -173,14 +174,14 @@ impl<'a> ShadedLanes<'a> {
     /// each lane what [`Self::set`] gives it from its [`ShadingPoint`], and
     /// `radiance` its ambient or emitted part. Returns false, setting nothing,
     /// for lanes on several objects (or none) or on other shapes.
-    fn set_common(
+    fn set_common<T: Tracer>(
         &mut self,
         scene: &'a Scene,
         rays: &RayLanes,
         closest: &ClosestLanes,
         hit_lanes: u32,
         radiance: &mut Vec3Lanes,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> bool {
         let Some(object) = closest.common_object(hit_lanes) else {
             return false;
@@ -226,12 +227,12 @@ impl<'a> ShadedLanes<'a> {
     /// Per lane, the Phong reflection of the light point at `(ux, uy)` on `light`, or
     /// zero where it is behind the light, below the surface, reflects nothing or
     /// is blocked: `unoccluded_reflection` of the scalar path, with its counts.
-    fn area_light(
+    fn area_light<T: Tracer>(
         &self,
         scene: &Scene,
         light: &AreaLight,
         (ux, uy): (F32Lanes, F32Lanes),
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let position = light.sample_points(ux, uy);
         let towards = position - self.point;
@@ -282,11 +283,11 @@ impl<'a> ShadedLanes<'a> {
 /// `material`'s reflectances `(kd, ks)` at each lane's uv (the lanes of
 /// `hit_lanes`; the others zero), as [`PhongMaterial::reflectances_at`] gives
 /// them: constants in every lane at once, textures lane by lane.
-fn reflectances_lanes(
+fn reflectances_lanes<T: Tracer>(
     material: &PhongMaterial,
     surface: &SurfaceLanes,
     hit_lanes: u32,
-    ctx: &mut SampleContext,
+    ctx: &mut SampleContext<T>,
 ) -> (Vec3Lanes, Vec3Lanes) {
     let (u, v) = (surface.u.to_array(), surface.v.to_array());
     let uv = |k: usize| Vec2::new(u[k], v[k]);

@@ -1,6 +1,7 @@
 use crate::counters::{ShadingCounters, TextureCounters};
 use crate::sampling::Pcg32;
 use crate::sampling::{DimensionPair, PixelSample, SamplePattern, MAX_JOINT};
+use crate::trace::{Event, Shadow, Skip, Tracer};
 use crate::{Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::{
@@ -38,8 +39,9 @@ pub struct DirectIntegrator {
 }
 
 /// Reusable per-thread state: the current camera sample and its random stream,
-/// buffers for sample positions, and ray counters.
-pub struct SampleContext {
+/// buffers for sample positions, ray counters, and the [`Tracer`] that sees
+/// each step (`()`, which sees nothing at no cost, for renders).
+pub struct SampleContext<T: Tracer = ()> {
     /// The camera sample being traced; names its points of the Sobol sequences.
     pub sample: PixelSample,
     /// Its PCG stream (for the patterns other than Sobol).
@@ -52,10 +54,19 @@ pub struct SampleContext {
     pub textures: TextureCounters,
     /// Whether to gather [`Self::textures`] (`--stats`).
     pub detailed: bool,
+    /// Sees every step of the integrator ([`crate::trace`]).
+    pub tracer: T,
 }
 
 impl SampleContext {
     pub fn new(light_samples: u32, environment_samples: u32) -> Self {
+        Self::with_tracer(light_samples, environment_samples, ())
+    }
+}
+
+impl<T: Tracer> SampleContext<T> {
+    /// [`SampleContext::new`] with `tracer` seeing every step.
+    pub fn with_tracer(light_samples: u32, environment_samples: u32, tracer: T) -> Self {
         Self {
             sample: PixelSample::default(),
             rng: PixelSample::default().rng(),
@@ -64,6 +75,7 @@ impl SampleContext {
             counters: ShadingCounters::default(),
             textures: TextureCounters::default(),
             detailed: false,
+            tracer,
         }
     }
 
@@ -98,13 +110,13 @@ impl DirectIntegrator {
     /// reflections deep), whose footprint is given by the ray differentials `diff`.
     /// Light and environment samples come from the camera sample `ctx` was
     /// started on ([`SampleContext::begin_sample`]).
-    pub fn li(
+    pub fn li<T: Tracer>(
         &self,
         scene: &Scene,
         ray: &Ray,
         diff: &RayDifferential,
         depth: u32,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let hit = scene.shapes.closest_hit(ray, f32::INFINITY);
         self.li_at(scene, ray, diff, hit, depth, ctx)
@@ -112,15 +124,20 @@ impl DirectIntegrator {
 
     /// [`Self::li`] for a ray whose closest hit is already found: `hit`, or
     /// `None` for a miss.
-    pub fn li_at(
+    pub fn li_at<T: Tracer>(
         &self,
         scene: &Scene,
         ray: &Ray,
         diff: &RayDifferential,
         hit: Option<Hit>,
         depth: u32,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
+        ctx.tracer.record(|| Event::Ray {
+            depth,
+            ray: *ray,
+            hit: hit.map(Box::new),
+        });
         let Some(hit) = hit else {
             return match &scene.environment {
                 Some(env) => {
@@ -135,15 +152,27 @@ impl DirectIntegrator {
                         ShadingModel::Phong => diff.angular_width(ray.direction),
                         ShadingModel::Physical => 0.0,
                     };
-                    env.radiance(ray.direction.normalize(), width)
+                    let radiance = env.radiance(ray.direction.normalize(), width);
+                    ctx.tracer.record(|| Event::Environment {
+                        direction: ray.direction.normalize(),
+                        width,
+                        radiance,
+                    });
+                    radiance
                 }
                 None => Vec3::ZERO,
             };
         };
         let material = match scene.surface_of(&hit) {
-            SurfaceKind::Emitter(Light::Area(area)) => return area.color,
-            SurfaceKind::Emitter(Light::Sphere(sphere)) => return sphere.color,
-            SurfaceKind::Emitter(_) => return Vec3::ZERO,
+            SurfaceKind::Emitter(light) => {
+                let radiance = match light {
+                    Light::Area(area) => area.color,
+                    Light::Sphere(sphere) => sphere.color,
+                    _ => Vec3::ZERO,
+                };
+                ctx.tracer.record(|| Event::Emitter { radiance });
+                return radiance;
+            }
             SurfaceKind::Material(m) => m,
         };
         let r = material.reflectivity;
@@ -156,6 +185,14 @@ impl DirectIntegrator {
                 ctx.textures.record(material, &tc);
             }
             let point = ShadingPoint::new(&hit, material, ray, &tc);
+            ctx.tracer.record(|| Event::Surface {
+                tc,
+                kd: point.kd,
+                ks: point.ks,
+                n: point.n,
+                ng: point.ng,
+                v: point.v,
+            });
             match scene.shading {
                 ShadingModel::Phong => self.shade(scene, &point, depth, ctx),
                 ShadingModel::Physical => self.shade_physical(scene, &point, depth, ctx),
@@ -168,26 +205,40 @@ impl DirectIntegrator {
             let (wi, reflected_diff) = reflect_differential(&hit, ray.direction, diff, &surface);
             let reflected = spawn_ray(&hit, wi);
             ctx.counters.reflection_rays += 1;
+            ctx.tracer.record(|| Event::Mirror {
+                reflectivity: r,
+                tint: material.mirror_tint,
+                direction: wi,
+            });
             material.mirror_tint * self.li(scene, &reflected, &reflected_diff, depth + 1, ctx)
         } else {
             Vec3::ZERO
         };
-        (1.0 - r) * local + r * mirror
+        let value = (1.0 - r) * local + r * mirror;
+        ctx.tracer.record(|| Event::Radiance {
+            depth,
+            local,
+            mirror,
+            value,
+        });
+        value
     }
 
     /// The local shading of `point`, `depth` reflections deep: ambient, the
     /// lights and the environment.
-    fn shade(
+    fn shade<T: Tracer>(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         depth: u32,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let mut radiance = scene.ambient * point.kd;
+        ctx.tracer.record(|| Event::Ambient { value: radiance });
         let mut pairs = PairAllocation::new(depth);
         for (index, light) in scene.lights.iter().enumerate() {
-            radiance += match light {
+            ctx.tracer.record(|| Event::Light { light: index });
+            let value = match light {
                 Light::Point(p) => {
                     let target = RayTarget::exact(p.position);
                     let reflected =
@@ -206,28 +257,49 @@ impl DirectIntegrator {
                 // accepts them under physical shading only.
                 Light::Sphere(_) => Vec3::ZERO,
             };
+            ctx.tracer.record(|| Event::LightTotal {
+                light: index,
+                value,
+            });
+            radiance += value;
         }
-        if self.environment_samples > 0 {
-            let pair = pairs.take(
-                DimensionPair::Environment { depth },
-                self.environment_samples,
-            );
-            radiance += self.environment_light(scene, point, pair, ctx);
-        }
+        radiance += self.environment_term(scene, point, &mut pairs, depth, ctx);
         radiance
+    }
+
+    /// The environment's light at `point` (zero without environment samples),
+    /// its sample points taken from `pairs`.
+    pub(crate) fn environment_term<T: Tracer>(
+        &self,
+        scene: &Scene,
+        point: &ShadingPoint,
+        pairs: &mut PairAllocation,
+        depth: u32,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
+        if self.environment_samples == 0 || scene.environment.is_none() {
+            return Vec3::ZERO;
+        }
+        let pair = pairs.take(
+            DimensionPair::Environment { depth },
+            self.environment_samples,
+        );
+        let value = self.environment_light(scene, point, pair, ctx);
+        ctx.tracer.record(|| Event::EnvironmentTotal { value });
+        value
     }
 
     /// The average over the light's samples (the dimension pair `pair` of the
     /// Sobol pattern) of the Phong reflection of each visible sample, times the
     /// light's color.
-    fn area_light(
+    fn area_light<T: Tracer>(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         index: usize,
         light: &AreaLight,
         pair: DimensionPair,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let mut samples = std::mem::take(&mut ctx.light_points);
         let sobol = ctx.sample.sobol_points(pair, self.light_samples);
@@ -253,12 +325,12 @@ impl DirectIntegrator {
     /// importance-sampled from the environment (the points of
     /// `environment_pattern` over [0, 1)² mapped to directions), for a shading
     /// point `depth` reflections deep.
-    pub(crate) fn environment_light(
+    pub(crate) fn environment_light<T: Tracer>(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         pair: DimensionPair,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let Some(env) = &scene.environment else {
             return Vec3::ZERO;
@@ -270,24 +342,49 @@ impl DirectIntegrator {
         let mut sum = Vec3::ZERO;
         for &u in &samples {
             let s = env.sample(point.n, u);
+            let record = |ctx: &mut SampleContext<T>, f_cos: Vec3, shadow: Shadow, value: Vec3| {
+                ctx.tracer.record(|| Event::EnvironmentSample {
+                    direction: s.direction,
+                    pdf: s.pdf,
+                    radiance: s.radiance,
+                    f_cos,
+                    shadow,
+                    value,
+                })
+            };
             if s.pdf.is_nan() || s.pdf <= 0.0 || s.radiance == Vec3::ZERO {
+                record(ctx, Vec3::ZERO, Shadow::Skipped(Skip::ZeroPdf), Vec3::ZERO);
                 continue;
             }
             if !point.above_surface(s.direction) {
                 ctx.counters.skipped_behind_surface += 1;
+                record(
+                    ctx,
+                    Vec3::ZERO,
+                    Shadow::Skipped(Skip::BehindSurface),
+                    Vec3::ZERO,
+                );
                 continue;
             }
             let f = point.brdf_cos(s.direction, ctx);
             if f == Vec3::ZERO {
                 ctx.counters.skipped_zero_brdf += 1;
+                record(ctx, f, Shadow::Skipped(Skip::ZeroBrdf), Vec3::ZERO);
                 continue;
             }
             ctx.counters.environment_shadow_rays += 1;
-            if !scene
-                .shapes
-                .any_hit(&spawn_ray(point.hit, s.direction), f32::INFINITY)
-            {
-                sum += s.radiance * f / s.pdf;
+            let shadow_ray = spawn_ray(point.hit, s.direction);
+            if !scene.shapes.any_hit(&shadow_ray, f32::INFINITY) {
+                let value = s.radiance * f / s.pdf;
+                record(ctx, f, Shadow::Unoccluded, value);
+                sum += value;
+            } else {
+                record(
+                    ctx,
+                    f,
+                    blocker(scene, &shadow_ray, f32::INFINITY),
+                    Vec3::ZERO,
+                );
             }
         }
         ctx.environment_points = samples;
@@ -372,7 +469,7 @@ impl<'a> ShadingPoint<'a> {
     /// The BRDF times the cosine for light from direction `l`: the specular
     /// lobe only where `ks` is nonzero.
     #[inline]
-    pub(crate) fn brdf_cos(&self, l: Vec3, ctx: &mut SampleContext) -> Vec3 {
+    pub(crate) fn brdf_cos<T: Tracer>(&self, l: Vec3, ctx: &mut SampleContext<T>) -> Vec3 {
         if self.has_specular {
             ctx.counters.specular_lobes += 1;
             self.material.brdf_cos(self.kd, self.ks, self.n, l, self.v)
@@ -386,18 +483,19 @@ impl ShadingPoint<'_> {
     /// Phong reflection towards `v` of a unit light at `target`, or zero if the
     /// light is behind the surface or a shadow ray finds it occluded (testing only
     /// `occluders`). The shadow ray is only traced when the light could contribute.
-    pub(crate) fn unoccluded_reflection(
+    pub(crate) fn unoccluded_reflection<T: Tracer>(
         &self,
         scene: &Scene,
         target: &RayTarget,
         occluders: &Occluders,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let Some(l) = (target.point - self.hit.point).try_normalize() else {
             return Vec3::ZERO;
         };
         if !self.above_surface(l) {
             ctx.counters.skipped_behind_surface += 1;
+            self.record_light_sample(target, l, Shadow::Skipped(Skip::BehindSurface), ctx);
             return Vec3::ZERO;
         }
         let reflected = if self.has_specular {
@@ -408,15 +506,57 @@ impl ShadingPoint<'_> {
         };
         if reflected == Vec3::ZERO {
             ctx.counters.skipped_zero_brdf += 1;
+            self.record_light_sample(target, l, Shadow::Skipped(Skip::ZeroBrdf), ctx);
             return Vec3::ZERO;
         }
         let shadow = spawn_ray_to(self.hit, target);
         ctx.counters.light_shadow_rays += 1;
         if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
+            self.record_light_sample(target, l, blocker(scene, &shadow, 1.0), ctx);
             Vec3::ZERO
         } else {
+            self.record_light_sample(target, l, Shadow::Unoccluded, ctx);
             reflected
         }
+    }
+
+    /// Records a light sample of the course's model towards `target` along
+    /// `l`: the diffuse and specular parts recomputed apart (their sum is
+    /// the reflection the integrator used, to rounding), zero unless lit.
+    #[inline(always)]
+    pub(crate) fn record_light_sample<T: Tracer>(
+        &self,
+        target: &RayTarget,
+        l: Vec3,
+        shadow: Shadow,
+        ctx: &mut SampleContext<T>,
+    ) {
+        ctx.tracer.record(|| {
+            let n_dot_l = self.n.dot(l);
+            let lit = shadow == Shadow::Unoccluded;
+            let diffuse = self.material.reflect_diffuse(self.kd, self.n, l);
+            let specular = if self.has_specular {
+                self.material
+                    .reflect(Vec3::ZERO, self.ks, self.n, l, self.v)
+            } else {
+                Vec3::ZERO
+            };
+            let value = match (lit, self.has_specular) {
+                (false, _) => Vec3::ZERO,
+                (true, true) => self.material.reflect(self.kd, self.ks, self.n, l, self.v),
+                (true, false) => diffuse,
+            };
+            Event::LightSample {
+                position: target.point,
+                l,
+                n_dot_l,
+                reflection: 2.0 * n_dot_l * self.n - l,
+                diffuse,
+                specular,
+                shadow,
+                value,
+            }
+        });
     }
 }
 
@@ -454,6 +594,22 @@ impl PairAllocation {
         } else {
             own
         }
+    }
+}
+
+/// The nearest object blocking `shadow` before `t_max`, as a tracer reports
+/// it (the integrator itself only asks whether anything does).
+pub(crate) fn blocker(scene: &Scene, shadow: &Ray, t_max: f32) -> Shadow {
+    match scene.shapes.closest_hit(shadow, t_max) {
+        Some(hit) => Shadow::Blocked {
+            object: hit.shape,
+            t: hit.t,
+        },
+        // Counted as blocked by a test the closest-hit query rounds differently.
+        None => Shadow::Blocked {
+            object: u32::MAX,
+            t: f32::NAN,
+        },
     }
 }
 

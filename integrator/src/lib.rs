@@ -30,19 +30,22 @@ mod aov;
 mod camera_lanes;
 pub mod counters;
 mod direct;
+mod explain;
 mod light_samples;
 mod physical;
 mod render;
 pub mod sampling;
 mod scene;
+pub mod trace;
 
 pub use aov::Aov;
 pub use counters::{LookupKind, ShadingCounters, TextureCounters};
 pub use direct::{DirectIntegrator, SampleContext};
+pub use explain::{explain_pixel, ExplainError, PixelExplanation};
 pub use glint_lighting::{AreaSampling, ShadingModel};
 pub use render::{
-    camera_ray, render, render_with, RenderControl, RenderOutput, RenderSettings, RenderStats,
-    SampleCount, SettingsError, MAX_SAMPLES, MAX_THREADS, TILE_SIZE,
+    camera_ray, render, render_with, Crop, RenderControl, RenderOutput, RenderSettings,
+    RenderStats, SampleCount, SettingsError, MAX_SAMPLES, MAX_THREADS, TILE_SIZE,
 };
 pub use sampling::SamplePattern;
 pub use scene::{Scene, SceneBuilder, SceneError, Surface, SurfaceKind};

@@ -14,6 +14,7 @@
 //! lanes, a shape counts one test per ray in the batch.
 
 use crate::direct::{SampleContext, ShadingPoint};
+use crate::trace::{Shadow, Skip, Tracer};
 use crate::{Scene, ShadingCounters};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
@@ -28,15 +29,15 @@ impl ShadingPoint<'_> {
     /// The sum over `samples` (coordinates on `light`) of the point's Phong
     /// reflection of each light point that shines on it and is not blocked
     /// (testing only `occluders`), before the light's colour and the average.
-    pub(crate) fn area_light_sum(
+    pub(crate) fn area_light_sum<T: Tracer>(
         &self,
         scene: &Scene,
         light: &AreaLight,
         samples: &[Vec2],
         occluders: &Occluders,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        if samples.len() < LANES_FROM_SAMPLES {
+        if samples.len() < LANES_FROM_SAMPLES || T::ON {
             return self.area_light_sum_one_by_one(scene, light, samples, occluders, ctx);
         }
         let point = self.hit.point;
@@ -91,9 +92,9 @@ impl ShadingPoint<'_> {
     }
 
     /// Adds one chunk's lanes to the counts ([`count_lanes`]).
-    fn count(
+    fn count<T: Tracer>(
         &self,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
         used: u32,
         lit: u32,
         normalized: u32,
@@ -113,13 +114,13 @@ impl ShadingPoint<'_> {
     }
 
     /// [`Self::area_light_sum`] one sample at a time.
-    pub(crate) fn area_light_sum_one_by_one(
+    pub(crate) fn area_light_sum_one_by_one<T: Tracer>(
         &self,
         scene: &Scene,
         light: &AreaLight,
         samples: &[Vec2],
         occluders: &Occluders,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let mut sum = Vec3::ZERO;
         for &u in samples {
@@ -129,6 +130,9 @@ impl ShadingPoint<'_> {
                 sum += self.unoccluded_reflection(scene, &target, occluders, ctx);
             } else {
                 ctx.counters.skipped_behind_light += 1;
+                let target = light.shadow_target(position);
+                let l = (position - self.hit.point).normalize_or_zero();
+                self.record_light_sample(&target, l, Shadow::Skipped(Skip::BehindLight), ctx);
             }
         }
         sum

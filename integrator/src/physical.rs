@@ -24,8 +24,9 @@
 //! the sharp highlight of a large light, where light samples alone are noisy.
 //! On a purely diffuse material only the light is sampled (weight 1).
 
-use crate::direct::{PairAllocation, SampleContext, ShadingPoint, CULL_FROM_SAMPLES};
+use crate::direct::{blocker, PairAllocation, SampleContext, ShadingPoint, CULL_FROM_SAMPLES};
 use crate::sampling::DimensionPair;
+use crate::trace::{Event, Shadow, Skip, Technique, Tracer};
 use crate::{DirectIntegrator, Scene};
 use glam::Vec3;
 use glint_geometry::{spawn_ray, spawn_ray_to, Occluders, RayTarget};
@@ -33,17 +34,19 @@ use glint_lighting::{AreaLight, Light, PointLight, SphereLight};
 
 impl DirectIntegrator {
     /// The local shading of `point` in physical units, `depth` reflections deep.
-    pub(crate) fn shade_physical(
+    pub(crate) fn shade_physical<T: Tracer>(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         depth: u32,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let mut radiance = scene.ambient * point.kd;
+        ctx.tracer.record(|| Event::Ambient { value: radiance });
         let mut pairs = PairAllocation::new(depth);
         for (index, light) in scene.lights.iter().enumerate() {
-            radiance += match light {
+            ctx.tracer.record(|| Event::Light { light: index });
+            let value = match light {
                 Light::Point(p) => point.point_light(scene, p, ctx),
                 Light::Area(area) => {
                     let own = DimensionPair::Light {
@@ -62,14 +65,13 @@ impl DirectIntegrator {
                     self.physical_sphere_light(scene, point, index, sphere, pair, depth, ctx)
                 }
             };
+            ctx.tracer.record(|| Event::LightTotal {
+                light: index,
+                value,
+            });
+            radiance += value;
         }
-        if self.environment_samples > 0 {
-            let pair = pairs.take(
-                DimensionPair::Environment { depth },
-                self.environment_samples,
-            );
-            radiance += self.environment_light(scene, point, pair, ctx);
-        }
+        radiance += self.environment_term(scene, point, &mut pairs, depth, ctx);
         radiance
     }
 
@@ -77,7 +79,7 @@ impl DirectIntegrator {
     /// `point`: light samples from `pair`, and on a glossy material as many
     /// specular-lobe samples, combined by the power heuristic.
     #[allow(clippy::too_many_arguments)]
-    fn physical_area_light(
+    fn physical_area_light<T: Tracer>(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
@@ -85,7 +87,7 @@ impl DirectIntegrator {
         light: &AreaLight,
         pair: DimensionPair,
         depth: u32,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let x = point.hit.point;
         let n = self.light_samples;
@@ -128,7 +130,7 @@ impl DirectIntegrator {
     /// at `point`: directions uniform over its cone, and on a glossy material
     /// as many specular-lobe samples, combined by the power heuristic.
     #[allow(clippy::too_many_arguments)]
-    fn physical_sphere_light(
+    fn physical_sphere_light<T: Tracer>(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
@@ -136,7 +138,7 @@ impl DirectIntegrator {
         light: &SphereLight,
         pair: DimensionPair,
         depth: u32,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let x = point.hit.point;
         let n = self.light_samples;
@@ -169,14 +171,14 @@ impl DirectIntegrator {
     /// The sum over `light_samples` directions drawn from `point`'s specular
     /// lobe of [`ShadingPoint::lobe_sample`] towards the light at `index`,
     /// whose own sampling has density `light_pdf(y)` towards its point `y`.
-    fn lobe_samples(
+    fn lobe_samples<T: Tracer>(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         index: usize,
         depth: u32,
         light_pdf: impl Fn(Vec3) -> f32,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let pair = DimensionPair::Brdf {
             light: index as u32,
@@ -212,48 +214,96 @@ pub(crate) fn power_heuristic(a: f32, b: f32) -> f32 {
 impl ShadingPoint<'_> {
     /// `f · cos θ · I / r²` of a point light, or zero behind the surface or in
     /// shadow.
-    fn point_light(&self, scene: &Scene, light: &PointLight, ctx: &mut SampleContext) -> Vec3 {
+    fn point_light<T: Tracer>(
+        &self,
+        scene: &Scene,
+        light: &PointLight,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
         let d = light.position - self.hit.point;
         let distance2 = d.length_squared();
         let Some(l) = d.try_normalize() else {
             return Vec3::ZERO;
         };
+        let record = |ctx: &mut SampleContext<T>, f_cos: Vec3, shadow: Shadow, value: Vec3| {
+            ctx.tracer.record(|| Event::PhysicalSample {
+                technique: Technique::PointLight,
+                l,
+                f_cos,
+                light_pdf: 1.0,
+                lobe_pdf: 0.0,
+                weight: 1.0,
+                shadow,
+                value,
+            })
+        };
         let Some(f) = self.reflection_towards(l, ctx) else {
+            record(ctx, Vec3::ZERO, self.skip_reason(l), Vec3::ZERO);
             return Vec3::ZERO;
         };
         ctx.counters.light_shadow_rays += 1;
         let shadow = spawn_ray_to(self.hit, &RayTarget::exact(light.position));
         if scene.shapes.any_hit_among(&Occluders::ALL, &shadow, 1.0) {
+            record(ctx, f, blocker(scene, &shadow, 1.0), Vec3::ZERO);
             return Vec3::ZERO;
         }
-        light.color * f / distance2
+        let value = light.color * f / distance2;
+        record(ctx, f, Shadow::Unoccluded, value);
+        value
     }
 
     /// One light sample's `f · cos θ · V · w / p` towards the point
     /// `target` on a light, drawn with solid-angle density `pdf` (the shadow
     /// ray testing only `occluders`), `w` its power-heuristic weight against
     /// the specular lobe's density (1 without `mis`).
-    fn light_sample(
+    fn light_sample<T: Tracer>(
         &self,
         scene: &Scene,
         target: &RayTarget,
         pdf: f32,
         mis: bool,
         occluders: &Occluders,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
+        let record = |ctx: &mut SampleContext<T>, f_cos: Vec3, shadow: Shadow, value: Vec3| {
+            ctx.tracer.record(|| {
+                let l = (target.point - self.hit.point).normalize_or_zero();
+                let lobe_pdf = if mis {
+                    self.material.specular_pdf(self.n, l, self.v)
+                } else {
+                    0.0
+                };
+                Event::PhysicalSample {
+                    technique: Technique::Light,
+                    l,
+                    f_cos,
+                    light_pdf: pdf,
+                    lobe_pdf,
+                    weight: if mis {
+                        power_heuristic(pdf, lobe_pdf)
+                    } else {
+                        1.0
+                    },
+                    shadow,
+                    value,
+                }
+            })
+        };
         if !(pdf > 0.0 && pdf.is_finite()) {
+            record(ctx, Vec3::ZERO, Shadow::Skipped(Skip::ZeroPdf), Vec3::ZERO);
             return Vec3::ZERO;
         }
         let Some(l) = (target.point - self.hit.point).try_normalize() else {
             return Vec3::ZERO;
         };
         let Some(f) = self.reflection_towards(l, ctx) else {
+            record(ctx, Vec3::ZERO, self.skip_reason(l), Vec3::ZERO);
             return Vec3::ZERO;
         };
         ctx.counters.light_shadow_rays += 1;
         let shadow = spawn_ray_to(self.hit, target);
         if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
+            record(ctx, f, blocker(scene, &shadow, 1.0), Vec3::ZERO);
             return Vec3::ZERO;
         }
         let weight = if mis {
@@ -261,26 +311,48 @@ impl ShadingPoint<'_> {
         } else {
             1.0
         };
-        f * (weight / pdf)
+        let value = f * (weight / pdf);
+        record(ctx, f, Shadow::Unoccluded, value);
+        value
     }
 
     /// One specular-lobe sample's `f · cos θ · V · w / p` towards the light
     /// whose surface is scene object `object` and whose light sampling draws
     /// the direction towards its point `y` with density `light_pdf(y)`: zero
     /// unless the ray from the point along `l` reaches that light first.
-    fn lobe_sample(
+    fn lobe_sample<T: Tracer>(
         &self,
         scene: &Scene,
         light_pdf: &impl Fn(Vec3) -> f32,
         object: u32,
         l: Vec3,
-        ctx: &mut SampleContext,
+        ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let pdf = self.material.specular_pdf(self.n, l, self.v);
+        let record = |ctx: &mut SampleContext<T>, f_cos: Vec3, light: f32, shadow, value| {
+            ctx.tracer.record(|| Event::PhysicalSample {
+                technique: Technique::Lobe,
+                l,
+                f_cos,
+                light_pdf: light,
+                lobe_pdf: pdf,
+                weight: power_heuristic(pdf, light),
+                shadow,
+                value,
+            })
+        };
         if !(pdf > 0.0 && pdf.is_finite()) {
+            record(
+                ctx,
+                Vec3::ZERO,
+                0.0,
+                Shadow::Skipped(Skip::ZeroPdf),
+                Vec3::ZERO,
+            );
             return Vec3::ZERO;
         }
         let Some(f) = self.reflection_towards(l, ctx) else {
+            record(ctx, Vec3::ZERO, 0.0, self.skip_reason(l), Vec3::ZERO);
             return Vec3::ZERO;
         };
         ctx.counters.brdf_rays += 1;
@@ -288,16 +360,41 @@ impl ShadingPoint<'_> {
         // The light's surface is one-sided: a hit on it is a hit on its front.
         match scene.shapes.closest_hit(&ray, f32::INFINITY) {
             Some(hit) if hit.shape == object => {
-                f * (power_heuristic(pdf, light_pdf(hit.point)) / pdf)
+                let light = light_pdf(hit.point);
+                let value = f * (power_heuristic(pdf, light) / pdf);
+                record(ctx, f, light, Shadow::Unoccluded, value);
+                value
             }
-            _ => Vec3::ZERO,
+            other => {
+                let shadow = match other {
+                    Some(hit) => Shadow::Blocked {
+                        object: hit.shape,
+                        t: hit.t,
+                    },
+                    None => Shadow::Blocked {
+                        object: u32::MAX,
+                        t: f32::INFINITY,
+                    },
+                };
+                record(ctx, f, 0.0, shadow, Vec3::ZERO);
+                Vec3::ZERO
+            }
         }
     }
 
     /// `f(l, v) · cos θ` towards the unit direction `l`, or `None` (counted)
     /// where no ray need be traced: `l` below the geometric surface, or a zero
     /// BRDF.
-    fn reflection_towards(&self, l: Vec3, ctx: &mut SampleContext) -> Option<Vec3> {
+    /// Why [`Self::reflection_towards`] gave `None` for `l`.
+    fn skip_reason(&self, l: Vec3) -> Shadow {
+        Shadow::Skipped(if self.above_surface(l) {
+            Skip::ZeroBrdf
+        } else {
+            Skip::BehindSurface
+        })
+    }
+
+    fn reflection_towards<T: Tracer>(&self, l: Vec3, ctx: &mut SampleContext<T>) -> Option<Vec3> {
         if !self.above_surface(l) {
             ctx.counters.skipped_behind_surface += 1;
             return None;

@@ -1,6 +1,7 @@
 use crate::counters::{ShadingCounters, TextureCounters};
 use crate::direct::SampleContext;
 use crate::sampling::{pixel_rng, PixelSample, SamplePattern, SobolPoints, PIXEL_STREAM};
+use crate::trace::{Event, Tracer};
 use crate::{Aov, DirectIntegrator, Scene};
 use glam::{UVec2, Vec2, Vec3};
 use glint_camera::{Camera, Film, PartialFilm};
@@ -120,6 +121,8 @@ pub enum SettingsError {
     ThreadPool(String),
     #[error("the partial render to resume is {}x{} pixels, the camera's film {}x{}", film.x, film.y, camera.x, camera.y)]
     ResumeResolution { film: UVec2, camera: UVec2 },
+    #[error("the crop {},{},{},{} is not a non-empty window of the {}x{} image (x0 < x1 <= width, y0 < y1 <= height)", crop.x0, crop.y0, crop.x1, crop.y1, size.x, size.y)]
+    Crop { crop: Crop, size: UVec2 },
 }
 
 impl RenderSettings {
@@ -220,6 +223,36 @@ pub struct RenderControl<'a> {
     /// settings and its own index, so with the same scene and settings the
     /// result is the uninterrupted render's, bit for bit.
     pub resume: Option<&'a PartialFilm>,
+    /// Render only this window of the camera's image: the film is the
+    /// window's size, and each of its pixels is the same pixel of the whole
+    /// render, bit for bit (a pixel depends only on its place in the whole
+    /// image).
+    pub crop: Option<Crop>,
+}
+
+/// A window of pixels, half-open: columns `x0..x1`, rows `y0..y1` from the top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Crop {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+impl Crop {
+    /// The window's width and height.
+    pub fn size(&self) -> UVec2 {
+        UVec2::new(self.x1 - self.x0, self.y1 - self.y0)
+    }
+
+    /// The window, if it is non-empty and lies inside an image of `size`.
+    fn check(self, size: UVec2) -> Result<Crop, SettingsError> {
+        if self.x0 < self.x1 && self.y0 < self.y1 && self.x1 <= size.x && self.y1 <= size.y {
+            Ok(self)
+        } else {
+            Err(SettingsError::Crop { crop: self, size })
+        }
+    }
 }
 
 /// A rendered image and what it cost.
@@ -255,13 +288,17 @@ pub fn render_with(
     control: RenderControl,
 ) -> Result<RenderOutput, SettingsError> {
     settings.validate()?;
+    let window = match control.crop {
+        Some(crop) => crop.check(scene.camera.resolution())?,
+        None => full_image(scene.camera.resolution()),
+    };
     if let Some(partial) = control.resume {
-        let (film, camera) = (partial.film.resolution(), scene.camera.resolution());
+        let (film, camera) = (partial.film.resolution(), window.size());
         if film != camera {
             return Err(SettingsError::ResumeResolution { film, camera });
         }
     }
-    let run = || render_on_current_pool(scene, settings, on_tile_done, control);
+    let run = || render_on_current_pool(scene, settings, on_tile_done, control, window);
     match settings.threads {
         None => Ok(run()),
         Some(threads) => rayon::ThreadPoolBuilder::new()
@@ -277,9 +314,10 @@ fn render_on_current_pool(
     settings: &RenderSettings,
     on_tile_done: &(dyn Fn(usize, usize) + Sync),
     control: RenderControl,
+    window: Crop,
 ) -> RenderOutput {
     let start = Instant::now();
-    let resolution = scene.camera.resolution();
+    let resolution = window.size();
     let integrator = DirectIntegrator::new(settings);
     let (mut film, mut finished) = match control.resume {
         Some(partial) => (partial.film.clone(), partial.finished.clone()),
@@ -298,9 +336,10 @@ fn render_on_current_pool(
         .zip(finished.par_chunks_mut(band))
         .enumerate()
         .map(|(i, (pixels, finished))| {
-            let first_row = i as u32 * TILE_SIZE;
             let rows = Rows {
-                first_row,
+                first_row: window.y0 + i as u32 * TILE_SIZE,
+                x0: window.x0,
+                width: resolution.x,
                 pixels,
                 finished,
             };
@@ -326,10 +365,13 @@ fn render_on_current_pool(
     }
 }
 
-/// One tile: whole rows of the film from `first_row`, row-major, with which of
-/// their pixels are finished.
+/// One tile: whole rows of the film from image row `first_row`, row-major,
+/// with which of their pixels are finished; the film's columns are the
+/// image's from `x0`, `width` of them.
 struct Rows<'a> {
     first_row: u32,
+    x0: u32,
+    width: u32,
     pixels: &'a mut [Vec3],
     finished: &'a mut [bool],
 }
@@ -347,6 +389,8 @@ fn render_rows(
 ) -> TileCounts {
     let Rows {
         first_row,
+        x0,
+        width,
         pixels,
         finished,
     } = rows;
@@ -355,20 +399,10 @@ fn render_rows(
         // Drop what other work on this thread counted: the tile's counts are its own.
         let _ = take_counters();
     }
-    let width = scene.camera.resolution().x;
     let mut pixel_samples = vec![Vec2::ZERO; settings.spp as usize];
     let mut ctx = SampleContext::new(settings.light_samples, settings.environment_samples);
     ctx.detailed = settings.stats;
-    // Each of spp samples stands for 1/√spp of the pixel's width (pbrt-v4 scales
-    // differentials the same way, never below 1/8).
-    let footprint_scale = (1.0 / (settings.spp as f32).sqrt()).max(0.125);
-    let differentials = scene.needs_differentials();
-    let first_hits_in_lanes = integrator.shades_first_hits_in_lanes(scene);
-    // The whole of a camera sample in lanes, from its ray to its radiance.
-    let all_in_lanes = first_hits_in_lanes
-        && settings.aov.is_none()
-        && !differentials
-        && scene.shapes.has_closest_lanes();
+    let pixels_of = PixelRenderer::new(scene, settings, integrator);
     for (offset, (radiance, finished)) in pixels.iter_mut().zip(finished).enumerate() {
         if *finished {
             continue;
@@ -376,13 +410,82 @@ fn render_rows(
         if stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
             break;
         }
-        let (x, y) = (offset as u32 % width, first_row + offset as u32 / width);
+        let (x, y) = (
+            x0 + offset as u32 % width,
+            first_row + offset as u32 / width,
+        );
+        *radiance = pixels_of.pixel(x, y, &mut pixel_samples, &mut ctx);
+        *finished = true;
+        rendered += 1;
+    }
+    TileCounts {
+        pixels: rendered,
+        shading: ctx.counters,
+        queries: if settings.stats {
+            take_counters()
+        } else {
+            QueryCounters::default()
+        },
+        textures: ctx.textures,
+    }
+}
+
+/// What every pixel of a render shares: the scene, the settings, and the
+/// paths their samples may take.
+pub(crate) struct PixelRenderer<'a> {
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+    integrator: &'a DirectIntegrator,
+    /// Each of spp samples stands for 1/√spp of the pixel's width (pbrt-v4
+    /// scales differentials the same way, never below 1/8).
+    footprint_scale: f32,
+    differentials: bool,
+    first_hits_in_lanes: bool,
+    /// The whole of a camera sample in lanes, from its ray to its radiance.
+    all_in_lanes: bool,
+}
+
+impl<'a> PixelRenderer<'a> {
+    pub(crate) fn new(
+        scene: &'a Scene,
+        settings: &'a RenderSettings,
+        integrator: &'a DirectIntegrator,
+    ) -> Self {
+        let differentials = scene.needs_differentials();
+        let first_hits_in_lanes = integrator.shades_first_hits_in_lanes(scene);
+        Self {
+            scene,
+            settings,
+            integrator,
+            footprint_scale: (1.0 / (settings.spp as f32).sqrt()).max(0.125),
+            differentials,
+            first_hits_in_lanes,
+            all_in_lanes: first_hits_in_lanes
+                && settings.aov.is_none()
+                && !differentials
+                && scene.shapes.has_closest_lanes(),
+        }
+    }
+
+    /// The radiance of pixel `(x, y)`: the mean of its finite camera samples.
+    /// It depends only on the scene, the settings and `(x, y)`. With a tracer
+    /// on (`T::ON`), every sample takes the scalar path and the tracer sees
+    /// each step; the lanes the render takes otherwise give the same bits.
+    pub(crate) fn pixel<T: Tracer>(
+        &self,
+        x: u32,
+        y: u32,
+        pixel_samples: &mut [Vec2],
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
+        let (scene, settings, integrator) = (self.scene, self.settings, self.integrator);
+        let width = scene.camera.resolution().x;
         let pixel = y as u64 * width as u64 + x as u64;
         let mut rng = pixel_rng(settings.seed, pixel, PIXEL_STREAM);
         let sobol = SobolPoints::pixel_positions(settings.seed, pixel);
-        settings
-            .pixel_pattern
-            .fill(&mut rng, sobol, &mut pixel_samples);
+        settings.pixel_pattern.fill(&mut rng, sobol, pixel_samples);
+        let all_in_lanes = self.all_in_lanes && !T::ON;
+        let first_hits_in_lanes = self.first_hits_in_lanes && !T::ON;
         let mut sum = Vec3::ZERO;
         let candidates = if all_in_lanes {
             objects_seen_by_pixel(scene, x, y)
@@ -416,15 +519,14 @@ fn render_rows(
                 };
                 let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
                 let closest = closest.expect("has_closest_lanes");
-                let values =
-                    integrator.li_first_hits(scene, &rays, &closest, used, first, &mut ctx);
-                accumulate(&mut sum, &values, used, &mut ctx);
+                let values = integrator.li_first_hits(scene, &rays, &closest, used, first, ctx);
+                accumulate(&mut sum, &values, used, ctx);
                 continue;
             }
             let rays: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
                 let raster = Vec2::new(x as f32, y as f32) + jitters[k.min(jitters.len() - 1)];
-                if differentials {
-                    camera_ray(&scene.camera, raster, footprint_scale)
+                if self.differentials {
+                    camera_ray(&scene.camera, raster, self.footprint_scale)
                 } else {
                     let c = scene.camera.generate_ray(raster.x, raster.y);
                     let ray = Ray::new(c.origin, c.direction);
@@ -434,46 +536,70 @@ fn render_rows(
             // Several camera rays at once: their closest hits one shape against
             // all of them, where the scene's layout allows it (the same hits).
             let ray_lanes = RayLanes::new(rays.map(|(ray, _)| ray));
-            let closest = (settings.aov.is_none() && used > 1)
+            let closest = (settings.aov.is_none() && used > 1 && !T::ON)
                 .then(|| scene.shapes.closest_lanes(&ray_lanes, used))
                 .flatten();
             let values = match &closest {
                 // One sample per light: the chunk's samples shaded together.
                 Some(closest) if first_hits_in_lanes => {
-                    integrator.li_first_hits(scene, &ray_lanes, closest, used, first, &mut ctx)
+                    integrator.li_first_hits(scene, &ray_lanes, closest, used, first, ctx)
                 }
                 _ => Vec3Lanes::from_lanes(std::array::from_fn(|k| {
                     let Some((ray, diff)) = rays.get(k).filter(|_| k < used) else {
                         return Vec3::ZERO;
                     };
-                    ctx.begin_sample(settings.seed, pixel, (chunk * LANES + k) as u64);
-                    match (settings.aov, &closest) {
+                    let sample = (chunk * LANES + k) as u64;
+                    ctx.begin_sample(settings.seed, pixel, sample);
+                    ctx.tracer.start_sample(sample);
+                    ctx.tracer
+                        .record(|| self.camera_event(jitters[k], x, y, ray, diff));
+                    let value = match (settings.aov, &closest) {
                         (None, Some(closest)) => {
                             let hit = closest
                                 .hit(k)
                                 .and_then(|found| scene.shapes.surface_record(ray, found));
-                            integrator.li_at(scene, ray, diff, hit, 0, &mut ctx)
+                            integrator.li_at(scene, ray, diff, hit, 0, ctx)
                         }
-                        (None, None) => integrator.li(scene, ray, diff, 0, &mut ctx),
+                        (None, None) => integrator.li(scene, ray, diff, 0, ctx),
                         (Some(aov), _) => aov.evaluate(scene, ray, diff, settings.max_depth),
-                    }
+                    };
+                    ctx.tracer.record(|| Event::SampleRadiance { value });
+                    value
                 })),
             };
-            accumulate(&mut sum, &values, used, &mut ctx);
+            accumulate(&mut sum, &values, used, ctx);
         }
-        *radiance = sum / settings.spp as f32;
-        *finished = true;
-        rendered += 1;
+        sum / settings.spp as f32
     }
-    TileCounts {
-        pixels: rendered,
-        shading: ctx.counters,
-        queries: if settings.stats {
-            take_counters()
-        } else {
-            QueryCounters::default()
-        },
-        textures: ctx.textures,
+
+    /// The camera stage of a sample at `jitter` in pixel `(x, y)`.
+    fn camera_event(
+        &self,
+        jitter: Vec2,
+        x: u32,
+        y: u32,
+        ray: &Ray,
+        diff: &RayDifferential,
+    ) -> Event {
+        let raster = Vec2::new(x as f32, y as f32) + jitter;
+        let (ndc, film_point) = self.scene.camera.film_point(raster.x, raster.y);
+        Event::Camera {
+            raster,
+            ndc,
+            film_point,
+            ray: *ray,
+            differential: self.differentials.then_some(*diff),
+        }
+    }
+}
+
+/// The whole image of `size` as a window.
+fn full_image(size: UVec2) -> Crop {
+    Crop {
+        x0: 0,
+        y0: 0,
+        x1: size.x,
+        y1: size.y,
     }
 }
 
@@ -498,7 +624,12 @@ fn objects_seen_by_pixel(scene: &Scene, x: u32, y: u32) -> u64 {
 /// Adds the first `used` of a chunk's radiance `values` to `sum`, leaving out
 /// (and counting) those that are NaN or infinite.
 #[inline]
-fn accumulate(sum: &mut Vec3, values: &Vec3Lanes, used: usize, ctx: &mut SampleContext) {
+fn accumulate<T: Tracer>(
+    sum: &mut Vec3,
+    values: &Vec3Lanes,
+    used: usize,
+    ctx: &mut SampleContext<T>,
+) {
     let finite = lanes::bits(values.x.is_finite() & values.y.is_finite() & values.z.is_finite());
     let (x, y, z) = (
         values.x.to_array(),

@@ -486,10 +486,12 @@ fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> {
                 ),
             },
             SettingsError::Depth(_) => ("render.max_depth", render.max_depth.span()),
-            // The file sets no thread count or partial render, so these cannot come from it.
+            // The file sets no thread count, partial render or crop, so these
+            // cannot come from it.
             SettingsError::Threads(_)
             | SettingsError::ThreadPool(_)
-            | SettingsError::ResumeResolution { .. } => ("render", 0..0),
+            | SettingsError::ResumeResolution { .. }
+            | SettingsError::Crop { .. } => ("render", 0..0),
         };
         Problem::new(span, field, e.to_string())
     })?;

@@ -160,7 +160,7 @@ impl ImageTexture {
 
 /// `(st, ∂st/∂x, ∂st/∂y)` from uv: t = 1 − v flips the v derivatives.
 #[inline]
-fn to_st(tc: &TexCoord) -> (Vec2, Vec2, Vec2) {
+pub(crate) fn to_st(tc: &TexCoord) -> (Vec2, Vec2, Vec2) {
     let flip = |d: Vec2| Vec2::new(d.x, -d.y);
     (
         Vec2::new(tc.uv.x, 1.0 - tc.uv.y),

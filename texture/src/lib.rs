@@ -30,6 +30,7 @@ mod environment;
 mod image;
 mod image_texture;
 mod io;
+mod lookup;
 mod mipmap;
 mod texcoord;
 
@@ -41,6 +42,7 @@ pub use environment::{
 };
 pub use image_texture::{ImageTexture, TextureFilter, TextureImage};
 pub use io::{load_image, srgb_to_linear, ImageLoadError, MAX_IMAGE_SIDE, MAX_IMAGE_TEXELS};
+pub use lookup::{LookupExplained, TexelRead};
 pub use mipmap::MipMap;
 pub use texcoord::TexCoord;
 

@@ -13,11 +13,13 @@
 mod acceleration;
 mod any_hit;
 mod closest;
+mod explain;
 mod frustum;
 mod linear;
 mod occluders;
 
 pub use closest::{ClosestLanes, PrimitiveHit};
+pub use explain::{ClosestExplained, ObjectTest};
 pub use occluders::Occluders;
 
 use crate::bvh::Bvh;

@@ -1,0 +1,198 @@
+//! `glint explain` and `glint render --crop` as a user runs them: the four
+//! pixels of the issue as text snapshots (every stage's numbers, rounded to 5
+//! significant digits), the JSON document and its stages, the explained
+//! radiance against the rendered pixel, and bad input.
+
+mod common;
+use common::{assert_input_error, glint, scene, stdout};
+
+use glint_camera::Film;
+use serde_json::Value;
+use std::path::Path;
+
+fn explain(args: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let out = glint(&[&["explain"], args].concat(), dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Nothing is written: explain only prints.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    stdout(&out)
+}
+
+#[test]
+fn set1_checkered_sphere_partly_facing_away_from_the_light() {
+    // Two of the four light samples are below the sphere's horizon here.
+    let s = scene("cornell-set1");
+    insta::assert_snapshot!(explain(&[&s, "--pixel", "400,192", "--light-samples", "4"]));
+}
+
+#[test]
+fn set1_floor_in_the_penumbra_of_a_sphere() {
+    let s = scene("cornell-set1");
+    let text = explain(&[
+        &s,
+        "--pixel",
+        "376,448",
+        "--light-samples",
+        "4",
+        "--stage",
+        "light",
+    ]);
+    assert!(text.contains("blocked by object 0"), "{text}");
+    insta::assert_snapshot!(text);
+}
+
+#[test]
+fn textured_ground_with_its_mip_levels_and_texels() {
+    let s = scene("ground-mipmap");
+    insta::assert_snapshot!(explain(&[&s, "--pixel", "80,200"]));
+}
+
+#[test]
+fn mirror_sphere_in_the_environment_scene() {
+    let s = scene("environment");
+    insta::assert_snapshot!(explain(&[
+        &s,
+        "--pixel",
+        "240,135",
+        "--environment-samples",
+        "4",
+    ]));
+}
+
+#[test]
+fn bunny_through_the_bvh() {
+    let s = scene("bunny");
+    let text = explain(&[&s, "--pixel", "240,180", "--light-samples", "4"]);
+    assert!(text.contains("(mesh)"), "{text}");
+    insta::assert_snapshot!(text);
+}
+
+/// The pixel `(x, y)` of the PFM `glint render` writes with `args`.
+fn rendered_pixel(args: &[&str], x: u32, y: u32) -> [f32; 3] {
+    let dir = tempfile::tempdir().unwrap();
+    let out = glint(
+        &[&["render"], args, &["-o", "out.pfm"]].concat(),
+        dir.path(),
+    );
+    assert!(out.status.success());
+    let film = Film::load(&dir.path().join("out.pfm")).unwrap();
+    film.pixel(x, y).to_array()
+}
+
+fn json(args: &[&str]) -> Value {
+    serde_json::from_str(&explain(&[args, &["--json"]].concat())).unwrap()
+}
+
+#[test]
+fn the_json_document_holds_the_rendered_pixel_and_every_stage() {
+    let s = scene("cornell-set1");
+    let flags = [
+        s.as_str(),
+        "--resolution",
+        "48x48",
+        "--spp",
+        "4",
+        "--light-samples",
+        "4",
+    ];
+    let doc = json(&[&flags[..], &["--pixel", "30,20", "--all-samples"]].concat());
+    assert_eq!(doc["schema"], "glint-explain/1");
+    assert_eq!(doc["samples"].as_array().unwrap().len(), 4);
+    let rendered = rendered_pixel(&flags, 30, 20);
+    for (k, c) in rendered.iter().enumerate() {
+        let explained = doc["film"]["radiance"][k].as_f64().unwrap();
+        assert!(
+            (explained - *c as f64).abs() <= 1e-4 * (*c as f64).abs(),
+            "channel {k}: explained {explained}, rendered {c}"
+        );
+    }
+    let sample = &doc["samples"][0];
+    for key in ["camera", "ray", "radiance"] {
+        assert!(!sample[key].is_null(), "{key} missing");
+    }
+    for key in ["intersect", "texture", "light", "radiance"] {
+        assert!(!sample["ray"][key].is_null(), "ray.{key} missing");
+    }
+    // One stage only.
+    let camera = json(&[&flags[..], &["--pixel", "30,20", "--stage", "camera"]].concat());
+    let only = camera["samples"][0].as_object().unwrap();
+    assert_eq!(only.keys().collect::<Vec<_>>(), ["camera", "sample"]);
+    assert!(camera["film"].is_null());
+    let film = json(&[&flags[..], &["--pixel", "30,20", "--stage", "film"]].concat());
+    assert!(!film["film"]["srgb8"].is_null());
+    assert!(film["samples"][0].get("camera").is_none());
+}
+
+#[test]
+fn bad_pixels_and_samples_are_refused() {
+    let s = scene("cornell-set1");
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str]| glint(&[&["explain", s.as_str()], args].concat(), dir.path());
+    assert_input_error(&run(&["--pixel", "512,0"]), "outside the 512x512 image");
+    assert_input_error(&run(&["--pixel", "3"]), "expected X,Y");
+    assert_input_error(&run(&["--pixel=-1,4"]), "not a whole number");
+    assert_input_error(&run(&["--pixel", "1,1", "--sample", "16"]), "16 samples");
+    assert_input_error(
+        &run(&["--pixel", "1,1", "--sample", "1", "--all-samples"]),
+        "--all-samples",
+    );
+    assert_input_error(&run(&["--pixel", "1,1", "--stage", "shading"]), "--stage");
+    assert_input_error(&run(&[]), "--pixel");
+}
+
+#[test]
+fn a_crop_is_the_same_pixels_as_the_whole_render() {
+    let s = scene("environment");
+    let dir = tempfile::tempdir().unwrap();
+    let flags = [
+        s.as_str(),
+        "--resolution",
+        "40x30",
+        "--spp",
+        "4",
+        "--environment-samples",
+        "4",
+    ];
+    let render = |extra: &[&str], out: &str| {
+        let o = glint(
+            &[&["render"], &flags[..], extra, &["-o", out]].concat(),
+            dir.path(),
+        );
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        Film::load(&dir.path().join(out)).unwrap()
+    };
+    let whole = render(&[], "whole.pfm");
+    let part = render(&["--crop", "7,5,31,22"], "part.pfm");
+    assert_eq!((part.resolution().x, part.resolution().y), (24, 17));
+    for y in 0..17 {
+        for x in 0..24 {
+            assert_eq!(
+                part.pixel(x, y).to_array().map(f32::to_bits),
+                whole.pixel(7 + x, 5 + y).to_array().map(f32::to_bits),
+                "({x}, {y})"
+            );
+        }
+    }
+    let out = Path::new("bad.png");
+    let o = glint(
+        &[
+            &["render"],
+            &flags[..],
+            &["--crop", "0,0,41,30", "-o", "bad.png"],
+        ]
+        .concat(),
+        dir.path(),
+    );
+    assert_input_error(&o, "--crop");
+    assert!(!dir.path().join(out).exists());
+    let o = glint(
+        &[&["render"], &flags[..], &["--crop", "5,5,5,9"]].concat(),
+        dir.path(),
+    );
+    assert_input_error(&o, "empty");
+}

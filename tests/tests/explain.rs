@@ -1,0 +1,182 @@
+//! `glint explain`'s guarantees over the shipped scenes: an explained pixel
+//! is the rendered pixel, bit for bit, whatever path the render took (SIMD
+//! lanes or scalar); the recorded steps add up to it; a crop renders the same
+//! pixels as the whole image.
+
+use glam::{UVec2, Vec3};
+use glint_integrator::trace::{Event, SampleSelection};
+use glint_integrator::{
+    explain_pixel, render, render_with, Crop, ExplainError, RenderControl, RenderSettings, Scene,
+};
+use glint_scene::load;
+use glint_tests::scene_path;
+
+/// A shipped scene at `size`, with its settings changed by `tweak`.
+fn scene(
+    name: &str,
+    size: UVec2,
+    tweak: impl FnOnce(&mut RenderSettings),
+) -> (Scene, RenderSettings) {
+    let d = load(&scene_path(name)).unwrap();
+    let camera = d.scene.camera.with_resolution(size).unwrap();
+    let mut settings = d.settings.clone();
+    tweak(&mut settings);
+    (Scene { camera, ..d.scene }, settings)
+}
+
+fn bits(v: Vec3) -> [u32; 3] {
+    v.to_array().map(f32::to_bits)
+}
+
+/// Each case takes another of the render loop's paths: whole samples in
+/// lanes (one light sample), first hits in lanes with light samples in lanes,
+/// the scalar path with footprints, mirrors and environment samples, the BVH,
+/// and physical shading with MIS.
+fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
+    let size = UVec2::new(24, 18);
+    let few = |s: &mut RenderSettings| {
+        s.spp = 4;
+        s.light_samples = s.light_samples.min(4);
+        s.environment_samples = s.environment_samples.min(4);
+    };
+    vec![
+        ("cornell-set1, 1 light sample", {
+            let (a, b) = scene("cornell-set1", size, |s| {
+                few(s);
+                s.light_samples = 1;
+            });
+            (a, b)
+        }),
+        (
+            "cornell-set1, 4 light samples",
+            scene("cornell-set1", size, few),
+        ),
+        ("cornell-set3", scene("cornell-set3", size, few)),
+        ("environment", scene("environment", size, few)),
+        ("ground-mipmap", scene("ground-mipmap", size, few)),
+        ("bunny-cornell", scene("bunny-cornell", size, few)),
+        ("physical-glossy", scene("physical-glossy", size, few)),
+    ]
+    .into_iter()
+    .map(|(name, (scene, settings))| (name, scene, settings))
+    .collect()
+}
+
+#[test]
+fn explained_pixels_are_the_rendered_pixels_bit_for_bit() {
+    for (name, scene, settings) in cases() {
+        let film = render(&scene, &settings, &|_, _| {}).unwrap().film;
+        let size = scene.camera.resolution();
+        for y in (0..size.y).step_by(3) {
+            for x in (0..size.x).step_by(2) {
+                let explained =
+                    explain_pixel(&scene, &settings, x, y, SampleSelection::One(0)).unwrap();
+                assert_eq!(
+                    bits(explained.radiance),
+                    bits(film.pixel(x, y)),
+                    "{name}: pixel ({x}, {y}): explained {} rendered {}",
+                    explained.radiance,
+                    film.pixel(x, y)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_recorded_samples_make_the_pixel_and_the_light_samples_their_lights() {
+    for (name, scene, settings) in cases() {
+        let explained = explain_pixel(&scene, &settings, 12, 12, SampleSelection::All).unwrap();
+        assert_eq!(explained.samples.len(), settings.spp as usize, "{name}");
+        let mut sum = Vec3::ZERO;
+        for sample in &explained.samples {
+            let mut samples = Vec::new();
+            for event in &sample.events {
+                match event {
+                    Event::SampleRadiance { value } => sum += *value,
+                    Event::Light { .. } => samples.clear(),
+                    Event::LightSample { value, .. } => samples.push(*value),
+                    Event::LightTotal { light, value } if !samples.is_empty() => {
+                        // The course's model: the light's color times the mean.
+                        let color = match &scene.lights[*light] {
+                            glint_lighting::Light::Area(a) => a.color,
+                            glint_lighting::Light::Point(p) => p.color,
+                            glint_lighting::Light::Sphere(s) => s.color,
+                        };
+                        let mean = samples.iter().sum::<Vec3>() / samples.len() as f32;
+                        let want = color * mean;
+                        assert!(
+                            (want - *value).abs().max_element()
+                                <= 1e-5 * want.max_element().max(1.0),
+                            "{name}: light {light}: samples give {want}, total {value}"
+                        );
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let mean = sum / settings.spp as f32;
+        assert!(
+            (mean - explained.radiance).abs().max_element()
+                <= 1e-5 * explained.radiance.max_element().max(1.0),
+            "{name}: samples' mean {mean}, pixel {}",
+            explained.radiance
+        );
+    }
+}
+
+#[test]
+fn a_crop_renders_the_same_pixels_as_the_whole_image() {
+    for (name, scene, settings) in cases().into_iter().take(4) {
+        let whole = render(&scene, &settings, &|_, _| {}).unwrap().film;
+        let crop = Crop {
+            x0: 5,
+            y0: 3,
+            x1: 19,
+            y1: 17,
+        };
+        let control = RenderControl {
+            crop: Some(crop),
+            ..RenderControl::default()
+        };
+        let part = render_with(&scene, &settings, &|_, _| {}, control).unwrap();
+        assert_eq!(part.film.resolution(), UVec2::new(14, 14));
+        for y in 0..14 {
+            for x in 0..14 {
+                assert_eq!(
+                    bits(part.film.pixel(x, y)),
+                    bits(whole.pixel(crop.x0 + x, crop.y0 + y)),
+                    "{name}: ({x}, {y}) of the crop"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn pixels_and_samples_outside_the_render_are_refused() {
+    let (scene, settings) = scene("cornell-set1", UVec2::new(8, 6), |s| s.spp = 4);
+    assert!(matches!(
+        explain_pixel(&scene, &settings, 8, 0, SampleSelection::One(0)),
+        Err(ExplainError::Outside { .. })
+    ));
+    assert!(matches!(
+        explain_pixel(&scene, &settings, 0, 6, SampleSelection::One(0)),
+        Err(ExplainError::Outside { .. })
+    ));
+    assert!(matches!(
+        explain_pixel(&scene, &settings, 0, 0, SampleSelection::One(4)),
+        Err(ExplainError::NoSuchSample { sample: 4, spp: 4 })
+    ));
+    let outside = Crop {
+        x0: 0,
+        y0: 0,
+        x1: 9,
+        y1: 6,
+    };
+    let control = RenderControl {
+        crop: Some(outside),
+        ..RenderControl::default()
+    };
+    assert!(render_with(&scene, &settings, &|_, _| {}, control).is_err());
+}

@@ -1,0 +1,210 @@
+//! What a texture lookup read, for `glint explain`: the footprint, the MIP
+//! level the course report would choose and the one Glint's filter chooses,
+//! the levels and texels read with their weights, and the filtered value.
+
+use crate::image::reduce_st;
+use crate::image_texture::{to_st, ImageTexture, TextureFilter};
+use crate::{TexCoord, Texture};
+use glam::{Vec2, Vec3};
+
+/// One texel a lookup read, with its weight in the result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TexelRead {
+    /// Pyramid level (0: the image itself).
+    pub level: usize,
+    /// Texel coordinates before wrapping (a lookup near an edge reads past it).
+    pub x: i64,
+    pub y: i64,
+    pub weight: f32,
+    pub value: Vec3,
+}
+
+/// A texture lookup explained ([`Texture::explain`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LookupExplained {
+    /// `constant`, `checkerboard`, `checkerboard (box-filtered)`, or the image
+    /// filter's name.
+    pub kind: String,
+    /// Texture coordinates `st = (u, 1 − v)` and their derivatives per pixel
+    /// (images only).
+    pub st: Option<Vec2>,
+    pub dst_dx: Option<Vec2>,
+    pub dst_dy: Option<Vec2>,
+    /// The report's level (section 2.8), `log2(L/W)`: the footprint's longer
+    /// axis `L` over a texel's width `W = 1/m` (`m` the image's larger side).
+    pub report_level: Option<f32>,
+    /// The level Glint's filter reads ([`ImageTexture::mip_level`]): trilinear
+    /// from half the longer axis (never below the shorter one), EWA from the
+    /// (clamped) minor axis.
+    pub glint_level: Option<f32>,
+    /// The texels read and their weights, for nearest, bilinear and trilinear
+    /// lookups (EWA's ellipse reads too many to list).
+    pub texels: Vec<TexelRead>,
+    /// For an analytic checkerboard, the fraction of the footprint on the
+    /// second color.
+    pub second_color_fraction: Option<f32>,
+    /// The filtered value: [`Texture::evaluate`]'s.
+    pub value: Vec3,
+}
+
+impl Texture {
+    /// [`Texture::evaluate`] at `tc`, with what it read.
+    pub fn explain(&self, tc: &TexCoord) -> LookupExplained {
+        let value = self.evaluate(tc);
+        let mut out = LookupExplained {
+            kind: String::new(),
+            st: None,
+            dst_dx: None,
+            dst_dy: None,
+            report_level: None,
+            glint_level: None,
+            texels: Vec::new(),
+            second_color_fraction: None,
+            value,
+        };
+        match self {
+            Texture::Constant(_) => out.kind = "constant".into(),
+            Texture::Checkerboard(c) => {
+                out.kind = if c.analytic {
+                    "checkerboard (box-filtered over the footprint)".into()
+                } else {
+                    "checkerboard".into()
+                };
+                // value = lerp(colors[0], colors[1], fraction): recover the
+                // fraction from the channel where the colors differ most.
+                let d = c.colors[1] - c.colors[0];
+                let axis = d.abs().max_position();
+                if d[axis] != 0.0 {
+                    out.second_color_fraction = Some((value[axis] - c.colors[0][axis]) / d[axis]);
+                }
+            }
+            Texture::Image(t) => explain_image(t, tc, &mut out),
+        }
+        out
+    }
+}
+
+fn explain_image(t: &ImageTexture, tc: &TexCoord, out: &mut LookupExplained) {
+    let (st, dst0, dst1) = to_st(tc);
+    out.kind = t.filter.name().to_owned();
+    out.st = Some(st);
+    out.dst_dx = Some(dst0);
+    out.dst_dy = Some(dst1);
+    let image = t.image.image();
+    let side = image.width().max(image.height()) as f32;
+    out.report_level = Some((dst0.length().max(dst1.length()) * side).log2());
+    out.glint_level = Some(t.mip_level(tc));
+    let reduced = reduce_st(st, t.wrap);
+    let mut bilinear = |level: usize, weight: f32| {
+        let image = match level {
+            0 => image,
+            _ => &t.image.pyramid().levels()[level],
+        };
+        let p = reduced * image.size() - 0.5;
+        let p0 = p.floor();
+        let f = p - p0;
+        for (dx, dy, w) in [
+            (0, 0, (1.0 - f.x) * (1.0 - f.y)),
+            (1, 0, f.x * (1.0 - f.y)),
+            (0, 1, (1.0 - f.x) * f.y),
+            (1, 1, f.x * f.y),
+        ] {
+            let (x, y) = (p0.x as i64 + dx, p0.y as i64 + dy);
+            out.texels.push(TexelRead {
+                level,
+                x,
+                y,
+                weight: weight * w,
+                value: image.texel_wrapped(x, y, t.wrap),
+            });
+        }
+    };
+    match t.filter {
+        TextureFilter::Nearest => {
+            let p = (reduced * image.size()).floor();
+            let (x, y) = (p.x as i64, p.y as i64);
+            out.texels.push(TexelRead {
+                level: 0,
+                x,
+                y,
+                weight: 1.0,
+                value: image.texel_wrapped(x, y, t.wrap),
+            });
+        }
+        TextureFilter::Bilinear => bilinear(0, 1.0),
+        TextureFilter::Trilinear => {
+            let level = out.glint_level.unwrap_or(0.0);
+            let last = t.image.pyramid().levels().len() - 1;
+            let lower = (level as usize).min(last);
+            let frac = level - lower as f32;
+            bilinear(lower, 1.0 - frac);
+            if frac > 0.0 {
+                bilinear((lower + 1).min(last), frac);
+            }
+        }
+        TextureFilter::Ewa => {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Checkerboard, Image, TextureImage, WrapMode};
+
+    #[test]
+    fn the_weighted_texels_make_the_filtered_value() {
+        let image = TextureImage::new(Image::from_fn(16, 8, |x, y| {
+            Vec3::new(x as f32, y as f32, ((x * 7 + y * 3) % 5) as f32)
+        }));
+        let tc = TexCoord {
+            uv: Vec2::new(0.37, 0.81),
+            duvdx: Vec2::new(0.09, 0.01),
+            duvdy: Vec2::new(-0.02, 0.05),
+        };
+        for filter in [
+            TextureFilter::Nearest,
+            TextureFilter::Bilinear,
+            TextureFilter::Trilinear,
+        ] {
+            let texture =
+                Texture::Image(ImageTexture::new(image.clone(), WrapMode::Repeat, filter));
+            let explained = texture.explain(&tc);
+            let sum = explained
+                .texels
+                .iter()
+                .fold(Vec3::ZERO, |acc, t| acc + t.weight * t.value);
+            assert!(
+                (sum - explained.value).abs().max_element() < 1e-4,
+                "{filter:?}: {sum} against {}",
+                explained.value
+            );
+            let weights: f32 = explained.texels.iter().map(|t| t.weight).sum();
+            assert!((weights - 1.0).abs() < 1e-5);
+        }
+        // The report's level is the longer axis in texels, log2(0.0906 · 16).
+        let t = Texture::Image(ImageTexture::new(
+            image,
+            WrapMode::Repeat,
+            TextureFilter::Trilinear,
+        ));
+        let level = t.explain(&tc).report_level.unwrap();
+        assert!((level - (Vec2::new(0.09, -0.01).length() * 16.0).log2()).abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_box_filtered_checkerboard_reports_its_blend() {
+        let c = Checkerboard {
+            colors: [Vec3::ZERO, Vec3::ONE],
+            checks: 4,
+            analytic: true,
+        };
+        let tc = TexCoord {
+            uv: Vec2::new(0.25, 0.1),
+            duvdx: Vec2::new(0.1, 0.0),
+            duvdy: Vec2::new(0.0, 0.01),
+        };
+        let explained = Texture::Checkerboard(c).explain(&tc);
+        let fraction = explained.second_color_fraction.unwrap();
+        assert!((fraction - 0.5).abs() < 1e-5, "{fraction}");
+    }
+}

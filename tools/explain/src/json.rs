@@ -1,0 +1,106 @@
+//! Numbers as the document holds them (5 significant digits), and the
+//! document cut down to one stage.
+
+use crate::Stage;
+use glam::{Vec2, Vec3};
+use glint_texture::LookupExplained;
+use serde_json::{json, Value};
+
+/// `x` rounded to 5 significant digits; `null` if not finite.
+pub(crate) fn num(x: f32) -> Value {
+    if !x.is_finite() {
+        return Value::Null;
+    }
+    if x == 0.0 {
+        return json!(0.0);
+    }
+    let rounded: f64 = format!("{:.4e}", x as f64).parse().expect("a float");
+    json!(rounded)
+}
+
+pub(crate) fn v2(v: Vec2) -> Value {
+    Value::Array(vec![num(v.x), num(v.y)])
+}
+
+pub(crate) fn v3(v: Vec3) -> Value {
+    Value::Array(vec![num(v.x), num(v.y), num(v.z)])
+}
+
+/// What a texture lookup read.
+pub(crate) fn lookup(l: &LookupExplained) -> Value {
+    let mut out = json!({ "kind": l.kind, "value": v3(l.value) });
+    if let (Some(st), Some(dx), Some(dy)) = (l.st, l.dst_dx, l.dst_dy) {
+        out["st"] = v2(st);
+        out["dst_dx"] = v2(dx);
+        out["dst_dy"] = v2(dy);
+    }
+    if let Some(level) = l.report_level {
+        out["report_level"] = num(level);
+    }
+    if let Some(level) = l.glint_level {
+        out["glint_level"] = num(level);
+    }
+    if !l.texels.is_empty() {
+        out["texels"] = l
+            .texels
+            .iter()
+            .map(|t| {
+                json!({"level": t.level, "x": t.x, "y": t.y, "weight": num(t.weight), "value": v3(t.value)})
+            })
+            .collect();
+    }
+    if let Some(f) = l.second_color_fraction {
+        out["second_color_fraction"] = num(f);
+    }
+    out
+}
+
+/// The document with only `stage`'s parts of each sample (and the header).
+pub(crate) fn only_stage(document: &Value, stage: Stage) -> Value {
+    let mut out = document.clone();
+    let ray_keys: &[&str] = match stage {
+        Stage::Intersect => &["depth", "intersect"],
+        Stage::Texture => &["depth", "texture"],
+        Stage::Light => &[
+            "depth",
+            "shading",
+            "light",
+            "environment",
+            "emitter",
+            "mirror",
+            "radiance",
+        ],
+        Stage::Camera | Stage::Film => &[],
+    };
+    if let Some(samples) = out["samples"].as_array_mut() {
+        for sample in samples {
+            let Some(map) = sample.as_object_mut() else {
+                continue;
+            };
+            map.retain(|k, _| {
+                k == "sample"
+                    || (k == "camera" && stage == Stage::Camera)
+                    || (k == "ray" && !ray_keys.is_empty())
+            });
+            if let Some(ray) = map.get_mut("ray") {
+                keep_ray_keys(ray, ray_keys);
+            }
+        }
+    }
+    if stage != Stage::Film {
+        if let Some(map) = out.as_object_mut() {
+            map.remove("film");
+        }
+    }
+    out
+}
+
+/// Keeps `keys` (and the nested reflections) of a ray and its reflections.
+fn keep_ray_keys(ray: &mut Value, keys: &[&str]) {
+    if let Some(map) = ray.as_object_mut() {
+        map.retain(|k, _| k == "reflection" || keys.contains(&k.as_str()));
+        if let Some(reflection) = map.get_mut("reflection") {
+            keep_ray_keys(reflection, keys);
+        }
+    }
+}

@@ -1,0 +1,486 @@
+//! `glint explain`: every stage's numbers for one pixel of a render, so that
+//! a student can find the first stage where their ray tracer parts from
+//! Glint, and a grader can check one stage of a submission.
+//!
+//! [`explain`] renders the pixel through the integrator's own code with a
+//! tracer ([`glint_integrator::explain_pixel`]: the radiance is the render's,
+//! bit for bit) and adds what the trace does not carry: each object's test
+//! against each ray and the BVH's work
+//! ([`glint_geometry::ShapeList::explain_closest`]), and what each texture
+//! lookup read ([`glint_texture::Texture::explain`]). The result is a JSON
+//! document (schema `glint-explain/1`, documented in
+//! `docs/checking-your-ray-tracer.md`) and its text form.
+//!
+//! # Conventions
+//! - World space, right-handed, y up; angles in radians; radiance linear RGB.
+//! - Every number is rounded to 5 significant digits, as the snapshot tests
+//!   round them; non-finite numbers are `null` in JSON.
+//! - Raster positions are in pixels from the image's top left corner; normalised
+//!   device coordinates run from −1 to 1 with y up.
+
+mod json;
+mod text;
+
+use glam::Vec3;
+use glint_integrator::trace::{Event, SampleSelection, Shadow, Skip, Technique};
+use glint_integrator::{explain_pixel, ExplainError, RenderSettings, Scene, SurfaceKind};
+use glint_lighting::Light;
+use json::{num, v2, v3};
+use serde_json::{json, Map, Value};
+
+/// A stage of the pipeline, to limit the output to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    Camera,
+    Intersect,
+    Texture,
+    Light,
+    Film,
+}
+
+impl Stage {
+    pub const NAMES: [&'static str; 5] = ["camera", "intersect", "texture", "light", "film"];
+
+    pub fn from_name(name: &str) -> Option<Stage> {
+        Some(match name {
+            "camera" => Stage::Camera,
+            "intersect" => Stage::Intersect,
+            "texture" => Stage::Texture,
+            "light" => Stage::Light,
+            "film" => Stage::Film,
+            _ => return None,
+        })
+    }
+}
+
+/// A pixel explained: the JSON document, from which the text is printed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Explanation {
+    pub document: Value,
+    /// The pixel's radiance as the render writes it (unrounded).
+    pub radiance: Vec3,
+}
+
+impl Explanation {
+    /// The document, limited to `stage` if given.
+    pub fn json(&self, stage: Option<Stage>) -> Value {
+        match stage {
+            None => self.document.clone(),
+            Some(stage) => json::only_stage(&self.document, stage),
+        }
+    }
+
+    /// The text form, limited to `stage` if given.
+    pub fn text(&self, stage: Option<Stage>) -> String {
+        text::render(&self.json(stage))
+    }
+}
+
+/// Pixel `(x, y)` of `scene` under `settings`, the samples `selection` names.
+pub fn explain(
+    scene: &Scene,
+    settings: &RenderSettings,
+    x: u32,
+    y: u32,
+    selection: SampleSelection,
+) -> Result<Explanation, ExplainError> {
+    let explained = explain_pixel(scene, settings, x, y, selection)?;
+    let samples: Vec<Value> = explained
+        .samples
+        .iter()
+        .map(|s| sample_document(scene, s.sample, &s.events))
+        .collect();
+    let r = explained.radiance;
+    let srgb: Vec<u8> = r
+        .to_array()
+        .iter()
+        .map(|&c| glint_camera::linear_to_srgb8(c))
+        .collect();
+    let document = json!({
+        "schema": "glint-explain/1",
+        "pixel": [x, y],
+        "resolution": [scene.camera.resolution().x, scene.camera.resolution().y],
+        "spp": explained.spp,
+        "seed": settings.seed,
+        "samples": samples,
+        "film": {
+            "radiance": v3(r),
+            "samples_averaged": explained.spp,
+            "srgb8": srgb,
+        },
+    });
+    Ok(Explanation {
+        document,
+        radiance: r,
+    })
+}
+
+/// One camera sample's document: its camera stage, its ray (each mirror
+/// reflection nested in the ray it leaves from, as `reflection`) and its
+/// radiance.
+fn sample_document(scene: &Scene, sample: u64, events: &[Event]) -> Value {
+    let mut camera = Value::Null;
+    // The rays being followed, one per depth; a finished ray is moved into
+    // its parent.
+    let mut stack: Vec<Map<String, Value>> = Vec::new();
+    let mut root = Value::Null;
+    let mut radiance = Value::Null;
+    let mut running = Running::default();
+    let close_to = |stack: &mut Vec<Map<String, Value>>, root: &mut Value, depth: usize| {
+        while stack.len() > depth {
+            let ray = Value::Object(stack.pop().expect("non-empty"));
+            match stack.last_mut() {
+                Some(parent) => {
+                    parent.insert("reflection".into(), ray);
+                }
+                None => *root = ray,
+            }
+        }
+    };
+    for event in events {
+        match event {
+            Event::Camera {
+                raster,
+                ndc,
+                film_point,
+                ray,
+                differential,
+            } => {
+                camera = json!({
+                    "raster": v2(*raster),
+                    "ndc": v2(*ndc),
+                    "film_point": v3(*film_point),
+                    "origin": v3(ray.origin),
+                    "direction": v3(ray.direction),
+                    "differentials": differential.map(|d| json!({
+                        "rx_origin": v3(d.rx_origin),
+                        "rx_direction": v3(d.rx_direction),
+                        "ry_origin": v3(d.ry_origin),
+                        "ry_direction": v3(d.ry_direction),
+                    })),
+                });
+            }
+            Event::Ray { depth, ray, hit } => {
+                close_to(&mut stack, &mut root, *depth as usize);
+                stack.push(ray_record(scene, *depth, ray, hit.as_deref()));
+            }
+            Event::SampleRadiance { value } => radiance = v3(*value),
+            other => {
+                if let Event::Radiance { depth, .. } = other {
+                    close_to(&mut stack, &mut root, *depth as usize + 1);
+                }
+                if let Some(ray) = stack.last_mut() {
+                    ray_event(scene, ray, other, &mut running);
+                }
+            }
+        }
+    }
+    close_to(&mut stack, &mut root, 0);
+    json!({
+        "sample": sample,
+        "camera": camera,
+        "ray": root,
+        "radiance": radiance,
+    })
+}
+
+/// A ray's record: its intersection stage.
+fn ray_record(
+    scene: &Scene,
+    depth: u32,
+    ray: &glint_geometry::Ray,
+    hit: Option<&glint_geometry::Hit>,
+) -> Map<String, Value> {
+    let explained = scene.shapes.explain_closest(ray, f32::INFINITY);
+    let tests: Vec<Value> = explained
+        .tests
+        .iter()
+        .map(|t| {
+            let mut test = json!({
+                "object": t.object,
+                "kind": t.kind,
+                "t": t.t.map_or(Value::Null, num),
+            });
+            if let Some(triangle) = t.triangle {
+                test["triangle"] = json!(triangle);
+            }
+            test
+        })
+        .collect();
+    let w = explained.work;
+    let mut record = Map::new();
+    record.insert("depth".into(), json!(depth));
+    record.insert(
+        "intersect".into(),
+        json!({
+            "origin": v3(ray.origin),
+            "direction": v3(ray.direction),
+            "tests": tests,
+            "work": {
+                "bvh_nodes": w.bvh_nodes,
+                "bvh_leaves": w.bvh_leaves,
+                "shape_tests": w.shape_tests(),
+                "triangle_tests": w.triangle_tests,
+            },
+            "hit": hit.map(|h| json!({
+                "object": h.shape,
+                "kind": object_kind(scene, h),
+                "triangle": h.primitive,
+                "t": num(h.t),
+                "point": v3(h.point),
+                "geometric_normal": v3(h.geometric_normal),
+                "shading_normal": v3(h.shading_normal),
+                "uv": v2(h.uv),
+                "dpdu": v3(h.dpdu),
+                "dpdv": v3(h.dpdv),
+                "front_face": h.front_face,
+            })),
+        }),
+    );
+    // The texture stage needs the material: looked up when the surface event comes.
+    if let Some(h) = hit {
+        record.insert("object".into(), json!(h.shape));
+        record.insert("triangle".into(), json!(h.primitive));
+    }
+    record
+}
+
+fn object_kind(scene: &Scene, hit: &glint_geometry::Hit) -> &'static str {
+    match scene.shapes.object(hit.shape) {
+        glint_geometry::ObjectRef::Mesh(_) => "mesh",
+        glint_geometry::ObjectRef::Shape(s) => match s {
+            glint_geometry::Shape::Sphere(_) => "sphere",
+            glint_geometry::Shape::Parallelogram(_) => "parallelogram",
+            glint_geometry::Shape::Plane(_) => "plane",
+            glint_geometry::Shape::Box(_) => "box",
+        },
+    }
+}
+
+fn light_kind(light: &Light) -> &'static str {
+    match light {
+        Light::Point(_) => "point",
+        Light::Area(_) => "area",
+        Light::Sphere(_) => "sphere",
+    }
+}
+
+fn shadow(s: &Shadow) -> Value {
+    match s {
+        Shadow::Unoccluded => json!("unoccluded"),
+        Shadow::Blocked { object, t } => json!({
+            "blocked_by": if *object == u32::MAX { Value::Null } else { json!(object) },
+            "t": num(*t),
+        }),
+        Shadow::Skipped(skip) => json!({
+            "not_traced": match skip {
+                Skip::BehindSurface => "below the surface",
+                Skip::BehindLight => "behind the light",
+                Skip::ZeroBrdf => "zero BRDF",
+                Skip::ZeroPdf => "zero density",
+            }
+        }),
+    }
+}
+
+/// Attaches one event to the ray it belongs to.
+fn ray_event(scene: &Scene, ray: &mut Map<String, Value>, event: &Event, running: &mut Running) {
+    match event {
+        Event::Environment {
+            direction,
+            width,
+            radiance,
+        } => {
+            ray.insert(
+                "environment".into(),
+                json!({"direction": v3(*direction), "filter_width": num(*width), "radiance": v3(*radiance)}),
+            );
+        }
+        Event::Emitter { radiance } => {
+            ray.insert("emitter".into(), json!({ "radiance": v3(*radiance) }));
+        }
+        Event::Surface {
+            tc,
+            kd,
+            ks,
+            n,
+            ng,
+            v,
+        } => {
+            let object = ray.get("object").and_then(Value::as_u64).unwrap_or(0) as u32;
+            let triangle = ray.get("triangle").and_then(Value::as_u64).unwrap_or(0) as u32;
+            let mut texture = json!({
+                "footprint": {"uv": v2(tc.uv), "duvdx": v2(tc.duvdx), "duvdy": v2(tc.duvdy)},
+                "kd": v3(*kd),
+                "ks": v3(*ks),
+            });
+            if let SurfaceKind::Material(m) = scene.surface_of_primitive(object, triangle) {
+                let tc = m.uv_transform.apply(tc);
+                texture["material_uv"] = json!(v2(tc.uv));
+                texture["diffuse"] = json::lookup(&m.diffuse.explain(&tc));
+                texture["specular"] = match &m.specular {
+                    Some(t) => json::lookup(&t.explain(&tc)),
+                    None => json!("the diffuse texture's (ks = kd)"),
+                };
+            }
+            ray.insert("texture".into(), texture);
+            ray.insert(
+                "shading".into(),
+                json!({"n": v3(*n), "ng": v3(*ng), "v": v3(*v)}),
+            );
+            ray.insert(
+                "light".into(),
+                json!({"ambient": Value::Null, "lights": [], "environment": Value::Null}),
+            );
+        }
+        Event::Ambient { value } => {
+            ray["light"]["ambient"] = v3(*value);
+        }
+        Event::Light { light } => {
+            *running = Running::default();
+            let kind = scene.lights.get(*light).map_or("?", light_kind);
+            lights(ray)
+                .push(json!({"light": light, "kind": kind, "samples": [], "total": Value::Null}));
+        }
+        Event::LightSample {
+            position,
+            l,
+            n_dot_l,
+            reflection,
+            diffuse,
+            specular,
+            shadow: s,
+            value,
+        } => {
+            let sample = json!({
+                "position": v3(*position),
+                "l": v3(*l),
+                "n_dot_l": num(*n_dot_l),
+                "reflection": v3(*reflection),
+                "diffuse": v3(*diffuse),
+                "specular": v3(*specular),
+                "shadow": shadow(s),
+                "value": v3(*value),
+            });
+            push_light_sample(ray, sample, *value, running);
+        }
+        Event::PhysicalSample {
+            technique,
+            l,
+            f_cos,
+            light_pdf,
+            lobe_pdf,
+            weight,
+            shadow: s,
+            value,
+        } => {
+            let sample = json!({
+                "technique": match technique {
+                    Technique::PointLight => "point light",
+                    Technique::Light => "light",
+                    Technique::Lobe => "specular lobe",
+                },
+                "l": v3(*l),
+                "f_cos": v3(*f_cos),
+                "light_pdf": num(*light_pdf),
+                "lobe_pdf": num(*lobe_pdf),
+                "mis_weight": num(*weight),
+                "shadow": shadow(s),
+                "value": v3(*value),
+            });
+            push_light_sample(ray, sample, *value, running);
+        }
+        Event::LightTotal { value, .. } => {
+            if let Some(last) = lights(ray).last_mut() {
+                last["total"] = v3(*value);
+            }
+            *running = Running::default();
+        }
+        Event::EnvironmentSample {
+            direction,
+            pdf,
+            radiance,
+            f_cos,
+            shadow: s,
+            value,
+        } => {
+            let light = &mut ray["light"];
+            if light["environment"].is_null() {
+                light["environment"] = json!({"samples": [], "total": Value::Null});
+            }
+            if let Some(samples) = light["environment"]["samples"].as_array_mut() {
+                samples.push(json!({
+                    "direction": v3(*direction),
+                    "pdf": num(*pdf),
+                    "radiance": v3(*radiance),
+                    "f_cos": v3(*f_cos),
+                    "shadow": shadow(s),
+                    "value": v3(*value),
+                }));
+            }
+        }
+        Event::EnvironmentTotal { value } => {
+            let light = &mut ray["light"];
+            if light["environment"].is_null() {
+                light["environment"] = json!({"samples": [], "total": Value::Null});
+            }
+            light["environment"]["total"] = v3(*value);
+        }
+        Event::Mirror {
+            reflectivity,
+            tint,
+            direction,
+        } => {
+            ray.insert(
+                "mirror".into(),
+                json!({"reflectivity": num(*reflectivity), "tint": v3(*tint), "direction": v3(*direction)}),
+            );
+        }
+        Event::Radiance {
+            local,
+            mirror,
+            value,
+            ..
+        } => {
+            ray.insert(
+                "radiance".into(),
+                json!({"local": v3(*local), "mirror": v3(*mirror), "value": v3(*value)}),
+            );
+        }
+        Event::Camera { .. } | Event::Ray { .. } | Event::SampleRadiance { .. } => {}
+    }
+}
+
+fn lights(ray: &mut Map<String, Value>) -> &mut Vec<Value> {
+    ray.entry("light").or_insert_with(
+        || json!({"ambient": Value::Null, "lights": [], "environment": Value::Null}),
+    );
+    ray["light"]["lights"]
+        .as_array_mut()
+        .expect("lights is an array")
+}
+
+/// The sum and count of a light's sample values so far (unrounded).
+#[derive(Clone, Copy, Debug, Default)]
+struct Running {
+    sum: Vec3,
+    count: u32,
+}
+
+/// Adds a sample to the light being shaded, with the running average of the
+/// samples' values so far.
+fn push_light_sample(
+    ray: &mut Map<String, Value>,
+    mut sample: Value,
+    value: Vec3,
+    running: &mut Running,
+) {
+    running.sum += value;
+    running.count += 1;
+    sample["running_average"] = v3(running.sum / running.count as f32);
+    if let Some(last) = lights(ray).last_mut() {
+        if let Some(samples) = last["samples"].as_array_mut() {
+            samples.push(sample);
+        }
+    }
+}

@@ -1,0 +1,392 @@
+//! The text form of an explanation: the document's numbers, stage by stage,
+//! mirror reflections indented under the ray that spawned them.
+
+use serde_json::Value;
+use std::fmt::Write;
+
+/// A number, vector or other value as the text shows it.
+fn f(v: &Value) -> String {
+    match v {
+        Value::Null => "none".into(),
+        Value::Number(n) => n.to_string(),
+        Value::Array(items) => {
+            let parts: Vec<String> = items.iter().map(f).collect();
+            format!("({})", parts.join(", "))
+        }
+        Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// Appends `key value` pairs of `object` that exist, on one line.
+fn pairs(out: &mut String, indent: &str, object: &Value, keys: &[(&str, &str)]) {
+    let parts: Vec<String> = keys
+        .iter()
+        .filter(|(key, _)| !object[*key].is_null())
+        .map(|(key, label)| format!("{label} {}", f(&object[*key])))
+        .collect();
+    if !parts.is_empty() {
+        writeln!(out, "{indent}{}", parts.join("   ")).unwrap();
+    }
+}
+
+pub(crate) fn render(doc: &Value) -> String {
+    let mut out = String::new();
+    writeln!(
+        out,
+        "pixel {} of {} x {}, {} samples per pixel, seed {}",
+        f(&doc["pixel"]),
+        doc["resolution"][0],
+        doc["resolution"][1],
+        doc["spp"],
+        doc["seed"]
+    )
+    .unwrap();
+    for sample in doc["samples"].as_array().into_iter().flatten() {
+        writeln!(out, "\nsample {}", sample["sample"]).unwrap();
+        if !sample["camera"].is_null() {
+            camera(&mut out, &sample["camera"]);
+        }
+        if !sample["ray"].is_null() {
+            ray_text(&mut out, &sample["ray"]);
+        }
+        if !sample["radiance"].is_null() {
+            writeln!(out, "  sample radiance {}", f(&sample["radiance"])).unwrap();
+        }
+    }
+    if !doc["film"].is_null() {
+        let film = &doc["film"];
+        writeln!(out, "\nfilm").unwrap();
+        writeln!(
+            out,
+            "  pixel radiance {} (mean of {} samples; linear)",
+            f(&film["radiance"]),
+            film["samples_averaged"]
+        )
+        .unwrap();
+        writeln!(
+            out,
+            "  sRGB 8-bit {} (as written to a PNG)",
+            f(&film["srgb8"])
+        )
+        .unwrap();
+    }
+    out
+}
+
+fn camera(out: &mut String, c: &Value) {
+    writeln!(out, "  camera").unwrap();
+    pairs(
+        out,
+        "    ",
+        c,
+        &[
+            ("raster", "raster"),
+            ("ndc", "ndc"),
+            ("film_point", "film point"),
+        ],
+    );
+    pairs(
+        out,
+        "    ",
+        c,
+        &[("origin", "ray origin"), ("direction", "direction")],
+    );
+    let d = &c["differentials"];
+    if !d.is_null() {
+        pairs(
+            out,
+            "    ",
+            d,
+            &[
+                ("rx_direction", "differential x direction"),
+                ("ry_direction", "y direction"),
+            ],
+        );
+    }
+}
+
+fn ray_text(out: &mut String, ray: &Value) {
+    let depth = ray["depth"].as_u64().unwrap_or(0) as usize;
+    let indent = "  ".repeat(2 * depth + 1);
+    let sub = format!("{indent}  ");
+    if depth > 0 {
+        let parent = "  ".repeat(2 * depth);
+        writeln!(out, "{parent}reflection ray, depth {depth}").unwrap();
+    }
+    let i = &ray["intersect"];
+    if !i.is_null() {
+        writeln!(out, "{indent}intersection").unwrap();
+        pairs(
+            out,
+            &sub,
+            i,
+            &[("origin", "origin"), ("direction", "direction")],
+        );
+        for test in i["tests"].as_array().into_iter().flatten() {
+            let hit = match &test["t"] {
+                Value::Null => "miss".to_owned(),
+                t => match &test["triangle"] {
+                    Value::Null => format!("t = {}", f(t)),
+                    tri => format!("t = {} (triangle {tri})", f(t)),
+                },
+            };
+            writeln!(
+                out,
+                "{sub}object {} {}: {hit}",
+                test["object"],
+                f(&test["kind"])
+            )
+            .unwrap();
+        }
+        let w = &i["work"];
+        writeln!(
+            out,
+            "{sub}the query's work: {} BVH nodes, {} leaves, {} shape tests, {} triangle tests",
+            w["bvh_nodes"], w["bvh_leaves"], w["shape_tests"], w["triangle_tests"]
+        )
+        .unwrap();
+        match &i["hit"] {
+            Value::Null => writeln!(out, "{sub}no hit").unwrap(),
+            h => {
+                writeln!(
+                    out,
+                    "{sub}hit object {} ({}) at t = {}{}",
+                    h["object"],
+                    f(&h["kind"]),
+                    f(&h["t"]),
+                    if h["front_face"] == Value::Bool(true) {
+                        ", front face"
+                    } else {
+                        ", back face"
+                    }
+                )
+                .unwrap();
+                pairs(out, &sub, h, &[("point", "point"), ("uv", "uv")]);
+                pairs(
+                    out,
+                    &sub,
+                    h,
+                    &[
+                        ("geometric_normal", "geometric normal"),
+                        ("shading_normal", "shading normal"),
+                    ],
+                );
+                pairs(out, &sub, h, &[("dpdu", "dp/du"), ("dpdv", "dp/dv")]);
+            }
+        }
+    }
+    if !ray["environment"].is_null() {
+        let e = &ray["environment"];
+        writeln!(out, "{indent}environment").unwrap();
+        pairs(
+            out,
+            &sub,
+            e,
+            &[
+                ("direction", "direction"),
+                ("filter_width", "filter width"),
+                ("radiance", "radiance"),
+            ],
+        );
+    }
+    if !ray["emitter"].is_null() {
+        writeln!(
+            out,
+            "{indent}light seen directly: radiance {}",
+            f(&ray["emitter"]["radiance"])
+        )
+        .unwrap();
+    }
+    texture(out, &ray["texture"], &indent);
+    lighting(out, ray, &indent);
+    if !ray["mirror"].is_null() {
+        pairs(
+            out,
+            &sub,
+            &ray["mirror"],
+            &[
+                ("reflectivity", "mirror: reflectivity"),
+                ("tint", "tint"),
+                ("direction", "direction"),
+            ],
+        );
+    }
+    if !ray["reflection"].is_null() {
+        ray_text(out, &ray["reflection"]);
+    }
+    if !ray["radiance"].is_null() {
+        pairs(
+            out,
+            &sub,
+            &ray["radiance"],
+            &[
+                ("local", "radiance: local"),
+                ("mirror", "mirror"),
+                ("value", "total"),
+            ],
+        );
+    }
+}
+
+fn texture(out: &mut String, t: &Value, indent: &str) {
+    if t.is_null() {
+        return;
+    }
+    let sub = format!("{indent}  ");
+    writeln!(out, "{indent}texture").unwrap();
+    let fp = &t["footprint"];
+    pairs(
+        out,
+        &sub,
+        fp,
+        &[("uv", "uv"), ("duvdx", "du/dx"), ("duvdy", "du/dy")],
+    );
+    for (key, label) in [("diffuse", "diffuse"), ("specular", "specular")] {
+        let l = &t[key];
+        if l.is_null() {
+            continue;
+        }
+        if let Value::String(s) = l {
+            writeln!(out, "{sub}{label}: {s}").unwrap();
+            continue;
+        }
+        writeln!(out, "{sub}{label}: {} -> {}", f(&l["kind"]), f(&l["value"])).unwrap();
+        let deeper = format!("{sub}  ");
+        pairs(
+            out,
+            &deeper,
+            l,
+            &[("st", "st"), ("dst_dx", "dst/dx"), ("dst_dy", "dst/dy")],
+        );
+        pairs(
+            out,
+            &deeper,
+            l,
+            &[
+                ("report_level", "level log2(L/W)"),
+                ("glint_level", "Glint's level"),
+                ("second_color_fraction", "second color's fraction"),
+            ],
+        );
+        for texel in l["texels"].as_array().into_iter().flatten() {
+            writeln!(
+                out,
+                "{deeper}texel ({}, {}) of level {}: weight {}, value {}",
+                texel["x"],
+                texel["y"],
+                texel["level"],
+                f(&texel["weight"]),
+                f(&texel["value"])
+            )
+            .unwrap();
+        }
+    }
+    pairs(out, &sub, t, &[("kd", "kd"), ("ks", "ks")]);
+}
+
+fn shadow(s: &Value) -> String {
+    match s {
+        Value::String(s) => s.clone(),
+        Value::Object(o) if o.contains_key("not_traced") => {
+            format!("no shadow ray ({})", f(&s["not_traced"]))
+        }
+        Value::Object(_) => format!(
+            "blocked by object {} at t = {}",
+            f(&s["blocked_by"]),
+            f(&s["t"])
+        ),
+        other => f(other),
+    }
+}
+
+fn lighting(out: &mut String, ray: &Value, indent: &str) {
+    let sub = format!("{indent}  ");
+    let light = &ray["light"];
+    if !ray["shading"].is_null() || !light.is_null() {
+        writeln!(out, "{indent}lighting").unwrap();
+        pairs(
+            out,
+            &sub,
+            &ray["shading"],
+            &[("n", "n"), ("ng", "ng"), ("v", "v")],
+        );
+    }
+    if !light.is_null() {
+        if !light["ambient"].is_null() {
+            writeln!(out, "{sub}ambient {}", f(&light["ambient"])).unwrap();
+        }
+        for l in light["lights"].as_array().into_iter().flatten() {
+            writeln!(out, "{sub}light {} ({})", l["light"], f(&l["kind"])).unwrap();
+            let deeper = format!("{sub}  ");
+            for (k, s) in l["samples"].as_array().into_iter().flatten().enumerate() {
+                writeln!(out, "{deeper}sample {k}: {}", shadow(&s["shadow"])).unwrap();
+                let d3 = format!("{deeper}  ");
+                pairs(
+                    out,
+                    &d3,
+                    s,
+                    &[
+                        ("technique", "by"),
+                        ("position", "position"),
+                        ("l", "l"),
+                        ("n_dot_l", "n·l"),
+                    ],
+                );
+                pairs(
+                    out,
+                    &d3,
+                    s,
+                    &[
+                        ("reflection", "r"),
+                        ("diffuse", "diffuse"),
+                        ("specular", "specular"),
+                    ],
+                );
+                pairs(
+                    out,
+                    &d3,
+                    s,
+                    &[
+                        ("f_cos", "f·cos"),
+                        ("light_pdf", "light pdf"),
+                        ("lobe_pdf", "lobe pdf"),
+                        ("mis_weight", "MIS weight"),
+                    ],
+                );
+                pairs(
+                    out,
+                    &d3,
+                    s,
+                    &[("value", "adds"), ("running_average", "running average")],
+                );
+            }
+            writeln!(out, "{deeper}total {}", f(&l["total"])).unwrap();
+        }
+        let env = &light["environment"];
+        if !env.is_null() {
+            writeln!(out, "{sub}environment").unwrap();
+            let deeper = format!("{sub}  ");
+            for (k, s) in env["samples"].as_array().into_iter().flatten().enumerate() {
+                writeln!(out, "{deeper}sample {k}: {}", shadow(&s["shadow"])).unwrap();
+                pairs(
+                    out,
+                    &format!("{deeper}  "),
+                    s,
+                    &[
+                        ("direction", "direction"),
+                        ("pdf", "pdf"),
+                        ("radiance", "radiance"),
+                    ],
+                );
+                pairs(
+                    out,
+                    &format!("{deeper}  "),
+                    s,
+                    &[("f_cos", "f·cos"), ("value", "adds")],
+                );
+            }
+            writeln!(out, "{deeper}total {}", f(&env["total"])).unwrap();
+        }
+    }
+}

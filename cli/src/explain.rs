@@ -6,6 +6,7 @@ use clap::Args;
 use glint_explain::Stage;
 use glint_integrator::trace::SampleSelection;
 use glint_integrator::ExplainError;
+use std::io::Write;
 
 #[derive(Args)]
 pub(crate) struct ExplainArgs {
@@ -66,12 +67,15 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
                 ExplainError::Settings(e) => Failure::Input(format!("render settings: {e}")),
                 ExplainError::Diverged { .. } => Failure::Other(e.to_string()),
             })?;
-    if args.json {
-        let text = serde_json::to_string_pretty(&explanation.json(args.stage))
-            .expect("JSON of numbers and strings");
-        println!("{text}");
-    } else {
-        print!("{}", explanation.text(args.stage));
-    }
+    let text = match args.json {
+        true => {
+            serde_json::to_string_pretty(&explanation.json(args.stage))
+                .expect("JSON of numbers and strings")
+                + "\n"
+        }
+        false => explanation.text(args.stage),
+    };
+    // A reader that stops early (`| head`) is not an error.
+    let _ = std::io::stdout().write_all(text.as_bytes());
     Ok(())
 }

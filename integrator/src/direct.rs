@@ -378,13 +378,10 @@ impl DirectIntegrator {
                 let value = s.radiance * f / s.pdf;
                 record(ctx, f, Shadow::Unoccluded, value);
                 sum += value;
-            } else {
-                record(
-                    ctx,
-                    f,
-                    blocker(scene, &shadow_ray, f32::INFINITY),
-                    Vec3::ZERO,
-                );
+            } else if T::ON {
+                // Finding the blocker costs a query: only when tracing.
+                let shadow = blocker(scene, &shadow_ray, f32::INFINITY);
+                record(ctx, f, shadow, Vec3::ZERO);
             }
         }
         ctx.environment_points = samples;
@@ -512,7 +509,10 @@ impl ShadingPoint<'_> {
         let shadow = spawn_ray_to(self.hit, target);
         ctx.counters.light_shadow_rays += 1;
         if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
-            self.record_light_sample(target, l, blocker(scene, &shadow, 1.0), ctx);
+            if T::ON {
+                // Finding the blocker costs a query: only when tracing.
+                self.record_light_sample(target, l, blocker(scene, &shadow, 1.0), ctx);
+            }
             Vec3::ZERO
         } else {
             self.record_light_sample(target, l, Shadow::Unoccluded, ctx);
@@ -598,7 +598,9 @@ impl PairAllocation {
 }
 
 /// The nearest object blocking `shadow` before `t_max`, as a tracer reports
-/// it (the integrator itself only asks whether anything does).
+/// it (the integrator itself only asks whether anything does). A closest-hit
+/// query: call it under `if T::ON`, never as an argument the untraced code
+/// would evaluate.
 pub(crate) fn blocker(scene: &Scene, shadow: &Ray, t_max: f32) -> Shadow {
     match scene.shapes.closest_hit(shadow, t_max) {
         Some(hit) => Shadow::Blocked {

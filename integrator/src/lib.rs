@@ -22,6 +22,11 @@
 //!   [`RenderOutput`]: the film and its [`RenderStats`].
 //! - [`DirectIntegrator::li`] is the radiance along one ray, for callers that drive
 //!   their own loop ([`camera_ray`] makes the camera ray with its differentials).
+//! - [`explain_pixel`] is one pixel as [`render`] computes it, with every step of
+//!   its samples recorded ([`trace`]: the integrator's events, seen by a
+//!   [`trace::Tracer`] type parameter that costs nothing when it is `()`);
+//!   [`RenderControl::crop`] renders a window of the image with the whole
+//!   render's pixels.
 //! - [`SamplePattern`] and [`sampling`]: the sample patterns (grid, random,
 //!   stratified, Owen-scrambled Sobol) and per-pixel streams;
 //!   [`Aov`]: buffers other than radiance.

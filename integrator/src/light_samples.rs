@@ -130,9 +130,12 @@ impl ShadingPoint<'_> {
                 sum += self.unoccluded_reflection(scene, &target, occluders, ctx);
             } else {
                 ctx.counters.skipped_behind_light += 1;
-                let target = light.shadow_target(position);
-                let l = (position - self.hit.point).normalize_or_zero();
-                self.record_light_sample(&target, l, Shadow::Skipped(Skip::BehindLight), ctx);
+                if T::ON {
+                    let target = light.shadow_target(position);
+                    let l = (position - self.hit.point).normalize_or_zero();
+                    let shadow = Shadow::Skipped(Skip::BehindLight);
+                    self.record_light_sample(&target, l, shadow, ctx);
+                }
             }
         }
         sum

@@ -244,11 +244,14 @@ impl ShadingPoint<'_> {
         ctx.counters.light_shadow_rays += 1;
         let shadow = spawn_ray_to(self.hit, &RayTarget::exact(light.position));
         if scene.shapes.any_hit_among(&Occluders::ALL, &shadow, 1.0) {
-            record(ctx, f, blocker(scene, &shadow, 1.0), Vec3::ZERO);
+            if T::ON {
+                // Finding the blocker costs a query: only when tracing.
+                record(ctx, f, blocker(scene, &shadow, 1.0), Vec3::ZERO);
+            }
             return Vec3::ZERO;
         }
         let value = light.color * f / distance2;
-        record(ctx, f, Shadow::Unoccluded, value);
+        record(ctx, f, Shadow::Unoccluded, f / distance2);
         value
     }
 
@@ -303,7 +306,10 @@ impl ShadingPoint<'_> {
         ctx.counters.light_shadow_rays += 1;
         let shadow = spawn_ray_to(self.hit, target);
         if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
-            record(ctx, f, blocker(scene, &shadow, 1.0), Vec3::ZERO);
+            if T::ON {
+                // Finding the blocker costs a query: only when tracing.
+                record(ctx, f, blocker(scene, &shadow, 1.0), Vec3::ZERO);
+            }
             return Vec3::ZERO;
         }
         let weight = if mis {
@@ -366,15 +372,9 @@ impl ShadingPoint<'_> {
                 value
             }
             other => {
-                let shadow = match other {
-                    Some(hit) => Shadow::Blocked {
-                        object: hit.shape,
-                        t: hit.t,
-                    },
-                    None => Shadow::Blocked {
-                        object: u32::MAX,
-                        t: f32::INFINITY,
-                    },
+                let shadow = Shadow::MissedLight {
+                    object: other.map(|hit| hit.shape),
+                    t: other.map_or(f32::INFINITY, |hit| hit.t),
                 };
                 record(ctx, f, 0.0, shadow, Vec3::ZERO);
                 Vec3::ZERO

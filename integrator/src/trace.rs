@@ -61,6 +61,10 @@ pub enum Shadow {
     /// The nearest blocker: its object index and the distance along the
     /// shadow ray (in multiples of its direction, which ends at the light).
     Blocked { object: u32, t: f32 },
+    /// A ray along a direction drawn from the specular lobe did not reach the
+    /// light it was drawn for: it hit `object` first (at `t`), or left the
+    /// scene (`None`).
+    MissedLight { object: Option<u32>, t: f32 },
 }
 
 /// How a physical-shading sample was drawn.
@@ -134,7 +138,9 @@ pub enum Event {
     /// One sample of physical shading: the direction, the BRDF times the
     /// cosine, the densities of the two techniques (the lobe's is 0 without
     /// MIS), the power-heuristic weight, the shadow ray's verdict and what the
-    /// sample adds (before the light's radiance and the average).
+    /// sample adds: `f·cos·w/p` before the light's radiance and the division
+    /// by the light sample count (a point light: `f·cos/r²`, before its
+    /// intensity). Light and lobe samples of one light add into one sum.
     PhysicalSample {
         technique: Technique,
         l: Vec3,

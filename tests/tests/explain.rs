@@ -90,21 +90,35 @@ fn the_recorded_samples_make_the_pixel_and_the_light_samples_their_lights() {
         assert_eq!(explained.samples.len(), settings.spp as usize, "{name}");
         let mut sum = Vec3::ZERO;
         for sample in &explained.samples {
-            let mut samples = Vec::new();
+            let (mut samples, mut physical) = (Vec::new(), Vec::new());
             for event in &sample.events {
                 match event {
                     Event::SampleRadiance { value } => sum += *value,
-                    Event::Light { .. } => samples.clear(),
+                    Event::Light { .. } => {
+                        samples.clear();
+                        physical.clear();
+                    }
                     Event::LightSample { value, .. } => samples.push(*value),
-                    Event::LightTotal { light, value } if !samples.is_empty() => {
-                        // The course's model: the light's color times the mean.
+                    Event::PhysicalSample { value, .. } => physical.push(*value),
+                    Event::LightTotal { light, value }
+                        if !samples.is_empty() || !physical.is_empty() =>
+                    {
                         let color = match &scene.lights[*light] {
                             glint_lighting::Light::Area(a) => a.color,
                             glint_lighting::Light::Point(p) => p.color,
                             glint_lighting::Light::Sphere(s) => s.color,
                         };
-                        let mean = samples.iter().sum::<Vec3>() / samples.len() as f32;
-                        let want = color * mean;
+                        // The course's model: the light's color times the mean
+                        // of its samples. Physical shading: its radiance times
+                        // the sum of both techniques' samples over the light
+                        // sample count (a point light: its one sample).
+                        let want = if physical.is_empty() {
+                            color * samples.iter().sum::<Vec3>() / samples.len() as f32
+                        } else if matches!(scene.lights[*light], glint_lighting::Light::Point(_)) {
+                            color * physical[0]
+                        } else {
+                            color * physical.iter().sum::<Vec3>() / settings.light_samples as f32
+                        };
                         assert!(
                             (want - *value).abs().max_element()
                                 <= 1e-5 * want.max_element().max(1.0),

@@ -219,7 +219,7 @@ fn ray_record(
             "work": {
                 "bvh_nodes": w.bvh_nodes,
                 "bvh_leaves": w.bvh_leaves,
-                "shape_tests": w.shape_tests(),
+                "shape_tests": w.shape_tests() - w.triangle_tests,
                 "triangle_tests": w.triangle_tests,
             },
             "hit": hit.map(|h| json!({
@@ -271,6 +271,9 @@ fn shadow(s: &Shadow) -> Value {
         Shadow::Blocked { object, t } => json!({
             "blocked_by": if *object == u32::MAX { Value::Null } else { json!(object) },
             "t": num(*t),
+        }),
+        Shadow::MissedLight { object, t } => json!({
+            "missed_light": {"hit": object, "t": num(*t)},
         }),
         Shadow::Skipped(skip) => json!({
             "not_traced": match skip {
@@ -388,7 +391,7 @@ fn ray_event(scene: &Scene, ray: &mut Map<String, Value>, event: &Event, running
                 "shadow": shadow(s),
                 "value": v3(*value),
             });
-            push_light_sample(ray, sample, *value, running);
+            push_physical_sample(ray, sample, *value, running);
         }
         Event::LightTotal { value, .. } => {
             if let Some(last) = lights(ray).last_mut() {
@@ -458,6 +461,25 @@ fn lights(ray: &mut Map<String, Value>) -> &mut Vec<Value> {
     ray["light"]["lights"]
         .as_array_mut()
         .expect("lights is an array")
+}
+
+/// Adds a physical-shading sample to the light being shaded, with the sum of
+/// the light's sample values so far: light and lobe samples add into one sum,
+/// which the light's radiance times, over the light sample count, is its total.
+fn push_physical_sample(
+    ray: &mut Map<String, Value>,
+    mut sample: Value,
+    value: Vec3,
+    running: &mut Running,
+) {
+    running.sum += value;
+    running.count += 1;
+    sample["running_sum"] = v3(running.sum);
+    if let Some(last) = lights(ray).last_mut() {
+        if let Some(samples) = last["samples"].as_array_mut() {
+            samples.push(sample);
+        }
+    }
 }
 
 /// The sum and count of a light's sample values so far (unrounded).

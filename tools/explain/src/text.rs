@@ -240,7 +240,7 @@ fn texture(out: &mut String, t: &Value, indent: &str) {
         out,
         &sub,
         fp,
-        &[("uv", "uv"), ("duvdx", "du/dx"), ("duvdy", "du/dy")],
+        &[("uv", "uv"), ("duvdx", "duv/dx"), ("duvdy", "duv/dy")],
     );
     for (key, label) in [("diffuse", "diffuse"), ("specular", "specular")] {
         let l = &t[key];
@@ -291,6 +291,13 @@ fn shadow(s: &Value) -> String {
         Value::Object(o) if o.contains_key("not_traced") => {
             format!("no shadow ray ({})", f(&s["not_traced"]))
         }
+        Value::Object(o) if o.contains_key("missed_light") => match &s["missed_light"]["hit"] {
+            Value::Null => "the lobe ray leaves the scene without reaching the light".into(),
+            object => format!(
+                "the lobe ray hits object {object} first, at t = {}",
+                f(&s["missed_light"]["t"])
+            ),
+        },
         Value::Object(_) => format!(
             "blocked by object {} at t = {}",
             f(&s["blocked_by"]),
@@ -358,7 +365,11 @@ fn lighting(out: &mut String, ray: &Value, indent: &str) {
                     out,
                     &d3,
                     s,
-                    &[("value", "adds"), ("running_average", "running average")],
+                    &[
+                        ("value", "adds"),
+                        ("running_average", "running average"),
+                        ("running_sum", "running sum"),
+                    ],
                 );
             }
             writeln!(out, "{deeper}total {}", f(&l["total"])).unwrap();

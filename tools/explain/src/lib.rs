@@ -21,6 +21,10 @@
 mod json;
 mod text;
 
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
+
 use glam::Vec3;
 use glint_integrator::trace::{Event, SampleSelection, Shadow, Skip, Technique};
 use glint_integrator::{explain_pixel, ExplainError, RenderSettings, Scene, SurfaceKind};

@@ -369,7 +369,7 @@ fn ray_event(scene: &Scene, ray: &mut Map<String, Value>, event: &Event, running
                 "shadow": shadow(s),
                 "value": v3(*value),
             });
-            push_light_sample(ray, sample, *value, running);
+            push_light_sample(ray, sample, *value, running, false);
         }
         Event::PhysicalSample {
             technique,
@@ -395,7 +395,7 @@ fn ray_event(scene: &Scene, ray: &mut Map<String, Value>, event: &Event, running
                 "shadow": shadow(s),
                 "value": v3(*value),
             });
-            push_physical_sample(ray, sample, *value, running);
+            push_light_sample(ray, sample, *value, running, true);
         }
         Event::LightTotal { value, .. } => {
             if let Some(last) = lights(ray).last_mut() {
@@ -467,25 +467,6 @@ fn lights(ray: &mut Map<String, Value>) -> &mut Vec<Value> {
         .expect("lights is an array")
 }
 
-/// Adds a physical-shading sample to the light being shaded, with the sum of
-/// the light's sample values so far: light and lobe samples add into one sum,
-/// which the light's radiance times, over the light sample count, is its total.
-fn push_physical_sample(
-    ray: &mut Map<String, Value>,
-    mut sample: Value,
-    value: Vec3,
-    running: &mut Running,
-) {
-    running.sum += value;
-    running.count += 1;
-    sample["running_sum"] = v3(running.sum);
-    if let Some(last) = lights(ray).last_mut() {
-        if let Some(samples) = last["samples"].as_array_mut() {
-            samples.push(sample);
-        }
-    }
-}
-
 /// The sum and count of a light's sample values so far (unrounded).
 #[derive(Clone, Copy, Debug, Default)]
 struct Running {
@@ -493,17 +474,25 @@ struct Running {
     count: u32,
 }
 
-/// Adds a sample to the light being shaded, with the running average of the
-/// samples' values so far.
+/// Adds a sample to the light being shaded, with its running figure: in the
+/// course's model the average of the light's sample values so far; in
+/// physical shading (`physical`) their sum, as light and lobe samples add
+/// into one sum, which the light's radiance times, over the light sample
+/// count, is its total.
 fn push_light_sample(
     ray: &mut Map<String, Value>,
     mut sample: Value,
     value: Vec3,
     running: &mut Running,
+    physical: bool,
 ) {
     running.sum += value;
     running.count += 1;
-    sample["running_average"] = v3(running.sum / running.count as f32);
+    if physical {
+        sample["running_sum"] = v3(running.sum);
+    } else {
+        sample["running_average"] = v3(running.sum / running.count as f32);
+    }
     if let Some(last) = lights(ray).last_mut() {
         if let Some(samples) = last["samples"].as_array_mut() {
             samples.push(sample);

@@ -233,12 +233,12 @@ impl DirectIntegrator {
         depth: u32,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let mut radiance = scene.ambient * point.kd;
-        ctx.tracer.record(|| Event::Ambient { value: radiance });
-        let mut pairs = PairAllocation::new(depth);
-        for (index, light) in scene.lights.iter().enumerate() {
-            ctx.tracer.record(|| Event::Light { light: index });
-            let value = match light {
+        self.shade_with(
+            scene,
+            point,
+            depth,
+            ctx,
+            |index, light, pairs, ctx| match light {
                 Light::Point(p) => {
                     let target = RayTarget::exact(p.position);
                     let reflected =
@@ -246,17 +246,33 @@ impl DirectIntegrator {
                     p.color * reflected
                 }
                 Light::Area(area) => {
-                    let own = DimensionPair::Light {
-                        light: index as u32,
-                        depth,
-                    };
-                    let pair = pairs.take(own, self.light_samples);
+                    let pair = self.light_pair(pairs, index, depth);
                     self.area_light(scene, point, index, area, pair, ctx)
                 }
                 // The course's model has no sphere lights: the scene file
                 // accepts them under physical shading only.
                 Light::Sphere(_) => Vec3::ZERO,
-            };
+            },
+        )
+    }
+
+    /// What both shading models share: `ambient · kd`, plus what each light
+    /// adds (`light_term(index, light, pairs, ctx)`, in scene order, taking
+    /// its dimension pair from `pairs` if it samples), plus the environment.
+    pub(crate) fn shade_with<T: Tracer>(
+        &self,
+        scene: &Scene,
+        point: &ShadingPoint,
+        depth: u32,
+        ctx: &mut SampleContext<T>,
+        mut light_term: impl FnMut(usize, &Light, &mut PairAllocation, &mut SampleContext<T>) -> Vec3,
+    ) -> Vec3 {
+        let mut radiance = scene.ambient * point.kd;
+        ctx.tracer.record(|| Event::Ambient { value: radiance });
+        let mut pairs = PairAllocation::new(depth);
+        for (index, light) in scene.lights.iter().enumerate() {
+            ctx.tracer.record(|| Event::Light { light: index });
+            let value = light_term(index, light, &mut pairs, ctx);
             ctx.tracer.record(|| Event::LightTotal {
                 light: index,
                 value,
@@ -265,6 +281,36 @@ impl DirectIntegrator {
         }
         radiance += self.environment_term(scene, point, &mut pairs, depth, ctx);
         radiance
+    }
+
+    /// The dimension pair of light `index`'s samples at a point `depth`
+    /// reflections deep.
+    #[inline]
+    pub(crate) fn light_pair(
+        &self,
+        pairs: &mut PairAllocation,
+        index: usize,
+        depth: u32,
+    ) -> DimensionPair {
+        let own = DimensionPair::Light {
+            light: index as u32,
+            depth,
+        };
+        pairs.take(own, self.light_samples)
+    }
+
+    /// Light `pair`'s points for this camera sample, in the buffer taken from
+    /// `ctx.light_points` (the caller puts it back).
+    #[inline]
+    pub(crate) fn draw_light_points<T: Tracer>(
+        &self,
+        pair: DimensionPair,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec<Vec2> {
+        let mut samples = std::mem::take(&mut ctx.light_points);
+        let sobol = ctx.sample.sobol_points(pair, self.light_samples);
+        self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+        samples
     }
 
     /// The environment's light at `point` (zero without environment samples),
@@ -301,9 +347,7 @@ impl DirectIntegrator {
         pair: DimensionPair,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let mut samples = std::mem::take(&mut ctx.light_points);
-        let sobol = ctx.sample.sobol_points(pair, self.light_samples);
-        self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+        let samples = self.draw_light_points(pair, ctx);
         // Culling the shapes that cannot block this point's shadow rays costs
         // about as much as testing them once: it pays from a few samples on.
         let occluders = if self.light_samples >= CULL_FROM_SAMPLES {

@@ -24,7 +24,7 @@
 //! the sharp highlight of a large light, where light samples alone are noisy.
 //! On a purely diffuse material only the light is sampled (weight 1).
 
-use crate::direct::{blocker, PairAllocation, SampleContext, ShadingPoint, CULL_FROM_SAMPLES};
+use crate::direct::{blocker, SampleContext, ShadingPoint, CULL_FROM_SAMPLES};
 use crate::sampling::DimensionPair;
 use crate::trace::{Event, Shadow, Skip, Technique, Tracer};
 use crate::{DirectIntegrator, Scene};
@@ -41,38 +41,23 @@ impl DirectIntegrator {
         depth: u32,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let mut radiance = scene.ambient * point.kd;
-        ctx.tracer.record(|| Event::Ambient { value: radiance });
-        let mut pairs = PairAllocation::new(depth);
-        for (index, light) in scene.lights.iter().enumerate() {
-            ctx.tracer.record(|| Event::Light { light: index });
-            let value = match light {
+        self.shade_with(
+            scene,
+            point,
+            depth,
+            ctx,
+            |index, light, pairs, ctx| match light {
                 Light::Point(p) => point.point_light(scene, p, ctx),
                 Light::Area(area) => {
-                    let own = DimensionPair::Light {
-                        light: index as u32,
-                        depth,
-                    };
-                    let pair = pairs.take(own, self.light_samples);
+                    let pair = self.light_pair(pairs, index, depth);
                     self.physical_area_light(scene, point, index, area, pair, depth, ctx)
                 }
                 Light::Sphere(sphere) => {
-                    let own = DimensionPair::Light {
-                        light: index as u32,
-                        depth,
-                    };
-                    let pair = pairs.take(own, self.light_samples);
+                    let pair = self.light_pair(pairs, index, depth);
                     self.physical_sphere_light(scene, point, index, sphere, pair, depth, ctx)
                 }
-            };
-            ctx.tracer.record(|| Event::LightTotal {
-                light: index,
-                value,
-            });
-            radiance += value;
-        }
-        radiance += self.environment_term(scene, point, &mut pairs, depth, ctx);
-        radiance
+            },
+        )
     }
 
     /// The light `light` (at `index` of the scene's lights) reflects at
@@ -99,9 +84,7 @@ impl DirectIntegrator {
         }
         let sampler = light.sampler(x, self.area_sampling);
         let mis = self.mis && point.has_specular;
-        let mut samples = std::mem::take(&mut ctx.light_points);
-        let sobol = ctx.sample.sobol_points(pair, n);
-        self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+        let samples = self.draw_light_points(pair, ctx);
         let occluders = if n >= CULL_FROM_SAMPLES {
             scene.shapes.occluders_towards(
                 x,
@@ -150,9 +133,7 @@ impl DirectIntegrator {
             return Vec3::ZERO;
         }
         let mis = self.mis && point.has_specular;
-        let mut samples = std::mem::take(&mut ctx.light_points);
-        let sobol = ctx.sample.sobol_points(pair, n);
-        self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+        let samples = self.draw_light_points(pair, ctx);
         let mut sum = Vec3::ZERO;
         for &u in &samples {
             if let Some(s) = light.sample(x, u) {
@@ -184,9 +165,7 @@ impl DirectIntegrator {
             light: index as u32,
             depth,
         };
-        let mut samples = std::mem::take(&mut ctx.light_points);
-        let sobol = ctx.sample.sobol_points(pair, self.light_samples);
-        self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+        let samples = self.draw_light_points(pair, ctx);
         let object = scene.light_objects[index];
         let mut sum = Vec3::ZERO;
         for &u in &samples {

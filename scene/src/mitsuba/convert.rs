@@ -158,13 +158,7 @@ impl<'a> Converter<'a> {
                     self.shapes.comment(
                         "Glint does not shade a light's surface: black, so that Mitsuba adds nothing to its emission",
                     );
-                    self.shapes.open("bsdf", &[("type", "diffuse")]);
-                    self.shapes.rgb("reflectance", Vec3::ZERO);
-                    self.shapes.close("bsdf");
-                    self.shapes.open("emitter", &[("type", "area")]);
-                    self.shapes.rgb("radiance", a.color);
-                    self.shapes.close("emitter");
-                    self.shapes.close("shape");
+                    self.black_emitter(a.color);
                 }
                 Light::Sphere(s) => {
                     let n = self.count("sphere-light");
@@ -175,13 +169,7 @@ impl<'a> Converter<'a> {
                     self.shapes
                         .property("point", "center", &vector(sphere.center()));
                     self.shapes.float("radius", sphere.radius());
-                    self.shapes.open("bsdf", &[("type", "diffuse")]);
-                    self.shapes.rgb("reflectance", Vec3::ZERO);
-                    self.shapes.close("bsdf");
-                    self.shapes.open("emitter", &[("type", "area")]);
-                    self.shapes.rgb("radiance", s.color);
-                    self.shapes.close("emitter");
-                    self.shapes.close("shape");
+                    self.black_emitter(s.color);
                 }
                 // A kind of light added to Glint after this exporter was written.
                 _ => self.warn(format!(
@@ -721,6 +709,18 @@ impl<'a> Converter<'a> {
                 number(m.shininess)
             ));
         }
+    }
+
+    /// Closes an open light `shape` with a black `diffuse` BSDF (Glint does
+    /// not shade a light's surface) and an `area` emitter of `radiance`.
+    fn black_emitter(&mut self, radiance: Vec3) {
+        self.shapes.open("bsdf", &[("type", "diffuse")]);
+        self.shapes.rgb("reflectance", Vec3::ZERO);
+        self.shapes.close("bsdf");
+        self.shapes.open("emitter", &[("type", "area")]);
+        self.shapes.rgb("radiance", radiance);
+        self.shapes.close("emitter");
+        self.shapes.close("shape");
     }
 
     // -- the environment ----------------------------------------------------

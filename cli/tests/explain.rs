@@ -53,6 +53,68 @@ fn textured_ground_with_its_mip_levels_and_texels() {
 }
 
 #[test]
+fn ewa_lookup_across_a_check_edge() {
+    let s = scene("ground-mipmap");
+    let text = explain(&[
+        &s,
+        "--pixel",
+        "40,200",
+        "--texture-filter",
+        "ewa",
+        "--stage",
+        "texture",
+    ]);
+    assert!(text.contains("texels, weights adding up to"), "{text}");
+    insta::assert_snapshot!(text);
+}
+
+#[test]
+fn the_json_lists_the_bvh_path_and_every_texel_of_an_ellipse() {
+    // The bunny's camera ray: the path starts at the root, and the leaf
+    // holding the hit triangle is on it.
+    let s = scene("bunny");
+    let doc = json(&[&s, "--pixel", "240,180", "--stage", "intersect"]);
+    let intersect = &doc["samples"][0]["ray"]["intersect"];
+    let path = intersect["bvh"].as_array().unwrap();
+    assert_eq!(path[0]["node"], 0);
+    assert_eq!(path.len() as u64, {
+        let w = &intersect["work"];
+        w["bvh_nodes"].as_u64().unwrap() + w["bvh_leaves"].as_u64().unwrap()
+    });
+    let triangle = &intersect["hit"]["triangle"];
+    assert!(path.iter().any(|step| step["primitives"]
+        .as_array()
+        .is_some_and(|p| p.iter().any(|p| p["triangle"] == *triangle))));
+    // An EWA lookup: the listed texels' weighted values make the filtered value.
+    let s = scene("ground-mipmap");
+    let doc = json(&[
+        &s,
+        "--pixel",
+        "40,200",
+        "--texture-filter",
+        "ewa",
+        "--stage",
+        "texture",
+    ]);
+    let lookup = &doc["samples"][0]["ray"]["texture"]["diffuse"];
+    let texels = lookup["texels"].as_array().unwrap();
+    assert!(texels.len() > 16, "{} texels", texels.len());
+    let mut sum = [0.0; 3];
+    for t in texels {
+        for (k, s) in sum.iter_mut().enumerate() {
+            *s += t["weight"].as_f64().unwrap() * t["value"][k].as_f64().unwrap();
+        }
+    }
+    for (k, s) in sum.iter().enumerate() {
+        let value = lookup["value"][k].as_f64().unwrap();
+        assert!(
+            (s - value).abs() < 1e-3 * value.max(0.01),
+            "{k}: {s} vs {value}"
+        );
+    }
+}
+
+#[test]
 fn mirror_sphere_in_the_environment_scene() {
     let s = scene("environment");
     insta::assert_snapshot!(explain(&[

@@ -71,7 +71,8 @@ pub use hit::Hit;
 pub use offset::{offset_ray_origin, offset_ray_origins, spawn_ray, spawn_ray_to, RayTarget};
 pub use ray::Ray;
 pub use shape_list::{
-    ClosestExplained, ClosestLanes, ObjectRef, ObjectTest, Occluders, PrimitiveHit, ShapeList,
+    BvhRef, BvhVisit, ChildVisit, ClosestExplained, ClosestLanes, LeafPrimitive, ObjectRef,
+    ObjectTest, Occluders, PrimitiveHit, ShapeList,
 };
 pub use shapes::{triangle, triangle_packet};
 pub use shapes::{

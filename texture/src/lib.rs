@@ -43,7 +43,7 @@ pub use environment::{
 pub use image_texture::{ImageTexture, TextureFilter, TextureImage};
 pub use io::{load_image, srgb_to_linear, ImageLoadError, MAX_IMAGE_SIDE, MAX_IMAGE_TEXELS};
 pub use lookup::{LookupExplained, TexelRead};
-pub use mipmap::MipMap;
+pub use mipmap::{EwaExplained, EwaFallback, EwaRead, EwaTexel, MipMap};
 pub use texcoord::TexCoord;
 
 #[cfg(doctest)]

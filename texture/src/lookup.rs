@@ -4,6 +4,7 @@
 
 use crate::image::reduce_st;
 use crate::image_texture::{to_st, ImageTexture, TextureFilter};
+use crate::mipmap::{EwaFallback, EwaRead};
 use crate::{TexCoord, Texture};
 use glam::{Vec2, Vec3};
 
@@ -37,8 +38,8 @@ pub struct LookupExplained {
     /// from half the longer axis (never below the shorter one), EWA from the
     /// (clamped) minor axis.
     pub glint_level: Option<f32>,
-    /// The texels read and their weights, for nearest, bilinear and trilinear
-    /// lookups (EWA's ellipse reads too many to list).
+    /// The texels read and their weights in the result (for EWA, every texel
+    /// of the ellipse in each level read).
     pub texels: Vec<TexelRead>,
     /// For an analytic checkerboard, the fraction of the footprint on the
     /// second color.
@@ -119,6 +120,15 @@ fn explain_image(t: &ImageTexture, tc: &TexCoord, out: &mut LookupExplained) {
             });
         }
     };
+    let mut trilinear = |level: f32| {
+        let last = t.image.pyramid().levels().len() - 1;
+        let lower = (level as usize).min(last);
+        let frac = level - lower as f32;
+        bilinear(lower, 1.0 - frac);
+        if frac > 0.0 {
+            bilinear((lower + 1).min(last), frac);
+        }
+    };
     match t.filter {
         TextureFilter::Nearest => {
             let p = (reduced * image.size()).floor();
@@ -132,17 +142,43 @@ fn explain_image(t: &ImageTexture, tc: &TexCoord, out: &mut LookupExplained) {
             });
         }
         TextureFilter::Bilinear => bilinear(0, 1.0),
-        TextureFilter::Trilinear => {
-            let level = out.glint_level.unwrap_or(0.0);
-            let last = t.image.pyramid().levels().len() - 1;
-            let lower = (level as usize).min(last);
-            let frac = level - lower as f32;
-            bilinear(lower, 1.0 - frac);
-            if frac > 0.0 {
-                bilinear((lower + 1).min(last), frac);
+        TextureFilter::Trilinear => trilinear(out.glint_level.unwrap_or(0.0)),
+        TextureFilter::Ewa => match t
+            .image
+            .pyramid()
+            .ewa_explained(st, dst0, dst1, t.wrap)
+            .reads
+        {
+            EwaRead::Texels(texels) => {
+                let levels = t.image.pyramid().levels();
+                out.texels.extend(texels.iter().map(|e| TexelRead {
+                    level: e.level,
+                    x: e.x,
+                    y: e.y,
+                    weight: e.weight,
+                    value: levels[e.level].texel_wrapped(e.x, e.y, t.wrap),
+                }));
             }
-        }
-        TextureFilter::Ewa => {}
+            EwaRead::Fallback(EwaFallback::Bilinear) => {
+                out.kind = "ewa (zero footprint: bilinear)".into();
+                bilinear(0, 1.0);
+            }
+            EwaRead::Fallback(EwaFallback::LastLevel) => {
+                out.kind = "ewa (past the last level: its one texel)".into();
+                let levels = t.image.pyramid().levels();
+                out.texels.push(TexelRead {
+                    level: levels.len() - 1,
+                    x: 0,
+                    y: 0,
+                    weight: 1.0,
+                    value: levels[levels.len() - 1].texel(0, 0),
+                });
+            }
+            EwaRead::Fallback(EwaFallback::Trilinear { width }) => {
+                out.kind = "ewa (ellipse too large: trilinear)".into();
+                trilinear(t.image.pyramid().level_for_width(width));
+            }
+        },
     }
 }
 
@@ -161,11 +197,25 @@ mod tests {
             duvdx: Vec2::new(0.09, 0.01),
             duvdy: Vec2::new(-0.02, 0.05),
         };
+        let footprints = [
+            (tc.duvdx, tc.duvdy),
+            // A needle, its minor axis lengthened to an eighth of the major.
+            (Vec2::new(0.3, 0.05), Vec2::new(0.0, 0.001)),
+            // Zero: EWA falls back to bilinear; huge: past the last level.
+            (Vec2::ZERO, Vec2::ZERO),
+            (Vec2::new(40.0, 0.0), Vec2::new(0.0, 40.0)),
+        ];
         for filter in [
             TextureFilter::Nearest,
             TextureFilter::Bilinear,
             TextureFilter::Trilinear,
-        ] {
+            TextureFilter::Ewa,
+        ]
+        .into_iter()
+        .flat_map(|filter| footprints.into_iter().enumerate().map(move |f| (filter, f)))
+        {
+            let (filter, (footprint, (duvdx, duvdy))) = filter;
+            let tc = TexCoord { duvdx, duvdy, ..tc };
             let texture =
                 Texture::Image(ImageTexture::new(image.clone(), WrapMode::Repeat, filter));
             let explained = texture.explain(&tc);
@@ -179,7 +229,18 @@ mod tests {
                 explained.value
             );
             let weights: f32 = explained.texels.iter().map(|t| t.weight).sum();
-            assert!((weights - 1.0).abs() < 1e-5);
+            assert!(
+                (weights - 1.0).abs() < 1e-5,
+                "{filter:?}: weights {weights}"
+            );
+            if filter == TextureFilter::Ewa {
+                let (kind, texels) = (explained.kind.as_str(), explained.texels.len());
+                match footprint {
+                    0 | 1 => assert!(kind == "ewa" && texels > 4, "{kind}: {texels} texels"),
+                    2 => assert!(kind.contains("bilinear") && texels == 4, "{kind}"),
+                    _ => assert!(kind.contains("last level") && texels == 1, "{kind}"),
+                }
+            }
         }
         // The report's level is the longer axis in texels, log2(0.0906 · 16).
         let t = Texture::Image(ImageTexture::new(

@@ -35,6 +35,7 @@
 //! - `traversal_stack`: the children still to visit, front to back.
 //! - `traversal`: the single-ray queries.
 //! - `stream`: traversal of a batch of rays, interleaved.
+//! - `trail`: the steps of one query, recorded for `glint explain`.
 //! - `stats`: [`BvhStats`].
 //! - `tests` and `test_support`: tests of the tree as built (the queries' tests
 //!   sit beside them, in `traversal` and `stream`).
@@ -50,6 +51,7 @@ mod stream;
 pub(crate) mod test_support;
 #[cfg(test)]
 mod tests;
+mod trail;
 mod traversal;
 mod traversal_stack;
 mod wide;
@@ -57,6 +59,7 @@ mod wide;
 pub use bounds::Bounds3;
 pub use stats::BvhStats;
 pub use stream::{RayStream, LEAF_PREFETCH_LINES, STREAM_LANES};
+pub use trail::{record_steps, BvhChild, BvhStep, ChildTest};
 use wide::WideBvh;
 pub use wide::LEAF_WIDTH;
 

@@ -3,6 +3,7 @@
 //! children), with the hit children of each node prefetched.
 
 use super::prepared_ray::PreparedRay;
+use super::trail;
 use super::traversal_stack::TraversalStack;
 use super::wide::{self, Link};
 use super::Bvh;
@@ -150,13 +151,20 @@ impl Bvh {
         read_ahead: impl FnOnce(&wide::WideNode, u32),
     ) -> ControlFlow<(), Option<Link>> {
         if link.is_leaf() {
-            count(|c| c.bvh_leaves += 1);
+            count(|c| {
+                c.bvh_leaves += 1;
+                trail::record_leaf(link, *t_max);
+            });
             *t_max = visit_leaf(link, *t_max)?;
             return ControlFlow::Continue(stack.pop_before(*t_max));
         }
-        count(|c| c.bvh_nodes += 1);
         let node = &self.tree.nodes[link.node()];
-        ControlFlow::Continue(match ray.enters(node, *t_max) {
+        let (hits, enter) = ray.enters(node, *t_max);
+        count(|c| {
+            c.bvh_nodes += 1;
+            trail::record_node(link, node, hits, enter);
+        });
+        ControlFlow::Continue(match (hits, enter) {
             (0, _) => stack.pop_before(*t_max),
             (hits, enter) => {
                 read_ahead(node, hits);

@@ -19,7 +19,7 @@ mod linear;
 mod occluders;
 
 pub use closest::{ClosestLanes, PrimitiveHit};
-pub use explain::{ClosestExplained, ObjectTest};
+pub use explain::{BvhRef, BvhVisit, ChildVisit, ClosestExplained, LeafPrimitive, ObjectTest};
 pub use occluders::Occluders;
 
 use crate::bvh::Bvh;

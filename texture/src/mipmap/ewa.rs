@@ -45,25 +45,57 @@ impl MipMap {
     /// Gaussian-weighted averages of levels `⌊ℓ⌋` and `⌊ℓ⌋ + 1` (see `ewa_in_level`)
     /// are blended by `ℓ − ⌊ℓ⌋`. A zero footprint gives bilinear at level 0.
     pub fn ewa(&self, st: Vec2, dst0: Vec2, dst1: Vec2, wrap: WrapMode) -> Vec3 {
+        self.ewa_with(st, dst0, dst1, wrap, &mut ())
+    }
+
+    /// [`MipMap::ewa`], with what it read: each texel of the ellipse in each
+    /// level with its share of the result, or the filter it fell back to.
+    pub fn ewa_explained(&self, st: Vec2, dst0: Vec2, dst1: Vec2, wrap: WrapMode) -> EwaExplained {
+        let mut reads = EwaReads::default();
+        let value = self.ewa_with(st, dst0, dst1, wrap, &mut reads);
+        EwaExplained {
+            value,
+            reads: reads.finish(),
+        }
+    }
+
+    /// [`MipMap::ewa`] telling `sink` what it reads.
+    #[inline(always)]
+    fn ewa_with(
+        &self,
+        st: Vec2,
+        dst0: Vec2,
+        dst1: Vec2,
+        wrap: WrapMode,
+        sink: &mut impl EwaSink,
+    ) -> Vec3 {
         let Some(axes) = EwaAxes::new(dst0, dst1) else {
+            sink.fallback(EwaFallback::Bilinear);
             return self.bilinear(0, st, wrap);
         };
         let level = self.level_for_width(axes.minor.length());
         let lower = level as usize;
         if lower >= self.last_level() {
+            sink.fallback(EwaFallback::LastLevel);
             return self.levels[self.last_level()].texel(0, 0);
         }
         let st = reduce_st(st, wrap);
         let frac = level - lower as f32;
-        let fine = ewa_in_level(&self.levels[lower], st, axes, wrap);
+        sink.level(lower, if frac > 0.0 { 1.0 - frac } else { 1.0 });
+        let fine = ewa_in_level(&self.levels[lower], st, axes, wrap, sink);
         let coarse = if frac > 0.0 {
-            ewa_in_level(&self.levels[lower + 1], st, axes, wrap)
+            sink.level(lower + 1, frac);
+            ewa_in_level(&self.levels[lower + 1], st, axes, wrap, sink)
         } else {
             fine
         };
         match (fine, coarse) {
             (Some(fine), Some(coarse)) => lerp(fine, coarse, frac),
-            _ => self.trilinear(st, axes.major.length(), wrap),
+            _ => {
+                let width = axes.major.length();
+                sink.fallback(EwaFallback::Trilinear { width });
+                self.trilinear(st, width, wrap)
+            }
         }
     }
 
@@ -71,6 +103,111 @@ impl MipMap {
     /// `log2(|minor| · max(w0, h0))` of the clamped minor axis, in `[0, level_count − 1]`.
     pub fn ewa_level(&self, dst0: Vec2, dst1: Vec2) -> f32 {
         EwaAxes::new(dst0, dst1).map_or(0.0, |axes| self.level_for_width(axes.minor.length()))
+    }
+}
+
+/// What an EWA lookup read ([`MipMap::ewa_explained`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EwaExplained {
+    /// [`MipMap::ewa`]'s result.
+    pub value: Vec3,
+    pub reads: EwaRead,
+}
+
+/// The texels an EWA lookup averaged, or the filter it used instead.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EwaRead {
+    /// The texels inside the ellipse in one level or two, each with its share
+    /// of the result: its Gaussian weight over its level's sum, times the
+    /// level's blend weight. The shares add up to 1.
+    Texels(Vec<EwaTexel>),
+    /// The lookup was not an ellipse average.
+    Fallback(EwaFallback),
+}
+
+/// One texel of an EWA average.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EwaTexel {
+    pub level: usize,
+    /// Texel coordinates before wrapping.
+    pub x: i64,
+    pub y: i64,
+    /// The texel's share of the result.
+    pub weight: f32,
+}
+
+/// What an EWA lookup did instead of averaging an ellipse.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EwaFallback {
+    /// A zero footprint: bilinear in level 0.
+    Bilinear,
+    /// A footprint past the last level: its one texel.
+    LastLevel,
+    /// An ellipse whose box held more than 4096 texels (the clamps rule it
+    /// out): trilinear over the major axis, `width` long.
+    Trilinear { width: f32 },
+}
+
+/// Sees what [`MipMap::ewa_with`] reads; `()` sees nothing and costs nothing.
+trait EwaSink {
+    /// Level `level` is read next; its mean enters the result with weight `blend`.
+    #[inline(always)]
+    fn level(&mut self, _level: usize, _blend: f32) {}
+    /// A texel of the current level with its Gaussian weight.
+    #[inline(always)]
+    fn texel(&mut self, _x: i64, _y: i64, _weight: f32) {}
+    #[inline(always)]
+    fn fallback(&mut self, _fallback: EwaFallback) {}
+}
+
+impl EwaSink for () {}
+
+/// An [`EwaSink`] keeping every read, for [`MipMap::ewa_explained`].
+#[derive(Default)]
+struct EwaReads {
+    /// Per level read: (level, blend, its texels with their Gaussian weights).
+    levels: Vec<(usize, f32, Vec<EwaTexel>)>,
+    fallback: Option<EwaFallback>,
+}
+
+impl EwaSink for EwaReads {
+    fn level(&mut self, level: usize, blend: f32) {
+        self.levels.push((level, blend, Vec::new()));
+    }
+
+    fn texel(&mut self, x: i64, y: i64, weight: f32) {
+        if let Some((level, _, texels)) = self.levels.last_mut() {
+            texels.push(EwaTexel {
+                level: *level,
+                x,
+                y,
+                weight,
+            });
+        }
+    }
+
+    fn fallback(&mut self, fallback: EwaFallback) {
+        self.fallback = Some(fallback);
+    }
+}
+
+impl EwaReads {
+    /// Each texel's Gaussian weight turned into its share of the result. (A
+    /// level always holds a texel of positive weight: the ellipse contains the
+    /// unit disc around the lookup point, and with it a texel centre.)
+    fn finish(self) -> EwaRead {
+        if let Some(fallback) = self.fallback {
+            return EwaRead::Fallback(fallback);
+        }
+        let mut shares = Vec::new();
+        for (_, blend, texels) in self.levels {
+            let sum: f32 = texels.iter().map(|t| t.weight).sum();
+            shares.extend(texels.into_iter().map(|t| EwaTexel {
+                weight: blend * t.weight / sum,
+                ..t
+            }));
+        }
+        EwaRead::Texels(shares)
     }
 }
 
@@ -139,7 +276,15 @@ fn ewa_weights() -> &'static [f32; EWA_LUT_SIZE] {
 /// half-sides `√C` in x and `√A` in y. Each texel inside, at `r² = (A x² + B x y + C y²)/F`,
 /// gets the Gaussian weight from [`ewa_weights`]; the result is the weighted mean.
 /// `None` if the box holds more than [`EWA_MAX_TEXELS`] texels.
-fn ewa_in_level(image: &Image, st: Vec2, axes: EwaAxes, wrap: WrapMode) -> Option<Vec3> {
+/// `sink` sees each texel with its weight.
+#[inline(always)]
+fn ewa_in_level(
+    image: &Image,
+    st: Vec2,
+    axes: EwaAxes,
+    wrap: WrapMode,
+    sink: &mut impl EwaSink,
+) -> Option<Vec3> {
     let res = image.size();
     let p = st * res - 0.5;
     let (a, b) = (axes.major * res, axes.minor * res);
@@ -167,6 +312,7 @@ fn ewa_in_level(image: &Image, st: Vec2, axes: EwaAxes, wrap: WrapMode) -> Optio
                 let weight = lut[((r2 * EWA_LUT_SIZE as f32) as usize).min(EWA_LUT_SIZE - 1)];
                 sum += weight * image.texel_wrapped(x, y, wrap);
                 sum_weights += weight;
+                sink.texel(x, y, weight);
             }
         }
     }
@@ -231,7 +377,7 @@ mod tests {
             major: Vec2::new(4.0, 4.0),
             minor: Vec2::new(0.5, -0.5),
         };
-        assert!(ewa_in_level(image, Vec2::splat(0.5), needle, WrapMode::Repeat).is_none());
+        assert!(ewa_in_level(image, Vec2::splat(0.5), needle, WrapMode::Repeat, &mut ()).is_none());
         // Through `ewa` the clamps keep it small: the same lookup still gives a
         // finite blur of the two colors.
         let v = mip.ewa(Vec2::splat(0.5), needle.major, Vec2::ZERO, WrapMode::Repeat);
@@ -243,7 +389,8 @@ mod tests {
             &mip.levels()[level],
             Vec2::splat(0.5),
             axes,
-            WrapMode::Clamp
+            WrapMode::Clamp,
+            &mut ()
         )
         .is_some());
     }

@@ -20,6 +20,8 @@ mod single_level;
 mod test_support;
 mod trilinear;
 
+pub use ewa::{EwaExplained, EwaFallback, EwaRead, EwaTexel};
+
 use crate::Image;
 
 /// An image pyramid from the full-resolution image down to 1×1.

@@ -3,6 +3,7 @@
 
 use crate::Stage;
 use glam::{Vec2, Vec3};
+use glint_geometry::{BvhRef, BvhVisit};
 use glint_texture::LookupExplained;
 use serde_json::{json, Value};
 
@@ -24,6 +25,52 @@ pub(crate) fn v2(v: Vec2) -> Value {
 
 pub(crate) fn v3(v: Vec3) -> Value {
     Value::Array(vec![num(v.x), num(v.y), num(v.z)])
+}
+
+/// A BVH node or leaf as `{"node": i}` or `{"leaf": i}`.
+fn bvh_ref(r: BvhRef) -> Value {
+    match r {
+        BvhRef::Node(node) => json!({ "node": node }),
+        BvhRef::Leaf(leaf) => json!({ "leaf": leaf }),
+    }
+}
+
+/// The query's path through the BVH, one entry per step.
+pub(crate) fn bvh_path(visits: &[BvhVisit]) -> Value {
+    let step = |v: &BvhVisit| match v {
+        BvhVisit::Node {
+            node,
+            depth,
+            children,
+        } => {
+            let children: Vec<Value> = children
+                .iter()
+                .map(|c| {
+                    let mut child = bvh_ref(c.child);
+                    child["enter"] = c.enter.map_or(Value::Null, num);
+                    child["visited"] = json!(c.visited);
+                    child
+                })
+                .collect();
+            json!({ "node": node, "depth": depth, "children": children })
+        }
+        BvhVisit::Leaf {
+            leaf,
+            depth,
+            primitives,
+            t_max,
+        } => {
+            let primitives: Vec<Value> = primitives
+                .iter()
+                .map(|p| match p.triangle {
+                    Some(triangle) => json!({ "object": p.object, "triangle": triangle }),
+                    None => json!({ "object": p.object }),
+                })
+                .collect();
+            json!({ "leaf": leaf, "depth": depth, "t_max": num(*t_max), "primitives": primitives })
+        }
+    };
+    Value::Array(visits.iter().map(step).collect())
 }
 
 /// What a texture lookup read.

@@ -226,6 +226,7 @@ fn ray_record(
                 "shape_tests": w.shape_tests() - w.triangle_tests,
                 "triangle_tests": w.triangle_tests,
             },
+            "bvh": json::bvh_path(&explained.bvh),
             "hit": hit.map(|h| json!({
                 "object": h.shape,
                 "kind": object_kind(scene, h),

@@ -106,6 +106,66 @@ fn camera(out: &mut String, c: &Value) {
     }
 }
 
+/// The BVH path, a step per line, indented by depth below the root.
+fn bvh_text(out: &mut String, sub: &str, path: &Value) {
+    let Some(steps) = path.as_array().filter(|s| !s.is_empty()) else {
+        return;
+    };
+    writeln!(out, "{sub}BVH path, nearest child first").unwrap();
+    let name = |v: &Value| match (&v["node"], &v["leaf"]) {
+        (Value::Null, leaf) => format!("leaf {leaf}"),
+        (node, _) => format!("node {node}"),
+    };
+    for step in steps {
+        let depth = step["depth"].as_u64().unwrap_or(0) as usize;
+        let at = format!("{sub}  {}", "  ".repeat(depth));
+        if step["node"].is_null() {
+            let primitives = leaf_primitives_text(&step["primitives"]);
+            let limit = match &step["t_max"] {
+                Value::Null => "no hit yet".to_owned(),
+                t => format!("nearest so far t = {}", f(t)),
+            };
+            writeln!(out, "{at}{} ({limit}): tests {}", name(step), primitives).unwrap();
+        } else {
+            let children: Vec<String> = step["children"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .map(|c| match (&c["enter"], &c["visited"]) {
+                    (Value::Null, _) => format!("{} missed", name(c)),
+                    (t, Value::Bool(true)) => format!("{} at t = {}", name(c), f(t)),
+                    (t, _) => format!("{} at t = {} (pruned)", name(c), f(t)),
+                })
+                .collect();
+            writeln!(out, "{at}{}: {}", name(step), children.join(", ")).unwrap();
+        }
+    }
+}
+
+/// A leaf's primitives, a mesh's triangles after their object:
+/// `object 1 triangles 4, 5, object 3`.
+fn leaf_primitives_text(primitives: &Value) -> String {
+    let mut groups: Vec<(Value, Vec<String>)> = Vec::new();
+    for p in primitives.as_array().into_iter().flatten() {
+        let triangle = (!p["triangle"].is_null()).then(|| p["triangle"].to_string());
+        match groups.last_mut() {
+            Some((object, triangles)) if *object == p["object"] && triangle.is_some() => {
+                triangles.extend(triangle)
+            }
+            _ => groups.push((p["object"].clone(), triangle.into_iter().collect())),
+        }
+    }
+    let parts: Vec<String> = groups
+        .iter()
+        .map(|(object, triangles)| match triangles.len() {
+            0 => format!("object {object}"),
+            1 => format!("object {object} triangle {}", triangles[0]),
+            _ => format!("object {object} triangles {}", triangles.join(", ")),
+        })
+        .collect();
+    parts.join(", ")
+}
+
 fn ray_text(out: &mut String, ray: &Value) {
     let depth = ray["depth"].as_u64().unwrap_or(0) as usize;
     let indent = "  ".repeat(2 * depth + 1);
@@ -146,6 +206,7 @@ fn ray_text(out: &mut String, ray: &Value) {
             w["bvh_nodes"], w["bvh_leaves"], w["shape_tests"], w["triangle_tests"]
         )
         .unwrap();
+        bvh_text(out, &sub, &i["bvh"]);
         match &i["hit"] {
             Value::Null => writeln!(out, "{sub}no hit").unwrap(),
             h => {
@@ -269,20 +330,69 @@ fn texture(out: &mut String, t: &Value, indent: &str) {
                 ("second_color_fraction", "second color's fraction"),
             ],
         );
-        for texel in l["texels"].as_array().into_iter().flatten() {
-            writeln!(
-                out,
-                "{deeper}texel ({}, {}) of level {}: weight {}, value {}",
-                texel["x"],
-                texel["y"],
-                texel["level"],
-                f(&texel["weight"]),
-                f(&texel["value"])
-            )
-            .unwrap();
-        }
+        texels_text(out, &deeper, &l["texels"]);
     }
     pairs(out, &sub, t, &[("kd", "kd"), ("ks", "ks")]);
+}
+
+/// Texels listed in full up to this many; beyond (an EWA ellipse), each
+/// level's count and share and the heaviest texels.
+const TEXELS_LISTED: usize = 16;
+
+/// The texels a lookup read, with their weights.
+fn texels_text(out: &mut String, indent: &str, texels: &Value) {
+    let texels: Vec<&Value> = texels.as_array().into_iter().flatten().collect();
+    if texels.len() <= TEXELS_LISTED {
+        texels.iter().for_each(|t| texel_line(out, indent, t));
+        return;
+    }
+    let weight = |t: &Value| t["weight"].as_f64().unwrap_or(0.0);
+    let mut levels: Vec<(u64, usize, f64)> = Vec::new();
+    for t in &texels {
+        let level = t["level"].as_u64().unwrap_or(0);
+        match levels.iter_mut().find(|(l, _, _)| *l == level) {
+            Some((_, count, sum)) => {
+                *count += 1;
+                *sum += weight(t);
+            }
+            None => levels.push((level, 1, weight(t))),
+        }
+    }
+    for (level, count, sum) in levels {
+        let sum = crate::json::num(sum as f32);
+        writeln!(
+            out,
+            "{indent}level {level}: {count} texels, weights adding up to {}",
+            f(&sum)
+        )
+        .unwrap();
+    }
+    let mut heaviest = texels.clone();
+    heaviest.sort_by(|a, b| weight(b).total_cmp(&weight(a)));
+    writeln!(out, "{indent}the {} heaviest:", TEXELS_LISTED / 2).unwrap();
+    let deeper = format!("{indent}  ");
+    for t in &heaviest[..TEXELS_LISTED / 2] {
+        texel_line(out, &deeper, t);
+    }
+    writeln!(
+        out,
+        "{indent}and {} more (the JSON lists every texel)",
+        texels.len() - TEXELS_LISTED / 2
+    )
+    .unwrap();
+}
+
+fn texel_line(out: &mut String, indent: &str, texel: &Value) {
+    writeln!(
+        out,
+        "{indent}texel ({}, {}) of level {}: weight {}, value {}",
+        texel["x"],
+        texel["y"],
+        texel["level"],
+        f(&texel["weight"]),
+        f(&texel["value"])
+    )
+    .unwrap();
 }
 
 fn shadow(s: &Value) -> String {

@@ -52,18 +52,20 @@ fn textured_ground_with_its_mip_levels_and_texels() {
     insta::assert_snapshot!(explain(&[&s, "--pixel", "80,200"]));
 }
 
+/// A ground pixel whose EWA ellipse crosses a check edge (after the scene).
+const EWA_ACROSS_AN_EDGE: [&str; 6] = [
+    "--pixel",
+    "40,200",
+    "--texture-filter",
+    "ewa",
+    "--stage",
+    "texture",
+];
+
 #[test]
 fn ewa_lookup_across_a_check_edge() {
     let s = scene("ground-mipmap");
-    let text = explain(&[
-        &s,
-        "--pixel",
-        "40,200",
-        "--texture-filter",
-        "ewa",
-        "--stage",
-        "texture",
-    ]);
+    let text = explain(&[&[s.as_str()][..], &EWA_ACROSS_AN_EDGE].concat());
     assert!(text.contains("texels, weights adding up to"), "{text}");
     insta::assert_snapshot!(text);
 }
@@ -87,15 +89,7 @@ fn the_json_lists_the_bvh_path_and_every_texel_of_an_ellipse() {
         .is_some_and(|p| p.iter().any(|p| p["triangle"] == *triangle))));
     // An EWA lookup: the listed texels' weighted values make the filtered value.
     let s = scene("ground-mipmap");
-    let doc = json(&[
-        &s,
-        "--pixel",
-        "40,200",
-        "--texture-filter",
-        "ewa",
-        "--stage",
-        "texture",
-    ]);
+    let doc = json(&[&[s.as_str()][..], &EWA_ACROSS_AN_EDGE].concat());
     let lookup = &doc["samples"][0]["ray"]["texture"]["diffuse"];
     let texels = lookup["texels"].as_array().unwrap();
     assert!(texels.len() > 16, "{} texels", texels.len());

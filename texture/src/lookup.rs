@@ -164,7 +164,7 @@ fn explain_image(t: &ImageTexture, tc: &TexCoord, out: &mut LookupExplained) {
                 bilinear(0, 1.0);
             }
             EwaRead::Fallback(EwaFallback::LastLevel) => {
-                out.kind = "ewa (past the last level: its one texel)".into();
+                out.kind = "ewa (at the last level: its one texel)".into();
                 let levels = t.image.pyramid().levels();
                 out.texels.push(TexelRead {
                     level: levels.len() - 1,

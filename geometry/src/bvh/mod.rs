@@ -14,7 +14,8 @@
 //! Traversal (pbrt-v4 §7.3.5, for four children) tests a node's children against
 //! the ray, descends into the nearest and keeps the others on a fixed-size stack,
 //! farthest first, with their entry distances, so that they are dropped once a
-//! closer hit is known. Nothing is allocated per ray.
+//! closer hit is known. Nothing is allocated per ray (except while
+//! [`record_steps`] records a query's path).
 //!
 //! The primitives themselves stay with the caller: [`Bvh::closest_hit`] and
 //! [`Bvh::any_hit`] take the primitive intersection test as a closure, and report

@@ -4,11 +4,14 @@
 //!
 //! Recording rides on the query counters: a step is recorded only where it is
 //! counted, inside the one branch counting already takes, so a render that
-//! neither counts nor records runs the same instructions as before.
+//! neither counts nor records runs the same instructions as before, and one
+//! that counts (`--stats`) pays one relaxed load per step.
 
 use super::wide::{Link, WideNode};
+use crate::CountingGuard;
 use glam::Vec4;
 use std::cell::RefCell;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// What a node holds in one of its child slots.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,8 +49,8 @@ pub enum BvhStep {
     /// Interior node `node`: its used children, in slot order, with the ray's
     /// verdict on each box.
     Node { node: u32, children: Vec<ChildTest> },
-    /// A leaf reached, with the query's limit (the nearest hit so far, or the
-    /// ray's end) as it was entered.
+    /// A leaf reached, with the query's limit as it was entered: the ray's
+    /// end, or (for a closest-hit query) just past the nearest hit so far.
     Leaf { first: u32, count: u32, t_max: f32 },
 }
 
@@ -56,15 +59,53 @@ thread_local! {
     static TRAIL: RefCell<Option<Vec<BvhStep>>> = const { RefCell::new(None) };
 }
 
+/// How many threads are inside [`record_steps`].
+static RECORDING: AtomicUsize = AtomicUsize::new(0);
+
+/// Whether any thread records now; checked only where counting is on.
+#[inline(always)]
+pub(super) fn recording() -> bool {
+    RECORDING.load(Ordering::Relaxed) != 0
+}
+
 /// Runs `query` and returns, with its result, every BVH step made on this
 /// thread meanwhile, in order. Also turns the query counters on
-/// ([`crate::CountingGuard`]), since steps are recorded where they are counted.
+/// ([`CountingGuard`]), since steps are recorded where they are counted.
+///
+/// For one single-ray query at a time: a stream's rays would interleave
+/// their steps. A call nested in another's `query` keeps its steps to itself.
 pub fn record_steps<R>(query: impl FnOnce() -> R) -> (R, Vec<BvhStep>) {
-    let _counting = crate::CountingGuard::start();
-    let outer = TRAIL.with(|t| t.replace(Some(Vec::new())));
+    let recording = Recording::start();
     let result = query();
-    let steps = TRAIL.with(|t| t.replace(outer)).unwrap_or_default();
-    (result, steps)
+    (result, recording.finish())
+}
+
+/// This thread records while it lives; dropping it, also on unwind, gives
+/// back what an outer recording had.
+struct Recording {
+    outer: Option<Vec<BvhStep>>,
+    _counting: CountingGuard,
+}
+
+impl Recording {
+    fn start() -> Recording {
+        let _counting = CountingGuard::start();
+        RECORDING.fetch_add(1, Ordering::Relaxed);
+        let outer = TRAIL.with(|t| t.replace(Some(Vec::new())));
+        Recording { outer, _counting }
+    }
+
+    /// The steps recorded.
+    fn finish(self) -> Vec<BvhStep> {
+        TRAIL.with(|t| t.borrow_mut().take()).unwrap_or_default()
+    }
+}
+
+impl Drop for Recording {
+    fn drop(&mut self) {
+        TRAIL.with(|t| *t.borrow_mut() = self.outer.take());
+        RECORDING.fetch_sub(1, Ordering::Relaxed);
+    }
 }
 
 /// Records a node's test, if [`record_steps`] is running on this thread. Called
@@ -162,5 +203,27 @@ mod tests {
         }
         // Outside record_steps nothing is kept.
         assert!(TRAIL.with(|t| t.borrow().is_none()));
+    }
+
+    #[test]
+    fn a_nested_or_panicking_recording_leaves_the_outer_one_as_it_was() {
+        let bounds = random_boxes(500, 20.0, 0.1, 2.0, 4);
+        let bvh = Bvh::build(&bounds);
+        let ray = Ray::new(glam::Vec3::splat(-5.0), glam::Vec3::ONE);
+        let query = || bvh.any_hit(&ray, f32::INFINITY, |_, _, _| false);
+        let (_, alone) = record_steps(query);
+        assert!(!alone.is_empty());
+        let ((_, inner), outer) = record_steps(|| {
+            query();
+            let inner = record_steps(query);
+            query();
+            inner
+        });
+        assert_eq!(inner, alone);
+        assert_eq!(outer, [&alone[..], &alone[..]].concat());
+        let panicked = std::panic::catch_unwind(|| record_steps(|| panic!("in the query")));
+        assert!(panicked.is_err());
+        assert!(TRAIL.with(|t| t.borrow().is_none()));
+        assert_eq!(record_steps(query).1, alone);
     }
 }

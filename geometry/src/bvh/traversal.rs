@@ -153,7 +153,9 @@ impl Bvh {
         if link.is_leaf() {
             count(|c| {
                 c.bvh_leaves += 1;
-                trail::record_leaf(link, *t_max);
+                if trail::recording() {
+                    trail::record_leaf(link, *t_max);
+                }
             });
             *t_max = visit_leaf(link, *t_max)?;
             return ControlFlow::Continue(stack.pop_before(*t_max));
@@ -162,7 +164,9 @@ impl Bvh {
         let (hits, enter) = ray.enters(node, *t_max);
         count(|c| {
             c.bvh_nodes += 1;
-            trail::record_node(link, node, hits, enter);
+            if trail::recording() {
+                trail::record_node(link, node, hits, enter);
+            }
         });
         ControlFlow::Continue(match (hits, enter) {
             (0, _) => stack.pop_before(*t_max),

@@ -4,7 +4,7 @@
 //! tests), read from the query counters.
 
 use super::{Object, PrimitiveHit, ShapeList};
-use crate::bvh::{record_steps, BvhChild, BvhStep, LEAF_WIDTH};
+use crate::bvh::{record_steps, BvhChild, BvhStep, ChildTest, LEAF_WIDTH};
 use crate::counters::{take_counters, QueryCounters};
 use crate::triangle::WatertightRay;
 use crate::{Ray, Shape};
@@ -86,13 +86,32 @@ pub enum BvhVisit {
         children: Vec<ChildVisit>,
     },
     /// A leaf reached, its primitives tested with the query's limit `t_max`
-    /// (the nearest hit so far, or infinity).
+    /// (just past the nearest hit so far, or the `t_max` given to
+    /// [`ShapeList::explain_closest`]).
     Leaf {
         leaf: u32,
         depth: u32,
         primitives: Vec<LeafPrimitive>,
         t_max: f32,
     },
+}
+
+/// The node or leaf a step is at.
+fn step_ref(step: &BvhStep) -> BvhRef {
+    match *step {
+        BvhStep::Node { node, .. } => BvhRef::Node(node),
+        BvhStep::Leaf { first, count, .. } => BvhChild::Leaf { first, count }.into(),
+    }
+}
+
+/// A child's test, and whether one of the `later` steps went into it.
+fn child_visit(test: &ChildTest, later: &[BvhStep]) -> ChildVisit {
+    let child = BvhRef::from(test.child);
+    ChildVisit {
+        child,
+        enter: test.enter,
+        visited: later.iter().any(|s| step_ref(s) == child),
+    }
 }
 
 impl ShapeList {
@@ -118,34 +137,26 @@ impl ShapeList {
 
     /// The recorded steps with depths, visits and leaf primitives filled in.
     fn bvh_visits(&self, steps: &[BvhStep]) -> Vec<BvhVisit> {
-        let reached = |step: &BvhStep| match *step {
-            BvhStep::Node { node, .. } => BvhRef::Node(node),
-            BvhStep::Leaf { first, count, .. } => BvhChild::Leaf { first, count }.into(),
-        };
+        // A step's depth is one more than its parent's, recorded earlier.
         let mut depths = HashMap::from([(BvhRef::Node(0), 0)]);
         steps
             .iter()
             .enumerate()
             .map(|(k, step)| {
-                let depth = depths.get(&reached(step)).copied().unwrap_or(0);
-                match step {
-                    BvhStep::Node { node, children } => BvhVisit::Node {
-                        node: *node,
-                        depth,
-                        children: children
-                            .iter()
-                            .map(|c| {
-                                let child = BvhRef::from(c.child);
-                                depths.insert(child, depth + 1);
-                                ChildVisit {
-                                    child,
-                                    enter: c.enter,
-                                    visited: steps[k + 1..].iter().any(|s| reached(s) == child),
-                                }
-                            })
-                            .collect(),
-                    },
-                    &BvhStep::Leaf {
+                let depth = depths.get(&step_ref(step)).copied().unwrap_or(0);
+                match *step {
+                    BvhStep::Node { node, ref children } => {
+                        let later = &steps[k + 1..];
+                        let children: Vec<ChildVisit> =
+                            children.iter().map(|c| child_visit(c, later)).collect();
+                        depths.extend(children.iter().map(|c| (c.child, depth + 1)));
+                        BvhVisit::Node {
+                            node,
+                            depth,
+                            children,
+                        }
+                    }
+                    BvhStep::Leaf {
                         first,
                         count,
                         t_max,
@@ -325,5 +336,18 @@ mod tests {
             .collect();
         assert_eq!(visited.len(), steps.len() - 1);
         assert!(visited.iter().all(|c| steps[1..].contains(c)));
+        // Each step lies one level below the node that entered it.
+        for (k, v) in bvh.iter().enumerate().skip(1) {
+            let parent = bvh[..k].iter().find_map(|p| match p {
+                BvhVisit::Node {
+                    depth, children, ..
+                } if children.iter().any(|c| c.child == steps[k]) => Some(*depth),
+                _ => None,
+            });
+            let depth = match v {
+                BvhVisit::Node { depth, .. } | BvhVisit::Leaf { depth, .. } => *depth,
+            };
+            assert_eq!(Some(depth), parent.map(|d| d + 1), "step {k}");
+        }
     }
 }

@@ -141,7 +141,7 @@ pub struct EwaTexel {
 pub enum EwaFallback {
     /// A zero footprint: bilinear in level 0.
     Bilinear,
-    /// A footprint past the last level: its one texel.
+    /// A footprint at or past the last level: its one texel.
     LastLevel,
     /// An ellipse whose box held more than 4096 texels (the clamps rule it
     /// out): trilinear over the major axis, `width` long.
@@ -202,6 +202,7 @@ impl EwaReads {
         let mut shares = Vec::new();
         for (_, blend, texels) in self.levels {
             let sum: f32 = texels.iter().map(|t| t.weight).sum();
+            debug_assert!(sum > 0.0, "a level without a weighted texel");
             shares.extend(texels.into_iter().map(|t| EwaTexel {
                 weight: blend * t.weight / sum,
                 ..t
@@ -277,7 +278,6 @@ fn ewa_weights() -> &'static [f32; EWA_LUT_SIZE] {
 /// gets the Gaussian weight from [`ewa_weights`]; the result is the weighted mean.
 /// `None` if the box holds more than [`EWA_MAX_TEXELS`] texels.
 /// `sink` sees each texel with its weight.
-#[inline(always)]
 fn ewa_in_level(
     image: &Image,
     st: Vec2,
@@ -393,6 +393,53 @@ mod tests {
             &mut ()
         )
         .is_some());
+    }
+
+    #[test]
+    fn explained_lookups_are_the_lookups_and_their_shares_make_the_value() {
+        let mip = MipMap::new(Image::from_fn(16, 16, |x, y| {
+            Vec3::new(x as f32, y as f32, ((x * 5 + y * 3) % 7) as f32)
+        }));
+        let footprints = [
+            // Level 0.68: two levels blended.
+            (Vec2::new(0.2, 0.0), Vec2::new(0.0, 0.1)),
+            // A needle across a corner, level 1.3.
+            (Vec2::new(0.5, 0.45), Vec2::new(-0.12, 0.13)),
+            // Exactly level 1: one level read.
+            (Vec2::new(0.125, 0.0), Vec2::new(0.0, 0.125)),
+        ];
+        for wrap in [WrapMode::Repeat, WrapMode::Clamp] {
+            for (k, (d0, d1)) in footprints.into_iter().enumerate() {
+                let st = Vec2::new(0.03 + 0.41 * k as f32, 0.97 - 0.3 * k as f32);
+                let explained = mip.ewa_explained(st, d0, d1, wrap);
+                let value = mip.ewa(st, d0, d1, wrap);
+                assert_eq!(explained.value.to_array(), value.to_array());
+                let EwaRead::Texels(texels) = explained.reads else {
+                    panic!("footprint {k} fell back");
+                };
+                let levels: Vec<usize> = texels.iter().map(|t| t.level).collect();
+                let (first, last) = (levels[0], levels[levels.len() - 1]);
+                let expected = [(0, 1), (1, 2), (1, 1)][k];
+                assert_eq!((first, last), expected, "footprint {k}");
+                let mut sum = Vec3::ZERO;
+                let mut shares = 0.0;
+                for t in &texels {
+                    sum += t.weight * mip.levels()[t.level].texel_wrapped(t.x, t.y, wrap);
+                    shares += t.weight;
+                }
+                assert!((shares - 1.0).abs() < 1e-5, "footprint {k}: {shares}");
+                assert!(
+                    (sum - value).abs().max_element() < 1e-4 * value.max_element(),
+                    "footprint {k}: {sum} against {value}"
+                );
+            }
+        }
+        // A zero footprint falls back to bilinear, a huge one to the last level.
+        let zero = mip.ewa_explained(Vec2::splat(0.3), Vec2::ZERO, Vec2::ZERO, WrapMode::Repeat);
+        assert_eq!(zero.reads, EwaRead::Fallback(EwaFallback::Bilinear));
+        let huge = Vec2::new(3.0, 0.0);
+        let last = mip.ewa_explained(Vec2::splat(0.3), huge, huge.perp(), WrapMode::Repeat);
+        assert_eq!(last.reads, EwaRead::Fallback(EwaFallback::LastLevel));
     }
 
     #[test]

@@ -10,7 +10,8 @@
 //! - `ewa`: the elliptically weighted average.
 //!
 //! Lookups take texture coordinates `st`, where `[0, 1]²` is one copy of the image
-//! and `t = 0` is the top row (see [`Image`]). They never allocate and never panic:
+//! and `t = 0` is the top row (see [`Image`]). They never allocate (but
+//! [`MipMap::ewa_explained`], which lists what it read) and never panic:
 //! NaN or infinite inputs give a finite color.
 
 mod ewa;

@@ -5,9 +5,10 @@
 //! [`explain`] renders the pixel through the integrator's own code with a
 //! tracer ([`glint_integrator::explain_pixel`]: the radiance is the render's,
 //! bit for bit) and adds what the trace does not carry: each object's test
-//! against each ray and the BVH's work
+//! against each ray, the query's path through the BVH and its work
 //! ([`glint_geometry::ShapeList::explain_closest`]), and what each texture
-//! lookup read ([`glint_texture::Texture::explain`]). The result is a JSON
+//! lookup read, every texel of an EWA ellipse included
+//! ([`glint_texture::Texture::explain`]). The result is a JSON
 //! document (schema `glint-explain/1`, documented in
 //! `docs/checking-your-ray-tracer.md`) and its text form.
 //!

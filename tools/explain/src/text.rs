@@ -111,7 +111,7 @@ fn bvh_text(out: &mut String, sub: &str, path: &Value) {
     let Some(steps) = path.as_array().filter(|s| !s.is_empty()) else {
         return;
     };
-    writeln!(out, "{sub}BVH path, nearest child first").unwrap();
+    writeln!(out, "{sub}BVH path, in traversal order").unwrap();
     let name = |v: &Value| match (&v["node"], &v["leaf"]) {
         (Value::Null, leaf) => format!("leaf {leaf}"),
         (node, _) => format!("node {node}"),
@@ -346,16 +346,25 @@ fn texels_text(out: &mut String, indent: &str, texels: &Value) {
         texels.iter().for_each(|t| texel_line(out, indent, t));
         return;
     }
-    let weight = |t: &Value| t["weight"].as_f64().unwrap_or(0.0);
+    texel_levels_text(out, indent, &texels);
+    heaviest_texels_text(out, indent, &texels);
+}
+
+fn texel_weight(texel: &Value) -> f64 {
+    texel["weight"].as_f64().unwrap_or(0.0)
+}
+
+/// Each level's texel count and weight sum, in the order read.
+fn texel_levels_text(out: &mut String, indent: &str, texels: &[&Value]) {
     let mut levels: Vec<(u64, usize, f64)> = Vec::new();
-    for t in &texels {
+    for t in texels {
         let level = t["level"].as_u64().unwrap_or(0);
         match levels.iter_mut().find(|(l, _, _)| *l == level) {
             Some((_, count, sum)) => {
                 *count += 1;
-                *sum += weight(t);
+                *sum += texel_weight(t);
             }
-            None => levels.push((level, 1, weight(t))),
+            None => levels.push((level, 1, texel_weight(t))),
         }
     }
     for (level, count, sum) in levels {
@@ -367,17 +376,22 @@ fn texels_text(out: &mut String, indent: &str, texels: &Value) {
         )
         .unwrap();
     }
-    let mut heaviest = texels.clone();
-    heaviest.sort_by(|a, b| weight(b).total_cmp(&weight(a)));
-    writeln!(out, "{indent}the {} heaviest:", TEXELS_LISTED / 2).unwrap();
+}
+
+/// The heaviest half of [`TEXELS_LISTED`] texels, and how many are left.
+fn heaviest_texels_text(out: &mut String, indent: &str, texels: &[&Value]) {
+    let shown = TEXELS_LISTED / 2;
+    let mut heaviest = texels.to_vec();
+    heaviest.sort_by(|a, b| texel_weight(b).total_cmp(&texel_weight(a)));
+    writeln!(out, "{indent}the {shown} heaviest:").unwrap();
     let deeper = format!("{indent}  ");
-    for t in &heaviest[..TEXELS_LISTED / 2] {
+    for t in &heaviest[..shown] {
         texel_line(out, &deeper, t);
     }
     writeln!(
         out,
         "{indent}and {} more (the JSON lists every texel)",
-        texels.len() - TEXELS_LISTED / 2
+        texels.len() - shown
     )
     .unwrap();
 }

@@ -3,11 +3,11 @@
 //! [`record_steps`]), and its work (BVH nodes and leaves, shape and triangle
 //! tests), read from the query counters.
 
-use super::{Object, PrimitiveHit, ShapeList};
+use super::{Object, ObjectRef, PrimitiveHit, ShapeList};
 use crate::bvh::{record_steps, BvhChild, BvhStep, ChildTest, LEAF_WIDTH};
 use crate::counters::{take_counters, QueryCounters};
 use crate::triangle::WatertightRay;
-use crate::{Ray, Shape};
+use crate::Ray;
 use std::collections::HashMap;
 
 /// One object tested against a ray on its own.
@@ -184,24 +184,15 @@ impl ShapeList {
     }
 
     fn test_object(&self, object: u32, ray: &Ray, t_max: f32) -> ObjectTest {
-        match self.objects[object as usize] {
-            Object::Shape(s) => {
-                let shape = &self.shapes[s as usize];
-                let kind = match shape {
-                    Shape::Sphere(_) => "sphere",
-                    Shape::Parallelogram(_) => "parallelogram",
-                    Shape::Plane(_) => "plane",
-                    Shape::Box(_) => "box",
-                };
-                ObjectTest {
-                    object,
-                    kind,
-                    t: shape.hit_distance(ray, t_max),
-                    triangle: None,
-                }
-            }
-            Object::Mesh(m) => {
-                let mesh = &self.meshes[m as usize];
+        let kind = self.object(object).kind();
+        match self.object(object) {
+            ObjectRef::Shape(shape) => ObjectTest {
+                object,
+                kind,
+                t: shape.hit_distance(ray, t_max),
+                triangle: None,
+            },
+            ObjectRef::Mesh(mesh) => {
                 let watertight = WatertightRay::new(ray);
                 let nearest = (0..mesh.triangle_count() as u32)
                     .filter_map(|i| Some((mesh.hit_distance(i, &watertight, t_max)?, i)))
@@ -211,7 +202,7 @@ impl ShapeList {
                     });
                 ObjectTest {
                     object,
-                    kind: "mesh",
+                    kind,
                     t: nearest.map(|(t, _)| t),
                     triangle: nearest.map(|(_, i)| i),
                 }

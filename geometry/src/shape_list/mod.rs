@@ -42,6 +42,19 @@ pub enum ObjectRef<'a> {
     Mesh(&'a TriangleMesh),
 }
 
+impl ObjectRef<'_> {
+    /// `sphere`, `parallelogram`, `plane`, `box` or `mesh`.
+    pub fn kind(self) -> &'static str {
+        match self {
+            ObjectRef::Shape(Shape::Sphere(_)) => "sphere",
+            ObjectRef::Shape(Shape::Parallelogram(_)) => "parallelogram",
+            ObjectRef::Shape(Shape::Plane(_)) => "plane",
+            ObjectRef::Shape(Shape::Box(_)) => "box",
+            ObjectRef::Mesh(_) => "mesh",
+        }
+    }
+}
+
 /// A primitive the BVH holds: an analytic shape, or one triangle of a mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Primitive {

@@ -230,7 +230,7 @@ fn ray_record(
             "bvh": json::bvh_path(&explained.bvh),
             "hit": hit.map(|h| json!({
                 "object": h.shape,
-                "kind": object_kind(scene, h),
+                "kind": scene.shapes.object(h.shape).kind(),
                 "triangle": h.primitive,
                 "t": num(h.t),
                 "point": v3(h.point),
@@ -249,18 +249,6 @@ fn ray_record(
         record.insert("triangle".into(), json!(h.primitive));
     }
     record
-}
-
-fn object_kind(scene: &Scene, hit: &glint_geometry::Hit) -> &'static str {
-    match scene.shapes.object(hit.shape) {
-        glint_geometry::ObjectRef::Mesh(_) => "mesh",
-        glint_geometry::ObjectRef::Shape(s) => match s {
-            glint_geometry::Shape::Sphere(_) => "sphere",
-            glint_geometry::Shape::Parallelogram(_) => "parallelogram",
-            glint_geometry::Shape::Plane(_) => "plane",
-            glint_geometry::Shape::Box(_) => "box",
-        },
-    }
 }
 
 fn light_kind(light: &Light) -> &'static str {

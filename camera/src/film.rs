@@ -4,10 +4,11 @@
 //! rendered film with its coverage ([`PartialFilm`]) in `partial`.
 
 mod partial;
+mod ppm;
 mod read;
 
 pub use partial::PartialFilm;
-pub use read::{srgb_to_linear, MAX_LOAD_SIDE};
+pub use read::{srgb_to_linear, SampleEncoding, MAX_LOAD_SIDE};
 
 use glam::{UVec2, Vec3};
 use std::io::{Seek, Write};
@@ -42,7 +43,7 @@ pub enum FilmError {
     #[error("{}: unknown output format; expected a .png, .exr or .pfm extension", .0.display())]
     UnknownFormat(PathBuf),
     /// [`Film::load`] was given an extension it does not read.
-    #[error("{}: unknown image format; expected a .png, .jpg, .jpeg, .exr or .pfm extension", .0.display())]
+    #[error("{}: unknown image format; expected a .png, .ppm, .jpg, .jpeg, .exr or .pfm extension", .0.display())]
     UnknownInputFormat(PathBuf),
     /// [`Film::load`] could not open, decode or accept the file.
     #[error("{}: cannot read the image: {message}", path.display())]

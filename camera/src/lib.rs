@@ -25,9 +25,11 @@
 //! - [`Film::new`], [`Film::set_pixel`] or [`Film::pixels_mut`] to fill it, and
 //!   [`Film::save`], whose format ([`ImageFormat`]) follows the file extension;
 //!   [`linear_to_srgb8`] is the PNG writer's transfer curve.
-//! - [`Film::load`] reads a PNG, JPEG, OpenEXR or PFM file back into a film (8-bit
-//!   and 16-bit integers decoded from sRGB with [`srgb_to_linear`], floats kept as
-//!   stored, NaN and negative values included), refusing sides over [`MAX_LOAD_SIDE`].
+//! - [`Film::load`] reads a PNG, PPM (`P6` or `P3`), JPEG, OpenEXR or PFM file back
+//!   into a film (integers decoded from sRGB with [`srgb_to_linear`], floats kept
+//!   as stored, NaN and negative values included), refusing sides over
+//!   [`MAX_LOAD_SIDE`]; [`Film::load_with_encoding`] also says how the file
+//!   stored its samples ([`SampleEncoding`]: the quantisation a grader allows for).
 //! - Errors: [`CameraError`] and [`FilmError`].
 
 mod atomic_file;
@@ -39,7 +41,8 @@ pub use camera::{
     Camera, CameraError, CameraRay, CameraRayDifferential, CameraRayLanes, F32Lanes, LANES,
 };
 pub use film::{
-    linear_to_srgb8, srgb_to_linear, Film, FilmError, ImageFormat, PartialFilm, MAX_LOAD_SIDE,
+    linear_to_srgb8, srgb_to_linear, Film, FilmError, ImageFormat, PartialFilm, SampleEncoding,
+    MAX_LOAD_SIDE,
 };
 
 #[cfg(doctest)]

@@ -3,7 +3,9 @@
 //! other layouts each format allows, and one clear error per bad file.
 
 use glam::{UVec2, Vec3};
-use glint_camera::{linear_to_srgb8, srgb_to_linear, Film, FilmError, MAX_LOAD_SIDE};
+use glint_camera::{
+    linear_to_srgb8, srgb_to_linear, Film, FilmError, SampleEncoding, MAX_LOAD_SIDE,
+};
 use std::path::{Path, PathBuf};
 
 /// A 5 × 3 film (not square, so a row flip shows) of varied values in [0, 1].
@@ -209,7 +211,7 @@ fn unknown_extensions_and_missing_files_are_refused() {
         let message = error(name, b"whatever");
         assert!(
             message.ends_with(
-                "unknown image format; expected a .png, .jpg, .jpeg, .exr or .pfm extension"
+                "unknown image format; expected a .png, .ppm, .jpg, .jpeg, .exr or .pfm extension"
             ),
             "{message}"
         );
@@ -314,4 +316,76 @@ fn a_png_claiming_a_huge_size_is_refused_from_its_header() {
         message.ends_with("cannot read the image: the image is 100000x8, larger than the limit of 16384 pixels a side"),
         "{message}"
     );
+}
+
+/// The 8-bit sRGB codes of `film`, as a PPM in the layout `magic` names.
+fn ppm(film: &Film, magic: &str) -> Vec<u8> {
+    let size = film.resolution();
+    let codes = film.to_srgb8();
+    let mut bytes = format!("{magic}\n# a comment\n{} {}\n255\n", size.x, size.y).into_bytes();
+    match magic {
+        "P6" => bytes.extend(&codes),
+        _ => {
+            for row in codes.chunks(3 * size.x as usize) {
+                let line: Vec<String> = row.iter().map(u8::to_string).collect();
+                bytes.extend(line.join(" ").as_bytes());
+                bytes.push(b'\n');
+            }
+        }
+    }
+    bytes
+}
+
+#[test]
+fn ppm_binary_and_ascii_read_as_the_png_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let film = gradient();
+    let png = Film::load(&saved(&film, dir.path(), "g.png")).unwrap();
+    for magic in ["P6", "P3"] {
+        let path = dir.path().join(format!("{magic}.ppm"));
+        std::fs::write(&path, ppm(&film, magic)).unwrap();
+        let (loaded, encoding) = Film::load_with_encoding(&path).unwrap();
+        assert_eq!(bits(&loaded), bits(&png), "{magic}");
+        assert_eq!(encoding, SampleEncoding::Srgb { max_code: 255 });
+    }
+    let (_, encoding) = Film::load_with_encoding(&dir.path().join("g.png")).unwrap();
+    assert_eq!(encoding, SampleEncoding::Srgb { max_code: 255 });
+    let (_, encoding) = Film::load_with_encoding(&saved(&film, dir.path(), "g.pfm")).unwrap();
+    assert_eq!(encoding, SampleEncoding::Linear);
+}
+
+#[test]
+fn ppm_codes_are_scaled_by_maxval() {
+    // maxval 1000: code 500 is half way in the encoded domain; 16-bit samples
+    // are big-endian.
+    let film = load_bytes("a.ppm", b"P3 2 1 1000 0 500 1000 1000 1000 1000").unwrap();
+    assert_eq!(film.pixel(0, 0).y, srgb_to_linear(0.5));
+    assert_eq!(film.pixel(1, 0), Vec3::ONE);
+    let film = load_bytes("b.ppm", b"P6 1 1 65535 \x80\x00\xff\xff\x00\x00").unwrap();
+    assert_eq!(film.pixel(0, 0).x, srgb_to_linear(32768.0 / 65535.0));
+    assert_eq!((film.pixel(0, 0).y, film.pixel(0, 0).z), (1.0, 0.0));
+}
+
+#[test]
+fn bad_ppm_files_are_refused_with_the_reason() {
+    for (bytes, expected) in [
+        (
+            &b"P6 2 2 255 \x01\x02"[..],
+            "truncated: a 2x2 binary (P6) PPM needs at least 12 bytes",
+        ),
+        (b"P6 16384 16384 255 \x00", "truncated"),
+        (b"P3 1 1 255 1 2", "truncated"),
+        (
+            b"P3 1 1 255 1 2 x  ",
+            "sample 2 is \"x  \", not a whole number",
+        ),
+        (
+            b"P3 1 1 255 1 2 300",
+            "pixel (0, 0) has the sample 300, above the maxval 255",
+        ),
+        (b"P5 1 1 255 \x00", "not a colour PPM file"),
+    ] {
+        let message = error("bad.ppm", bytes);
+        assert!(message.contains(expected), "{message}");
+    }
 }

@@ -25,8 +25,9 @@ pub(crate) struct BenchArgs {
     output: Option<PathBuf>,
 
     /// Sampler strategies to compare, comma-separated: a pattern (grid, random,
-    /// stratified, sobol) for every sample, or PIXEL/LIGHT, or
-    /// PIXEL/LIGHT/ENVIRONMENT
+    /// stratified, sobol) for every sample, pixel, light and environment alike
+    /// (unlike render's --sampler, which sets only the pixel's), or PIXEL/LIGHT
+    /// (the environment following the light), or PIXEL/LIGHT/ENVIRONMENT
     #[arg(
         long,
         value_name = "LIST",

@@ -1,12 +1,15 @@
 //! `glint explain`: every stage's numbers for one pixel.
 
 use crate::render::SceneArgs;
-use crate::{named, Failure};
+use crate::Failure;
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::Args;
-use glint_explain::Stage;
+use glint_explain::against::{self, Node};
+use glint_explain::{Explanation, Stage};
 use glint_integrator::trace::SampleSelection;
 use glint_integrator::ExplainError;
 use std::io::Write;
+use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub(crate) struct ExplainArgs {
@@ -31,13 +34,38 @@ pub(crate) struct ExplainArgs {
     all_samples: bool,
 
     /// Print only this stage: camera, intersect, texture, light or film
-    #[arg(long, value_name = "STAGE", value_parser = named(&Stage::NAMES, Stage::from_name))]
+    /// (intersection and lighting, the text's headings, are accepted too);
+    /// with --against, compare only this stage
+    #[arg(long, value_name = "STAGE", value_parser = stage_parser())]
     stage: Option<Stage>,
 
     /// Print a JSON document instead of text (its schema:
-    /// docs/checking-your-ray-tracer.md)
+    /// docs/checking-your-ray-tracer.md); with --against, the comparison as JSON
     #[arg(long)]
     json: bool,
+
+    /// Compare a student's document (schema glint-explain/1, any subset of its
+    /// keys) with Glint's for this pixel and these flags, and report the first
+    /// stage, in pipeline order, where they part: exit status 0 if every value
+    /// given agrees within the tolerances, 1 if not (tolerances:
+    /// docs/checking-your-ray-tracer.md)
+    #[arg(long, value_name = "STUDENT.json")]
+    against: Option<PathBuf>,
+}
+
+/// `--stage`'s parser: the names in pipeline order, each with the heading
+/// the text prints for it as an alias (`intersection`, `lighting`); help and
+/// errors list the names.
+fn stage_parser() -> impl TypedValueParser<Value = Stage> {
+    let values = Stage::ALL.map(|stage| {
+        let value = PossibleValue::new(stage.name());
+        match stage.heading() {
+            heading if heading != stage.name() => value.alias(heading),
+            _ => value,
+        }
+    });
+    PossibleValuesParser::new(values)
+        .map(|name: String| Stage::from_name(&name).expect("clap accepted only listed names"))
 }
 
 fn parse_pixel(text: &str) -> Result<(u32, u32), String> {
@@ -67,6 +95,9 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
                 ExplainError::Settings(e) => Failure::Input(format!("render settings: {e}")),
                 ExplainError::Diverged { .. } => Failure::Other(e.to_string()),
             })?;
+    if let Some(path) = &args.against {
+        return compare(&explanation, path, args);
+    }
     let text = match args.json {
         true => {
             serde_json::to_string_pretty(&explanation.json(args.stage))
@@ -75,7 +106,43 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
         }
         false => explanation.text(args.stage),
     };
-    // A reader that stops early (`| head`) is not an error.
-    let _ = std::io::stdout().write_all(text.as_bytes());
+    print(&text);
     Ok(())
+}
+
+/// Prints `text` on stdout; a reader that stops early (`| head`) is not an
+/// error.
+fn print(text: &str) {
+    let _ = std::io::stdout().write_all(text.as_bytes());
+}
+
+/// `--against`: the student's document at `path` against Glint's; the
+/// report on stdout, exit status 1 where they part.
+fn compare(explanation: &Explanation, path: &Path, args: &ExplainArgs) -> Result<(), Failure> {
+    let name = path.display();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Failure::Input(format!("{name}: cannot read the document: {e}")))?;
+    let student = Node::parse(&text).map_err(|e| {
+        // serde_json's message ends in " at line L column C": moved to the front.
+        let message = e.to_string();
+        let message = message.split(" at line ").next().unwrap_or(&message);
+        Failure::Input(format!("{name}:{}:{}: {message}", e.line(), e.column()))
+    })?;
+    let comparison = against::compare(&student, &explanation.json(None), args.stage)
+        .map_err(|e| Failure::Input(format!("{name}: {e}")))?;
+    print(&match args.json {
+        true => {
+            serde_json::to_string_pretty(&comparison.json()).expect("JSON of numbers and strings")
+                + "\n"
+        }
+        false => comparison.text(&name.to_string()),
+    });
+    match comparison.first() {
+        None => Ok(()),
+        Some(d) => Err(Failure::Other(format!(
+            "{name} parts from Glint in the {} stage, at {}",
+            d.stage.heading(),
+            d.path
+        ))),
+    }
 }

@@ -20,6 +20,8 @@ mod bench;
 mod diff;
 mod explain;
 mod export;
+mod grade;
+mod grade_stages;
 mod interrupt;
 mod output;
 mod render;
@@ -27,6 +29,7 @@ mod stats;
 mod stress;
 
 use clap::builder::TypedValueParser;
+use clap::error::{ContextKind, ContextValue};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -64,6 +67,10 @@ enum Command {
     /// Every stage's numbers for one pixel: camera, intersection, texture,
     /// lighting, film (text, or JSON with --json)
     Explain(explain::ExplainArgs),
+    /// Whether submitted images are unbiased renders of their scenes, by a
+    /// statistical test that tells a bug from noise: one scene's images or a
+    /// whole class (table, CSV, JSON, HTML report with heat maps)
+    Grade(grade::GradeArgs),
 }
 
 /// A failure and the exit status it maps to.
@@ -77,6 +84,12 @@ pub(crate) enum Failure {
     /// Stopped by a signal after writing what was finished, which the message
     /// says; the exit status is the signal's (130 for Ctrl-C, 143 for SIGTERM).
     Interrupted { message: String, status: u8 },
+    /// `glint grade`: a submission failed or could not be read (the report
+    /// says which). Exit status 1.
+    Graded,
+    /// `glint grade`: a failure of Glint's own, told apart from a failed
+    /// submission. Exit status 3.
+    Internal(String),
 }
 
 fn main() -> ExitCode {
@@ -97,8 +110,11 @@ fn main() -> ExitCode {
         Command::Stress(args) => stress::stress(args),
         Command::Export(args) => export::export(args),
         Command::Explain(args) => explain::explain(args),
+        Command::Grade(args) => grade::grade(args),
     })
     .unwrap_or(Err(Failure::Panicked));
+    // A grader must tell Glint's own failures from a failed submission.
+    let grading = matches!(cli.command, Command::Grade(_));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(message)) => {
@@ -107,9 +123,14 @@ fn main() -> ExitCode {
         }
         Err(Failure::Other(message)) => {
             eprintln!("glint: error: {message}");
-            ExitCode::from(1)
+            ExitCode::from(if grading { 3 } else { 1 })
         }
-        Err(Failure::Panicked) => ExitCode::from(1),
+        Err(Failure::Panicked) => ExitCode::from(if grading { 3 } else { 1 }),
+        Err(Failure::Graded) => ExitCode::from(1),
+        Err(Failure::Internal(message)) => {
+            eprintln!("glint: internal error: {message}");
+            ExitCode::from(3)
+        }
         Err(Failure::Interrupted { message, status }) => {
             eprintln!("glint: interrupted: {message}");
             ExitCode::from(status)
@@ -118,7 +139,8 @@ fn main() -> ExitCode {
 }
 
 /// Help and version go to stdout in full; a usage error is one line on stderr
-/// (clap's first line, which names the problem) with exit status 2.
+/// (clap's first line, which names the problem, and the allowed values when
+/// the value must be one of a list) with exit status 2.
 fn usage_error(e: clap::Error) -> ExitCode {
     if !e.use_stderr() {
         let _ = e.print();
@@ -134,6 +156,11 @@ fn usage_error(e: clap::Error) -> ExitCode {
         if let Some(next) = lines.next() {
             problem = format!("{problem} {}", next.trim());
         }
+    }
+    // Clap lists the allowed values on a line of their own, which the one
+    // line would drop.
+    if let Some(ContextValue::Strings(values)) = e.get(ContextKind::ValidValue) {
+        problem = format!("{problem} [possible values: {}]", values.join(", "));
     }
     eprintln!("glint: error: {problem} (see glint --help)");
     ExitCode::from(2)

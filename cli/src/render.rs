@@ -33,11 +33,13 @@ pub(crate) struct RenderArgs {
     threads: Option<usize>,
 
     /// Write this buffer instead of the shaded image: uv (surface coordinates),
-    /// mip-level (the level the diffuse texture is read at), normal, depth
-    /// (distance from the camera), albedo (filtered diffuse color),
-    /// reflection-depth (mirror reflections taken). Raw values in .exr/.pfm, false
-    /// color in .png (normals as 0.5·n + 0.5, uv as its fractional part, depth as
-    /// gray from near to far, MIP level and reflection depth as a blue-green-red ramp)
+    /// mip-level (the level Glint reads the diffuse texture at),
+    /// report-mip-level (the course report's level log2(L/W), from a whole
+    /// pixel's footprint), normal, depth (distance from the camera), albedo
+    /// (filtered diffuse color), reflection-depth (mirror reflections taken). Raw
+    /// values in .exr/.pfm, false color in .png (normals as 0.5·n + 0.5, uv as its
+    /// fractional part, depth as gray from near to far, MIP levels and reflection
+    /// depth as a blue-green-red ramp)
     #[arg(long, value_name = "BUFFER", value_parser = named(&Aov::NAMES, Aov::from_name))]
     aov: Option<Aov>,
 
@@ -75,16 +77,18 @@ pub(crate) struct SceneArgs {
     #[arg(long, value_name = "N")]
     light_samples: Option<u32>,
 
-    /// Pixel sample pattern (overrides render.pixel_sampler): grid (the course's
-    /// uniform grid; needs a square spp), random (independent uniform points),
-    /// stratified (jittered grid; Latin hypercube when spp is not a square),
-    /// sobol (Owen-scrambled Sobol points, one sequence per pixel; best at powers
-    /// of two)
+    /// Pixel sample pattern: where the camera samples fall in the pixel, and
+    /// nothing else (overrides render.pixel_sampler; the light samples' pattern
+    /// is --light-sampler's): grid (the course's uniform grid; needs a square
+    /// spp), random (independent uniform points), stratified (jittered grid;
+    /// Latin hypercube when spp is not a square), sobol (Owen-scrambled Sobol
+    /// points, one sequence per pixel; best at powers of two)
     #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
     sampler: Option<SamplePattern>,
 
-    /// Light sample pattern (overrides render.light_sampler); the same patterns,
-    /// grid needing a square count
+    /// Light sample pattern: where the samples fall on each area light
+    /// (overrides render.light_sampler; --sampler sets only the pixel's); the
+    /// same patterns, grid needing a square count
     #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
     light_sampler: Option<SamplePattern>,
 

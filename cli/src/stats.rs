@@ -1,7 +1,7 @@
 //! `glint render --stats` and `--stats-json`: what a render did, as a table on
 //! standard output and as a JSON document (schema in docs/command-line.md).
 
-use glint_integrator::{LookupKind, RenderStats, Scene};
+use glint_integrator::{LookupKind, RenderStats, Scene, Skips};
 use glint_scene::LoadTimings;
 use glint_texture::Texture;
 use serde_json::{json, Value};
@@ -40,11 +40,21 @@ impl StatsReport<'_> {
                 "towards_lobe_samples": sh.brdf_rays,
                 "environment_lookups": sh.environment_lookups,
             },
-            "light_samples": sh.light_samples,
-            "shadow_rays_skipped": {
-                "behind_surface": sh.skipped_behind_surface,
-                "behind_light": sh.skipped_behind_light,
-                "zero_brdf": sh.skipped_zero_brdf,
+            "light_samples": {
+                "area": sh.light_samples,
+                "point": sh.point_light_samples,
+                "shadow_rays": sh.light_shadow_rays,
+                "skipped": skips_json(&sh.light_skips),
+            },
+            "environment_samples": {
+                "samples": sh.environment_samples,
+                "shadow_rays": sh.environment_shadow_rays,
+                "skipped": skips_json(&sh.environment_skips),
+            },
+            "lobe_samples": {
+                "samples": sh.lobe_samples,
+                "rays": sh.brdf_rays,
+                "skipped": skips_json(&sh.lobe_skips),
             },
             "specular_lobes": sh.specular_lobes,
             "texture_footprints": sh.footprints,
@@ -92,8 +102,24 @@ impl StatsReport<'_> {
                 sh.environment_lookups
             ),
             format!(
-                "  light samples   {} on area lights; no shadow ray for {} (light below the surface), {} (surface behind the light), {} (zero BRDF)",
-                sh.light_samples, sh.skipped_behind_surface, sh.skipped_behind_light, sh.skipped_zero_brdf
+                "  light samples   {} ({} on area and sphere lights, {} on point lights): {} shadow rays, and none for {}",
+                sh.light_samples + sh.point_light_samples,
+                sh.light_samples,
+                sh.point_light_samples,
+                sh.light_shadow_rays,
+                skips_text(&sh.light_skips, true)
+            ),
+            format!(
+                "  environment     {} samples: {} shadow rays, and none for {}",
+                sh.environment_samples,
+                sh.environment_shadow_rays,
+                skips_text(&sh.environment_skips, false)
+            ),
+            format!(
+                "  lobe samples    {}: {} rays, and none for {}",
+                sh.lobe_samples,
+                sh.brdf_rays,
+                skips_text(&sh.lobe_skips, false)
             ),
             format!(
                 "  shading         {} specular lobes, {} texture footprints, {} NaN/Inf samples dropped",
@@ -177,6 +203,28 @@ impl StatsReport<'_> {
             images.values().filter(|&&built| built).count(),
         )
     }
+}
+
+/// The skips of one kind of sample as JSON.
+fn skips_json(s: &Skips) -> Value {
+    json!({
+        "below_surface": s.below_surface,
+        "behind_light": s.behind_light,
+        "zero_brdf": s.zero_brdf,
+        "zero_density": s.zero_density,
+    })
+}
+
+/// The skips of one kind of sample, each with why; `behind_light` only for
+/// lights (nothing else has a back).
+fn skips_text(s: &Skips, lights: bool) -> String {
+    let mut parts = vec![format!("{} (below the surface)", s.below_surface)];
+    if lights {
+        parts.push(format!("{} (surface behind the light)", s.behind_light));
+    }
+    parts.push(format!("{} (zero BRDF)", s.zero_brdf));
+    parts.push(format!("{} (zero density)", s.zero_density));
+    parts.join(", ")
 }
 
 fn seconds(d: Duration) -> String {

@@ -184,6 +184,31 @@ fn bad_input_gives_one_line_exit_2_and_no_output() {
 }
 
 #[test]
+fn a_value_outside_its_list_is_refused_with_the_list() {
+    // One line that names the bad value and every value allowed, whichever
+    // command and flag.
+    let dir = tempfile::tempdir().unwrap();
+    let set1 = scene("cornell-set1");
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["render", &set1, "--sampler", "halton"],
+            "invalid value 'halton' for '--sampler <PATTERN>' [possible values: grid, random, stratified, sobol]",
+        ),
+        (
+            &["explain", &set1, "--pixel", "1,1", "--stage", "shading"],
+            "invalid value 'shading' for '--stage <STAGE>' [possible values: camera, intersect, texture, light, film]",
+        ),
+        (
+            &["diff", "a.pfm", "b.pfm", "--metric", "psnr"],
+            "invalid value 'psnr' for '--metric <METRIC>' [possible values: relmse, rmse, flip, max]",
+        ),
+    ];
+    for (args, expected) in cases {
+        assert_input_error(&glint(args, dir.path()), expected);
+    }
+}
+
+#[test]
 fn a_failed_run_leaves_an_existing_output_untouched() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("keep.png"), b"precious").unwrap();

@@ -252,3 +252,166 @@ fn a_crop_is_the_same_pixels_as_the_whole_render() {
     );
     assert_input_error(&o, "empty");
 }
+
+#[test]
+fn the_text_headings_are_accepted_as_stage_names() {
+    let s = scene("cornell-set1");
+    let at = [s.as_str(), "--pixel", "376,448", "--light-samples", "1"];
+    for (name, heading) in [("intersect", "intersection"), ("light", "lighting")] {
+        let by_name = explain(&[&at[..], &["--stage", name]].concat());
+        assert!(by_name.contains(&format!("\n  {heading}\n")), "{by_name}");
+        assert_eq!(by_name, explain(&[&at[..], &["--stage", heading]].concat()));
+    }
+    // Help gives the names and says the headings are accepted.
+    let o = glint(&["explain", "--help"], Path::new("."));
+    let help = stdout(&o);
+    assert!(help.contains("intersection and lighting"), "{help}");
+}
+
+#[test]
+fn the_reports_level_is_a_whole_pixels_and_does_not_change_with_spp() {
+    // The textured ground at pixel (80, 200); sample 0 is at the same place in
+    // the pixel for any spp (the first Sobol point). The report's level,
+    // log2(L/W) with L = 2·t·tan(fov/2)/(r·|N·D|) and W = |J_T|/m, stays;
+    // Glint's own level reads finer as the samples share the pixel.
+    let s = scene("ground-mipmap");
+    let mut glint_levels = Vec::new();
+    for spp in ["1", "4", "16"] {
+        let doc = json(&[&s, "--pixel", "80,200", "--spp", spp, "--stage", "texture"]);
+        let diffuse = &doc["samples"][0]["ray"]["texture"]["diffuse"];
+        assert_eq!(diffuse["report_level"], 5.0646, "spp {spp}: {diffuse}");
+        assert_eq!(diffuse["report_l"], 0.52291, "spp {spp}");
+        assert_eq!(diffuse["report_w"], 0.015625, "spp {spp}");
+        assert_eq!(diffuse["report_m"], 256, "spp {spp}");
+        glint_levels.push(diffuse["glint_level"].as_f64().unwrap());
+    }
+    assert!(
+        glint_levels[0] > glint_levels[1] && glint_levels[1] > glint_levels[2],
+        "{glint_levels:?}"
+    );
+}
+
+/// The deterministic recipe: one camera sample at the pixel's centre, one
+/// light sample at the light's centre.
+const DETERMINISTIC: [&str; 8] = [
+    "--spp",
+    "1",
+    "--sampler",
+    "grid",
+    "--light-samples",
+    "1",
+    "--light-sampler",
+    "grid",
+];
+
+/// `glint explain SCENE --pixel PIXEL` with the deterministic recipe and
+/// `extra`, against `document` written to a file; the output.
+fn against(scene_name: &str, pixel: &str, document: &str, extra: &[&str]) -> std::process::Output {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("student.json"), document).unwrap();
+    let s = scene(scene_name);
+    let args = [
+        &["explain", s.as_str(), "--pixel", pixel][..],
+        &DETERMINISTIC,
+        &["--against", "student.json"],
+        extra,
+    ]
+    .concat();
+    glint(&args, dir.path())
+}
+
+/// Glint's own document for the checkered Set 1 sphere's pixel.
+fn sphere_document() -> Value {
+    let s = scene("cornell-set1");
+    json(&[&[s.as_str(), "--pixel", "400,192"][..], &DETERMINISTIC].concat())
+}
+
+#[test]
+fn glints_own_document_agrees_at_every_stage() {
+    let doc = sphere_document().to_string();
+    let o = against("cornell-set1", "400,192", &doc, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", common::stderr(&o));
+    let text = stdout(&o);
+    for stage in ["camera", "intersection", "texture", "lighting", "film"] {
+        assert!(text.contains(&format!("  {stage}: agrees (")), "{text}");
+    }
+    // A partial document agrees too.
+    let partial = format!(
+        r#"{{"spp": 1, "schema": "glint-explain/1", "film": {{"srgb8": {}}}}}"#,
+        sphere_document()["film"]["srgb8"]
+    );
+    let o = against("cornell-set1", "400,192", &partial, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    assert!(stdout(&o).contains("  camera: not in your document"));
+}
+
+#[test]
+fn a_perturbed_camera_direction_parts_at_the_camera() {
+    let mut doc = sphere_document();
+    let direction = &mut doc["samples"][0]["camera"]["direction"];
+    direction[0] = (direction[0].as_f64().unwrap() + 0.01).into();
+    let o = against("cornell-set1", "400,192", &doc.to_string(), &["--json"]);
+    assert_eq!(o.status.code(), Some(1), "{}", common::stderr(&o));
+    let report: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let first = &report["first_difference"];
+    assert_eq!(first["stage"], "camera", "{report}");
+    assert_eq!(first["path"], "samples[0].camera.direction");
+    assert_eq!(first["tolerance"]["kind"], "angular");
+    assert_eq!(report["agrees"], false);
+}
+
+#[test]
+fn a_wrong_uv_parts_at_the_intersection_though_the_film_differs_too() {
+    // A student's wrong sphere uv: their checker colour, lighting and film
+    // follow from it; the film comes before the samples in their file.
+    let mut doc = sphere_document();
+    let hit = &mut doc["samples"][0]["ray"]["intersect"]["hit"];
+    hit["uv"] = serde_json::json!([0.1, 0.2]);
+    doc["film"]["radiance"] = serde_json::json!([0.9, 0.9, 0.9]);
+    doc["samples"][0]["ray"]["texture"]["kd"] = serde_json::json!([0.9, 0.9, 0.9]);
+    let text = doc.to_string();
+    assert!(text.find("\"film\"") < text.find("\"samples\""), "{text}");
+    let o = against("cornell-set1", "400,192", &text, &[]);
+    assert_eq!(o.status.code(), Some(1), "{}", common::stderr(&o));
+    let report = stdout(&o);
+    assert!(
+        report.contains("intersection: PARTS from Glint")
+            && report.contains("first difference: samples[0].ray.intersect.hit.uv")
+            && report.contains("film: 1 of"),
+        "{report}"
+    );
+    let err = common::stderr(&o);
+    assert!(err.contains("intersection stage"), "{err}");
+}
+
+#[test]
+fn a_bad_document_is_an_input_error() {
+    let o = against(
+        "cornell-set1",
+        "400,192",
+        "{\"schema\": \"glint-explain/1\",\n  \"pixel\": [400 192]}",
+        &[],
+    );
+    assert_input_error(&o, "student.json:2:17: expected `,` or `]`");
+    let o = against(
+        "cornell-set1",
+        "400,192",
+        r#"{"schema": "glint-explain/2"}"#,
+        &[],
+    );
+    assert_input_error(&o, "student.json: schema is \"glint-explain/2\"");
+    let doc = sphere_document().to_string();
+    let o = against("cornell-set1", "401,192", &doc, &[]);
+    assert_input_error(&o, "pass --pixel 400,192");
+    let mut small = sphere_document();
+    small["pixel"] = serde_json::json!([40, 19]);
+    let o = against(
+        "cornell-set1",
+        "40,19",
+        &small.to_string(),
+        &["--resolution", "64x64"],
+    );
+    assert_input_error(&o, "pass --resolution 512x512");
+    let o = against("cornell-set1", "400,192", "", &[]);
+    assert_input_error(&o, "student.json:1:0: EOF while parsing a value");
+}

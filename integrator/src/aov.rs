@@ -2,6 +2,7 @@
 //! studying a stage (texture coordinates, MIP level, normals, depth, albedo).
 
 use crate::direct::texture_footprint;
+use crate::report_level::report_level;
 use crate::{Scene, SurfaceKind};
 use glam::Vec3;
 use glint_camera::Film;
@@ -15,8 +16,14 @@ pub enum Aov {
     /// `(u, v, 0)`: the surface's own uv at the first hit.
     Uv,
     /// `(l, l, l)`: the continuous MIP level the diffuse texture is read at
-    /// (0 for textures without a pyramid).
+    /// (0 for textures without a pyramid): Glint's level, from the ray
+    /// differentials shrunk to each sample's share of the pixel.
     MipLevel,
+    /// `(l, l, l)`: the level the course report chooses for the diffuse texture,
+    /// `log2(L/W)` ([`crate::report_level()`]), from a whole pixel's footprint
+    /// (0 where the diffuse texture is not an image, or the level is not
+    /// finite). It may be negative: a texel wider than the pixel.
+    ReportMipLevel,
     /// The shading normal at the first hit, components in [−1, 1].
     Normal,
     /// `(d, d, d)`: the distance from the camera to the first hit.
@@ -29,9 +36,10 @@ pub enum Aov {
 }
 
 impl Aov {
-    pub const NAMES: [&'static str; 6] = [
+    pub const NAMES: [&'static str; 7] = [
         "uv",
         "mip-level",
+        "report-mip-level",
         "normal",
         "depth",
         "albedo",
@@ -42,6 +50,7 @@ impl Aov {
         match name {
             "uv" => Some(Self::Uv),
             "mip-level" => Some(Self::MipLevel),
+            "report-mip-level" => Some(Self::ReportMipLevel),
             "normal" => Some(Self::Normal),
             "depth" => Some(Self::Depth),
             "albedo" => Some(Self::Albedo),
@@ -75,6 +84,9 @@ impl Aov {
             Aov::MipLevel => Vec3::splat(material.map_or(0.0, |m| {
                 m.diffuse_mip_level(&texture_footprint(m, &hit, diff))
             })),
+            Aov::ReportMipLevel => Vec3::splat(material.map_or(0.0, |m| {
+                report_level(&scene.camera, ray, &hit, m, &m.diffuse).map_or(0.0, |r| r.level)
+            })),
             Aov::ReflectionDepth => {
                 Vec3::splat(reflection_depth(scene, *ray, hit, max_depth) as f32)
             }
@@ -102,7 +114,7 @@ impl Aov {
                 Aov::Uv => Vec3::new(p.x.rem_euclid(1.0), p.y.rem_euclid(1.0), 0.0),
                 Aov::Depth if p.x > 0.0 && max > 0.0 => Vec3::splat(1.0 - 0.9 * p.x / max),
                 Aov::Depth => Vec3::ZERO,
-                Aov::MipLevel | Aov::ReflectionDepth => {
+                Aov::MipLevel | Aov::ReportMipLevel | Aov::ReflectionDepth => {
                     ramp(if max > 0.0 { p.x / max } else { 0.0 })
                 }
                 Aov::Albedo => *p,

@@ -249,15 +249,7 @@ impl<'a> ShadedLanes<'a> {
         let shaded = lit & normalized & above;
         let traced = shaded & !lanes::bits(reflected.is_zero());
         let specular = self.phong.specular_lanes();
-        count_lanes(
-            &mut ctx.counters,
-            self.lanes,
-            lit,
-            normalized,
-            shaded,
-            traced,
-            specular,
-        );
+        count_lanes(&mut ctx.counters, self.lanes, lit, shaded, traced, specular);
         let ends = light.shadow_ends(&position);
         let visible = traced & !self.blocked(scene, &ends, &towards, traced);
         Vec3Lanes::select(lanes::from_bits(visible), &reflected, &Vec3Lanes::default())
@@ -513,9 +505,9 @@ mod tests {
         // Every branch was taken: lanes behind a light, below the horizon, with
         // zero reflection, traced, and the specular lobe evaluated.
         assert!(total.light_samples > 0, "{total:?}");
-        assert!(total.skipped_behind_light > 0, "{total:?}");
-        assert!(total.skipped_behind_surface > 0, "{total:?}");
-        assert!(total.skipped_zero_brdf > 0, "{total:?}");
+        assert!(total.light_skips.behind_light > 0, "{total:?}");
+        assert!(total.light_skips.below_surface > 0, "{total:?}");
+        assert!(total.light_skips.zero_brdf > 0, "{total:?}");
         assert!(total.light_shadow_rays > 0, "{total:?}");
         assert!(total.specular_lobes > 0, "{total:?}");
     }

@@ -9,24 +9,36 @@
 use glint_lighting::PhongMaterial;
 use glint_texture::{TexCoord, Texture};
 
-/// The integrator's counts.
+/// The integrator's counts. Every sample drawn at a shading point either
+/// sends one ray or is skipped for one reason, so each kind adds up:
+/// `light_samples + point_light_samples = light_shadow_rays +
+/// light_skips.total()`, `environment_samples = environment_shadow_rays +
+/// environment_skips.total()` and `lobe_samples = brdf_rays +
+/// lobe_skips.total()` (the tests check it on the shipped scenes).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ShadingCounters {
-    /// Shadow rays traced towards point and area lights.
+    /// Shadow rays traced towards point, area and sphere lights.
     pub light_shadow_rays: u64,
     /// Shadow rays traced towards environment samples.
     pub environment_shadow_rays: u64,
     pub reflection_rays: u64,
     /// Rays that left the scene and read the environment map.
     pub environment_lookups: u64,
-    /// Points sampled on area lights.
+    /// Points sampled on area lights (and sphere lights, physical shading).
     pub light_samples: u64,
-    /// Light samples with no shadow ray: the light is below the surface's horizon.
-    pub skipped_behind_surface: u64,
-    /// Light samples with no shadow ray: the surface is behind the (one-sided) light.
-    pub skipped_behind_light: u64,
-    /// Light samples with no shadow ray: the BRDF reflects nothing that way.
-    pub skipped_zero_brdf: u64,
+    /// Point lights evaluated at shading points: one sample each.
+    pub point_light_samples: u64,
+    /// Light samples (point lights' included) that sent no shadow ray, by why.
+    pub light_skips: Skips,
+    /// Directions drawn from the environment at shading points.
+    pub environment_samples: u64,
+    /// Environment samples that sent no shadow ray, by why.
+    pub environment_skips: Skips,
+    /// Directions drawn from specular lobes towards a light (physical
+    /// shading's multiple importance sampling).
+    pub lobe_samples: u64,
+    /// Lobe samples that sent no ray, by why.
+    pub lobe_skips: Skips,
     /// Rays towards directions drawn from a specular lobe, each checked for
     /// the light it reaches (physical shading's multiple importance sampling).
     pub brdf_rays: u64,
@@ -46,13 +58,48 @@ impl std::ops::AddAssign for ShadingCounters {
         self.reflection_rays += o.reflection_rays;
         self.environment_lookups += o.environment_lookups;
         self.light_samples += o.light_samples;
-        self.skipped_behind_surface += o.skipped_behind_surface;
-        self.skipped_behind_light += o.skipped_behind_light;
-        self.skipped_zero_brdf += o.skipped_zero_brdf;
+        self.point_light_samples += o.point_light_samples;
+        self.light_skips += o.light_skips;
+        self.environment_samples += o.environment_samples;
+        self.environment_skips += o.environment_skips;
+        self.lobe_samples += o.lobe_samples;
+        self.lobe_skips += o.lobe_skips;
         self.brdf_rays += o.brdf_rays;
         self.specular_lobes += o.specular_lobes;
         self.footprints += o.footprints;
         self.nonfinite_samples += o.nonfinite_samples;
+    }
+}
+
+/// Samples that sent no ray, by why: counting them shows that the skips are
+/// taken (`glint render --stats`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Skips {
+    /// The direction is below the surface's geometric horizon (or has no
+    /// length: the sample lies on the point).
+    pub below_surface: u64,
+    /// The surface is behind the one-sided light, or inside a sphere light.
+    pub behind_light: u64,
+    /// The BRDF reflects nothing that way.
+    pub zero_brdf: u64,
+    /// The sample's density is zero or not finite, no direction could be
+    /// drawn, or (environment) the map is black that way.
+    pub zero_density: u64,
+}
+
+impl Skips {
+    /// Every skipped sample.
+    pub fn total(&self) -> u64 {
+        self.below_surface + self.behind_light + self.zero_brdf + self.zero_density
+    }
+}
+
+impl std::ops::AddAssign for Skips {
+    fn add_assign(&mut self, o: Self) {
+        self.below_surface += o.below_surface;
+        self.behind_light += o.behind_light;
+        self.zero_brdf += o.zero_brdf;
+        self.zero_density += o.zero_density;
     }
 }
 

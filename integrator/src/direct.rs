@@ -240,6 +240,7 @@ impl DirectIntegrator {
             ctx,
             |index, light, pairs, ctx| match light {
                 Light::Point(p) => {
+                    ctx.counters.point_light_samples += 1;
                     let target = RayTarget::exact(p.position);
                     let reflected =
                         point.unoccluded_reflection(scene, &target, &Occluders::ALL, ctx);
@@ -383,6 +384,7 @@ impl DirectIntegrator {
         let sobol = ctx.sample.sobol_points(pair, self.environment_samples);
         self.environment_pattern
             .fill(&mut ctx.rng, sobol, &mut samples);
+        ctx.counters.environment_samples += samples.len() as u64;
         let mut sum = Vec3::ZERO;
         for &u in &samples {
             let s = env.sample(point.n, u);
@@ -397,11 +399,12 @@ impl DirectIntegrator {
                 })
             };
             if s.pdf.is_nan() || s.pdf <= 0.0 || s.radiance == Vec3::ZERO {
+                ctx.counters.environment_skips.zero_density += 1;
                 record(ctx, Vec3::ZERO, Shadow::Skipped(Skip::ZeroPdf), Vec3::ZERO);
                 continue;
             }
             if !point.above_surface(s.direction) {
-                ctx.counters.skipped_behind_surface += 1;
+                ctx.counters.environment_skips.below_surface += 1;
                 record(
                     ctx,
                     Vec3::ZERO,
@@ -412,7 +415,7 @@ impl DirectIntegrator {
             }
             let f = point.brdf_cos(s.direction, ctx);
             if f == Vec3::ZERO {
-                ctx.counters.skipped_zero_brdf += 1;
+                ctx.counters.environment_skips.zero_brdf += 1;
                 record(ctx, f, Shadow::Skipped(Skip::ZeroBrdf), Vec3::ZERO);
                 continue;
             }
@@ -531,11 +534,11 @@ impl ShadingPoint<'_> {
         occluders: &Occluders,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let Some(l) = (target.point - self.hit.point).try_normalize() else {
-            return Vec3::ZERO;
-        };
+        // A direction of no length (the light's point is the shading point)
+        // is not above the surface either: `ng · 0 > 0` is false.
+        let l = (target.point - self.hit.point).normalize_or_zero();
         if !self.above_surface(l) {
-            ctx.counters.skipped_behind_surface += 1;
+            ctx.counters.light_skips.below_surface += 1;
             self.record_light_sample(target, l, Shadow::Skipped(Skip::BehindSurface), ctx);
             return Vec3::ZERO;
         }
@@ -546,7 +549,7 @@ impl ShadingPoint<'_> {
             self.material.reflect_diffuse(self.kd, self.n, l)
         };
         if reflected == Vec3::ZERO {
-            ctx.counters.skipped_zero_brdf += 1;
+            ctx.counters.light_skips.zero_brdf += 1;
             self.record_light_sample(target, l, Shadow::Skipped(Skip::ZeroBrdf), ctx);
             return Vec3::ZERO;
         }

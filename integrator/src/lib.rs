@@ -30,6 +30,8 @@
 //! - [`SamplePattern`] and [`sampling`]: the sample patterns (grid, random,
 //!   stratified, Owen-scrambled Sobol) and per-pixel streams;
 //!   [`Aov`]: buffers other than radiance.
+//! - [`report_level()`]: the MIP level the course report chooses (section 2.8),
+//!   `log2(L/W)`, with its `L` and `W`.
 
 mod aov;
 mod camera_lanes;
@@ -39,12 +41,13 @@ mod explain;
 mod light_samples;
 mod physical;
 mod render;
+mod report_level;
 pub mod sampling;
 mod scene;
 pub mod trace;
 
 pub use aov::Aov;
-pub use counters::{LookupKind, ShadingCounters, TextureCounters};
+pub use counters::{LookupKind, ShadingCounters, Skips, TextureCounters};
 pub use direct::{DirectIntegrator, SampleContext};
 pub use explain::{explain_pixel, ExplainError, PixelExplanation};
 pub use glint_lighting::{AreaSampling, ShadingModel};
@@ -52,6 +55,7 @@ pub use render::{
     camera_ray, render, render_with, Crop, RenderControl, RenderOutput, RenderSettings,
     RenderStats, SampleCount, SettingsError, MAX_SAMPLES, MAX_THREADS, TILE_SIZE,
 };
+pub use report_level::{pixel_height_on_surface, report_level, uv_unit_length, ReportLevel};
 pub use sampling::SamplePattern;
 pub use scene::{Scene, SceneBuilder, SceneError, Surface, SurfaceKind};
 

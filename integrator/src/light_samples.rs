@@ -68,7 +68,7 @@ impl ShadingPoint<'_> {
             let shaded = lit & lanes::bits(normalized) & above;
             let traced = shaded & !lanes::bits(reflected.is_zero());
             let from_back = lanes::lt(towards.dot_splat(normal), F32Lanes::ZERO);
-            self.count(ctx, used, lit, lanes::bits(normalized), shaded, traced);
+            self.count(ctx, used, lit, shaded, traced);
             let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);
             let shadow_rays = RayLanes {
                 origin,
@@ -97,20 +97,11 @@ impl ShadingPoint<'_> {
         ctx: &mut SampleContext<T>,
         used: u32,
         lit: u32,
-        normalized: u32,
         shaded: u32,
         traced: u32,
     ) {
         let specular = if self.has_specular { u32::MAX } else { 0 };
-        count_lanes(
-            &mut ctx.counters,
-            used,
-            lit,
-            normalized,
-            shaded,
-            traced,
-            specular,
-        );
+        count_lanes(&mut ctx.counters, used, lit, shaded, traced, specular);
     }
 
     /// [`Self::area_light_sum`] one sample at a time.
@@ -129,7 +120,7 @@ impl ShadingPoint<'_> {
                 let target = light.shadow_target(position);
                 sum += self.unoccluded_reflection(scene, &target, occluders, ctx);
             } else {
-                ctx.counters.skipped_behind_light += 1;
+                ctx.counters.light_skips.behind_light += 1;
                 if T::ON {
                     let target = light.shadow_target(position);
                     let l = (position - self.hit.point).normalize_or_zero();
@@ -144,24 +135,24 @@ impl ShadingPoint<'_> {
 
 /// Adds one chunk of light samples in lanes to the counts, as the scalar path
 /// counts them one by one. Each argument is a set of lanes (bit k for lane k):
-/// the lanes `used`, those whose light point shines on the point (`lit`), whose
-/// direction could be normalised, which are above the horizon and so shaded
-/// (`shaded`), whose shadow ray is traced, and those that evaluate a specular
-/// lobe when shaded.
+/// the lanes `used`, those whose light point shines on the point (`lit`),
+/// which are shaded (`shaded`: their direction could be normalised and is
+/// above the horizon; a lit lane that is not is counted below the surface, as
+/// the scalar path counts a direction of no length), whose shadow ray is
+/// traced, and those that evaluate a specular lobe when shaded.
 pub(crate) fn count_lanes(
     counters: &mut ShadingCounters,
     used: u32,
     lit: u32,
-    normalized: u32,
     shaded: u32,
     traced: u32,
     specular: u32,
 ) {
     let ones = |bits: u32| u64::from(bits.count_ones());
-    counters.skipped_behind_light += ones(used & !lit);
-    counters.skipped_behind_surface += ones(lit & normalized & !shaded);
+    counters.light_skips.behind_light += ones(used & !lit);
+    counters.light_skips.below_surface += ones(lit & !shaded);
     counters.specular_lobes += ones(shaded & specular);
-    counters.skipped_zero_brdf += ones(shaded & !traced);
+    counters.light_skips.zero_brdf += ones(shaded & !traced);
     counters.light_shadow_rays += ones(traced);
 }
 
@@ -309,9 +300,9 @@ mod tests {
         // Every branch was taken: lanes behind the light, below the horizon, with
         // zero reflection, and traced.
         assert!(compared > 1000, "only {compared} comparisons");
-        assert!(total.skipped_behind_light > 0, "{total:?}");
-        assert!(total.skipped_behind_surface > 0, "{total:?}");
-        assert!(total.skipped_zero_brdf > 0, "{total:?}");
+        assert!(total.light_skips.behind_light > 0, "{total:?}");
+        assert!(total.light_skips.below_surface > 0, "{total:?}");
+        assert!(total.light_skips.zero_brdf > 0, "{total:?}");
         assert!(total.light_shadow_rays > 0, "{total:?}");
     }
 }

@@ -27,7 +27,7 @@
 use crate::direct::{blocker, SampleContext, ShadingPoint, CULL_FROM_SAMPLES};
 use crate::sampling::DimensionPair;
 use crate::trace::{Event, Shadow, Skip, Technique, Tracer};
-use crate::{DirectIntegrator, Scene};
+use crate::{DirectIntegrator, Scene, ShadingCounters, Skips};
 use glam::Vec3;
 use glint_geometry::{spawn_ray, spawn_ray_to, Occluders, RayTarget};
 use glint_lighting::{AreaLight, Light, PointLight, SphereLight};
@@ -79,7 +79,7 @@ impl DirectIntegrator {
         ctx.counters.light_samples += u64::from(n);
         // The light is flat: a point behind it is behind every point of it.
         if !light.illuminates(light.surface().center(), x) {
-            ctx.counters.skipped_behind_light += u64::from(n);
+            ctx.counters.light_skips.behind_light += u64::from(n);
             return Vec3::ZERO;
         }
         let sampler = light.sampler(x, self.area_sampling);
@@ -129,15 +129,18 @@ impl DirectIntegrator {
         let pdf = light.pdf(x);
         if pdf == 0.0 {
             // Inside the sphere: it lights nothing there.
-            ctx.counters.skipped_behind_light += u64::from(n);
+            ctx.counters.light_skips.behind_light += u64::from(n);
             return Vec3::ZERO;
         }
         let mis = self.mis && point.has_specular;
         let samples = self.draw_light_points(pair, ctx);
         let mut sum = Vec3::ZERO;
         for &u in &samples {
-            if let Some(s) = light.sample(x, u) {
-                sum += point.light_sample(scene, &s.target, s.pdf, mis, &Occluders::ALL, ctx);
+            match light.sample(x, u) {
+                Some(s) => {
+                    sum += point.light_sample(scene, &s.target, s.pdf, mis, &Occluders::ALL, ctx)
+                }
+                None => ctx.counters.light_skips.zero_density += 1,
             }
         }
         ctx.light_points = samples;
@@ -166,11 +169,13 @@ impl DirectIntegrator {
             depth,
         };
         let samples = self.draw_light_points(pair, ctx);
+        ctx.counters.lobe_samples += samples.len() as u64;
         let object = scene.light_objects[index];
         let mut sum = Vec3::ZERO;
         for &u in &samples {
-            if let Some(l) = point.material.sample_specular(point.n, point.v, u) {
-                sum += point.lobe_sample(scene, &light_pdf, object, l, ctx);
+            match point.material.sample_specular(point.n, point.v, u) {
+                Some(l) => sum += point.lobe_sample(scene, &light_pdf, object, l, ctx),
+                None => ctx.counters.lobe_skips.zero_density += 1,
             }
         }
         ctx.light_points = samples;
@@ -199,9 +204,12 @@ impl ShadingPoint<'_> {
         light: &PointLight,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
+        ctx.counters.point_light_samples += 1;
         let d = light.position - self.hit.point;
         let distance2 = d.length_squared();
         let Some(l) = d.try_normalize() else {
+            // The light is at the point: no direction, counted as below the surface.
+            ctx.counters.light_skips.below_surface += 1;
             return Vec3::ZERO;
         };
         let record = |ctx: &mut SampleContext<T>, f_cos: Vec3, shadow: Shadow, value: Vec3| {
@@ -216,7 +224,7 @@ impl ShadingPoint<'_> {
                 value,
             })
         };
-        let Some(f) = self.reflection_towards(l, ctx) else {
+        let Some(f) = self.reflection_towards(l, light_skips, ctx) else {
             record(ctx, Vec3::ZERO, self.skip_reason(l), Vec3::ZERO);
             return Vec3::ZERO;
         };
@@ -272,13 +280,16 @@ impl ShadingPoint<'_> {
             })
         };
         if !(pdf > 0.0 && pdf.is_finite()) {
+            ctx.counters.light_skips.zero_density += 1;
             record(ctx, Vec3::ZERO, Shadow::Skipped(Skip::ZeroPdf), Vec3::ZERO);
             return Vec3::ZERO;
         }
         let Some(l) = (target.point - self.hit.point).try_normalize() else {
+            // The light's point is the shading point: counted as below the surface.
+            ctx.counters.light_skips.below_surface += 1;
             return Vec3::ZERO;
         };
-        let Some(f) = self.reflection_towards(l, ctx) else {
+        let Some(f) = self.reflection_towards(l, light_skips, ctx) else {
             record(ctx, Vec3::ZERO, self.skip_reason(l), Vec3::ZERO);
             return Vec3::ZERO;
         };
@@ -327,6 +338,7 @@ impl ShadingPoint<'_> {
             })
         };
         if !(pdf > 0.0 && pdf.is_finite()) {
+            ctx.counters.lobe_skips.zero_density += 1;
             record(
                 ctx,
                 Vec3::ZERO,
@@ -336,7 +348,7 @@ impl ShadingPoint<'_> {
             );
             return Vec3::ZERO;
         }
-        let Some(f) = self.reflection_towards(l, ctx) else {
+        let Some(f) = self.reflection_towards(l, lobe_skips, ctx) else {
             record(ctx, Vec3::ZERO, 0.0, self.skip_reason(l), Vec3::ZERO);
             return Vec3::ZERO;
         };
@@ -361,9 +373,6 @@ impl ShadingPoint<'_> {
         }
     }
 
-    /// `f(l, v) · cos θ` towards the unit direction `l`, or `None` (counted)
-    /// where no ray need be traced: `l` below the geometric surface, or a zero
-    /// BRDF.
     /// Why [`Self::reflection_towards`] gave `None` for `l`.
     fn skip_reason(&self, l: Vec3) -> Shadow {
         Shadow::Skipped(if self.above_surface(l) {
@@ -373,16 +382,35 @@ impl ShadingPoint<'_> {
         })
     }
 
-    fn reflection_towards<T: Tracer>(&self, l: Vec3, ctx: &mut SampleContext<T>) -> Option<Vec3> {
+    /// `f(l, v) · cos θ` towards the unit direction `l`, or `None` where no
+    /// ray need be traced: `l` below the geometric surface, or a zero BRDF,
+    /// counted in the skips `skips` picks (a light's or a lobe's).
+    fn reflection_towards<T: Tracer>(
+        &self,
+        l: Vec3,
+        skips: SkipsOf,
+        ctx: &mut SampleContext<T>,
+    ) -> Option<Vec3> {
         if !self.above_surface(l) {
-            ctx.counters.skipped_behind_surface += 1;
+            skips(&mut ctx.counters).below_surface += 1;
             return None;
         }
         let f = self.brdf_cos(l, ctx);
         if f == Vec3::ZERO {
-            ctx.counters.skipped_zero_brdf += 1;
+            skips(&mut ctx.counters).zero_brdf += 1;
             return None;
         }
         Some(f)
     }
+}
+
+/// Which of the counters' skips a sample's skip is counted in.
+type SkipsOf = fn(&mut ShadingCounters) -> &mut Skips;
+
+fn light_skips(c: &mut ShadingCounters) -> &mut Skips {
+    &mut c.light_skips
+}
+
+fn lobe_skips(c: &mut ShadingCounters) -> &mut Skips {
+    &mut c.lobe_skips
 }

@@ -109,9 +109,10 @@ fn no_specular_lobe_where_ks_is_zero() {
 }
 
 #[test]
-fn point_lights_take_no_light_samples_and_area_lights_do() {
+fn point_lights_take_one_sample_and_area_lights_take_light_samples() {
     let stats = stats_of(&plain());
     assert_eq!(stats.shading.light_samples, 0);
+    assert!(stats.shading.point_light_samples > 0);
     assert!(stats.shading.light_shadow_rays > 0);
     let lit = scene_with(diffuse(Vec3::ONE), diffuse(Vec3::ONE), area_light);
     let stats = stats_of(&lit);
@@ -135,7 +136,7 @@ fn no_shadow_ray_for_a_light_behind_the_surface_or_a_surface_behind_the_light() 
     below(&mut b);
     let stats = stats_of(&b.build(camera()).unwrap());
     assert_eq!(stats.shading.light_shadow_rays, 0);
-    assert!(stats.shading.skipped_behind_surface > 0);
+    assert!(stats.shading.light_skips.below_surface > 0);
     // An area light facing up, above the floor: the floor is behind it.
     let mut b = SceneBuilder::new();
     let m = b.material(diffuse(Vec3::ONE));
@@ -145,7 +146,7 @@ fn no_shadow_ray_for_a_light_behind_the_surface_or_a_surface_behind_the_light() 
     let stats = stats_of(&b.build(camera()).unwrap());
     assert_eq!(stats.shading.light_shadow_rays, 0);
     assert_eq!(
-        stats.shading.skipped_behind_light,
+        stats.shading.light_skips.behind_light,
         stats.shading.light_samples
     );
 }
@@ -269,4 +270,73 @@ fn parallelogram_walls_cull_their_own_shadow_rays() {
         "{by_shadow_rays} tests by {} shadow rays",
         stats.shading.light_shadow_rays
     );
+}
+
+/// Whether every sample of each kind either sent a ray or was counted as
+/// skipped: the counts `glint render --stats` prints add up.
+fn assert_counts_add_up(stats: &RenderStats, what: &str) {
+    let s = &stats.shading;
+    assert_eq!(
+        s.light_samples + s.point_light_samples,
+        s.light_shadow_rays + s.light_skips.total(),
+        "{what}: lights {s:?}"
+    );
+    assert_eq!(
+        s.environment_samples,
+        s.environment_shadow_rays + s.environment_skips.total(),
+        "{what}: environment {s:?}"
+    );
+    assert_eq!(
+        s.lobe_samples,
+        s.brdf_rays + s.lobe_skips.total(),
+        "{what}: lobes {s:?}"
+    );
+}
+
+#[test]
+fn every_sample_sends_a_ray_or_is_counted_as_skipped() {
+    use glint_integrator::ShadingModel;
+    use glint_lighting::EnvironmentLight;
+    use glint_texture::Environment;
+    let shiny = || PhongMaterial::new(Vec3::splat(0.4), 30.0);
+    // Point light, area light (in lanes with one sample, one by one with four).
+    let lit = scene_with(diffuse(Vec3::ONE), shiny(), area_light);
+    for (what, scene) in [("point light", plain()), ("area light", lit)] {
+        for light_samples in [1, 4] {
+            let settings = RenderSettings {
+                spp: 4,
+                light_samples,
+                ..RenderSettings::default()
+            };
+            let stats = render(&scene, &settings, &|_, _| {}).unwrap().stats;
+            assert!(stats.shading.light_shadow_rays > 0, "{what}");
+            assert_counts_add_up(&stats, what);
+        }
+    }
+    // Physical shading: a glossy ball (lobe samples) under an area light, a
+    // point light and a sky.
+    let mut b = SceneBuilder::new();
+    let f = b.material(diffuse(Vec3::splat(0.5)));
+    let s = b.material(shiny());
+    b.shape(Plane::new(Vec3::ZERO, Vec3::Y, false).unwrap(), f)
+        .shape(Sphere::new(Vec3::new(0.0, 0.7, -2.0), 0.7).unwrap(), s)
+        .shading(ShadingModel::Physical)
+        .environment(EnvironmentLight::new(
+            Environment::Constant(Vec3::splat(0.2)),
+            0.0,
+            1.0,
+        ));
+    area_light(&mut b);
+    point_light(&mut b);
+    let scene = b.build(camera()).unwrap();
+    let settings = RenderSettings {
+        spp: 4,
+        light_samples: 4,
+        environment_samples: 4,
+        ..RenderSettings::default()
+    };
+    let stats = render(&scene, &settings, &|_, _| {}).unwrap().stats;
+    let s = &stats.shading;
+    assert!(s.lobe_samples > 0 && s.environment_samples > 0, "{s:?}");
+    assert_counts_add_up(&stats, "physical");
 }

@@ -32,6 +32,10 @@ pub struct SceneDescription {
     pub settings: RenderSettings,
     /// `material_names[i]` is the file's name for `scene.materials[i]`.
     pub material_names: Vec<String>,
+    /// `object_names[i]` names object `i` of `scene.shapes` (the index a hit
+    /// records): the table's `name`, or its table and index (`sphere[2]`; a
+    /// box with six face materials is six objects, `box[0].px` …).
+    pub object_names: Vec<String>,
     /// Every file the scene read besides itself (images, environment maps, OBJ
     /// and MTL files), each once, in the order first read.
     pub assets: Vec<PathBuf>,
@@ -65,6 +69,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
     let textures = textures(&file.textures, &referenced, base_dir, &mut assets)?;
     asset_time += clock.elapsed();
     let mut builder = SceneBuilder::new();
+    let mut names = ObjectNames::default();
     let mut extra_material_names = Vec::new();
     let mut material_ids = BTreeMap::new();
     for (name, table) in &file.materials {
@@ -96,6 +101,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
     for (i, s) in file.sphere.iter().enumerate() {
         let m = lookup(format!("sphere[{i}].material"), &s.material)?;
         let sphere = Sphere::new(s.center.0, s.radius.0).expect("radius read as positive");
+        names.add(s.name.as_ref(), format!("sphere[{i}]"))?;
         builder.shape(sphere, m);
     }
     for (i, p) in file.parallelogram.iter().enumerate() {
@@ -104,6 +110,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         let shape = Parallelogram::new(p.origin.0, p.edge1.get_ref().0, p.edge2.0, p.two_sided)
             .ok_or_else(|| no_area(&field, &p.edge1))?;
         let front = front_side(&field, shape.normal(), p.normal.as_ref())?;
+        names.add(p.name.as_ref(), field)?;
         builder.shape(shape.facing(front), m);
     }
     for (i, p) in file.plane.iter().enumerate() {
@@ -112,6 +119,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         let plane = Plane::new(p.point.0, p.normal.0, p.two_sided)
             .and_then(|plane| plane.with_tile_size(p.tile_size.0))
             .expect("normalizable normal, positive tile size");
+        names.add(p.name.as_ref(), format!("plane[{i}]"))?;
         builder.shape(plane, m);
     }
     for (i, b) in file.boxes.iter().enumerate() {
@@ -126,26 +134,28 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         match (&b.material, &b.face_materials) {
             (Some(material), None) => {
                 let m = lookup(format!("{field}.material"), material)?;
+                names.add(b.name.as_ref(), field.clone())?;
                 builder.shape(aabox, m);
             }
-            (None, Some(names)) if names.get_ref().len() == 6 => {
+            (None, Some(materials)) if materials.get_ref().len() == 6 => {
                 for (face, (shape, name)) in aabox
                     .face_parallelograms()
                     .into_iter()
-                    .zip(names.get_ref())
+                    .zip(materials.get_ref())
                     .enumerate()
                 {
                     let m = lookup(format!("{field}.face_materials[{face}]"), name)?;
+                    names.add_face(b.name.as_ref(), &field, face)?;
                     builder.shape(shape, m);
                 }
             }
-            (None, Some(names)) => {
+            (None, Some(materials)) => {
                 return Err(Problem::new(
-                    names.span(),
+                    materials.span(),
                     format!("{field}.face_materials"),
                     format!(
                         "expected 6 materials (px nx py ny pz nz), got {}",
-                        names.get_ref().len()
+                        materials.get_ref().len()
                     ),
                 ))
             }
@@ -230,6 +240,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
                 ),
             ));
         }
+        names.add(m.name.as_ref(), field)?;
         builder.mesh(mesh, triangle_materials);
     }
     let shading = file.shading.0;
@@ -266,6 +277,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         let light = AreaLight::new(a.center.0, a.edge1.get_ref().0, a.edge2.0, color)
             .ok_or_else(|| no_area(&field, &a.edge1))?;
         let front = front_side(&field, light.surface().normal(), a.normal.as_ref())?;
+        names.add(a.name.as_ref(), field)?;
         builder.area_light(light.facing(front));
     }
     for (i, s) in file.sphere_light.iter().enumerate() {
@@ -280,6 +292,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         let s = s.get_ref();
         let light = SphereLight::new(s.center.0, s.radius.0, s.radiance.0)
             .expect("radius read as positive");
+        names.add(s.name.as_ref(), format!("sphere_light[{i}]"))?;
         builder.sphere_light(light);
     }
     builder.ambient(file.ambient.0);
@@ -305,6 +318,7 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
         scene,
         settings,
         material_names,
+        object_names: names.names,
         assets,
         regions,
         timings: LoadTimings {
@@ -313,6 +327,64 @@ pub(crate) fn build(file: SceneFile, base_dir: &Path) -> Result<SceneDescription
             acceleration,
         },
     })
+}
+
+/// Object names in the order objects enter the scene's shape list.
+#[derive(Default)]
+struct ObjectNames {
+    names: Vec<String>,
+}
+
+/// The longest object name accepted, in characters.
+const MAX_NAME: usize = 60;
+
+impl ObjectNames {
+    /// The next object's name: `given`, checked, or `default`.
+    fn add(&mut self, given: Option<&Spanned<String>>, default: String) -> Result<(), Problem> {
+        let name = self.checked(given, default)?;
+        self.names.push(name);
+        Ok(())
+    }
+
+    /// Face `face` (in `px nx py ny pz nz` order) of the box `field`: the box's
+    /// name or field, then the face.
+    fn add_face(
+        &mut self,
+        given: Option<&Spanned<String>>,
+        field: &str,
+        face: usize,
+    ) -> Result<(), Problem> {
+        const FACES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
+        let base = self.checked(given, field.to_owned())?;
+        self.names.push(format!("{base}.{}", FACES[face]));
+        Ok(())
+    }
+
+    /// `given` if it is a usable name no other object has, else the problem;
+    /// `default` when there is none.
+    fn checked(&self, given: Option<&Spanned<String>>, default: String) -> Result<String, Problem> {
+        let Some(name) = given else {
+            return Ok(default);
+        };
+        let text = name.get_ref().trim();
+        let problem =
+            |message: String| Problem::new(name.span(), format!("{default}.name"), message);
+        let length = text.chars().count();
+        if length == 0 || length > MAX_NAME {
+            return Err(problem(format!(
+                "expected a name of 1 to {MAX_NAME} characters, got {length}"
+            )));
+        }
+        if text.chars().any(char::is_control) {
+            return Err(problem("a name cannot hold control characters".into()));
+        }
+        if self.names.iter().any(|n| n == text) {
+            return Err(problem(format!(
+                "another object is already named \"{text}\"; names must differ"
+            )));
+        }
+        Ok(text.to_owned())
+    }
 }
 
 /// The names of the textures some material reads: only those are loaded (an

@@ -263,6 +263,9 @@ pub struct SphereTable {
     pub center: Point,
     pub radius: Positive,
     pub material: Spanned<String>,
+    /// What reports call the object ("left wall"); by default its table and
+    /// index (`sphere[2]`).
+    pub name: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -276,6 +279,9 @@ pub struct ParallelogramTable {
     #[serde(default)]
     pub two_sided: bool,
     pub material: Spanned<String>,
+    /// What reports call the object ("left wall"); by default its table and
+    /// index (`sphere[2]`).
+    pub name: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -289,6 +295,9 @@ pub struct PlaneTable {
     #[serde(default)]
     pub two_sided: bool,
     pub material: Spanned<String>,
+    /// What reports call the object ("left wall"); by default its table and
+    /// index (`sphere[2]`).
+    pub name: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -300,6 +309,9 @@ pub struct BoxTable {
     pub material: Option<Spanned<String>>,
     /// …or one per face, in `px nx py ny pz nz` order (the report's textured box).
     pub face_materials: Option<Spanned<Vec<Spanned<String>>>>,
+    /// What reports call the object ("left wall"); by default its table and
+    /// index (`sphere[2]`).
+    pub name: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -325,6 +337,9 @@ pub struct AreaLightTable {
     /// Emitted radiance of the front face, W/(sr·m²) per channel
     /// (`shading = "physical"` only).
     pub radiance: Option<Spanned<Color>>,
+    /// What reports call the object ("left wall"); by default its table and
+    /// index (`sphere[2]`).
+    pub name: Option<Spanned<String>>,
 }
 
 /// A sphere emitting `radiance` from its surface (`shading = "physical"` only).
@@ -335,6 +350,9 @@ pub struct SphereLightTable {
     pub radius: Positive,
     /// Emitted radiance, W/(sr·m²) per channel.
     pub radiance: Color,
+    /// What reports call the object ("left wall"); by default its table and
+    /// index (`sphere[2]`).
+    pub name: Option<Spanned<String>>,
 }
 
 /// A triangle mesh read from an OBJ file, placed by a transform.
@@ -352,6 +370,9 @@ pub struct MeshTable {
     pub rotate: Point,
     #[serde(default = "unit_scale3")]
     pub scale: Scale3,
+    /// What reports call the object ("left wall"); by default its table and
+    /// index (`sphere[2]`).
+    pub name: Option<Spanned<String>>,
 }
 
 fn origin() -> Point {

@@ -249,6 +249,50 @@ fn regions_are_read_in_pixels_and_sorted_by_name() {
 }
 
 #[test]
+fn objects_are_named_in_shape_list_order() {
+    let body = format!(
+        "{CAMERA}{MATERIAL}[[parallelogram]]\nname = \" left wall \"\norigin = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 1, 0]\nmaterial = \"m\"\n\
+         [[sphere]]\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n\
+         [[box]]\nname = \"crate\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\nface_materials = [\"m\", \"m\", \"m\", \"m\", \"m\", \"m\"]\n\
+         [[area_light]]\nname = \"lamp\"\ncenter = [0, 3, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, 1]\n"
+    );
+    let d = parse(&body, "n.toml").unwrap();
+    // Spheres enter the shape list first, then parallelograms, planes, boxes,
+    // meshes and the lights' surfaces.
+    assert_eq!(
+        d.object_names,
+        [
+            "sphere[0]",
+            "left wall",
+            "crate.px",
+            "crate.nx",
+            "crate.py",
+            "crate.ny",
+            "crate.pz",
+            "crate.nz",
+            "lamp"
+        ]
+    );
+    assert_eq!(d.object_names.len(), d.scene.surfaces.len());
+
+    let sphere = |name: &str| {
+        format!("{CAMERA}{MATERIAL}[[sphere]]\nname = \"a\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n[[sphere]]\nname = {name}\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n")
+    };
+    let duplicate = error_of(&sphere("\"a\""));
+    assert!(
+        duplicate.contains("sphere[1].name: another object is already named \"a\""),
+        "{duplicate}"
+    );
+    let empty = error_of(&sphere("\"  \""));
+    assert!(
+        empty.contains("sphere[1].name: expected a name of 1 to 60 characters, got 0"),
+        "{empty}"
+    );
+    let long = error_of(&sphere(&format!("\"{}\"", "x".repeat(61))));
+    assert!(long.contains("got 61"), "{long}");
+}
+
+#[test]
 fn meshes_load_with_their_materials_and_bad_files_get_located_errors() {
     let dir = tempfile::tempdir().unwrap();
     let write = |name: &str, body: &str| std::fs::write(dir.path().join(name), body).unwrap();

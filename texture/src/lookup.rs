@@ -1,6 +1,7 @@
 //! What a texture lookup read, for `glint explain`: the footprint, the MIP
-//! level the course report would choose and the one Glint's filter chooses,
-//! the levels and texels read with their weights, and the filtered value.
+//! level Glint's filter chooses, the levels and texels read with their
+//! weights, and the filtered value. (The level the course report chooses
+//! needs the camera: `glint_integrator::report_level`.)
 
 use crate::image::reduce_st;
 use crate::image_texture::{to_st, ImageTexture, TextureFilter};
@@ -31,9 +32,6 @@ pub struct LookupExplained {
     pub st: Option<Vec2>,
     pub dst_dx: Option<Vec2>,
     pub dst_dy: Option<Vec2>,
-    /// The report's level (section 2.8), `log2(L/W)`: the footprint's longer
-    /// axis `L` over a texel's width `W = 1/m` (`m` the image's larger side).
-    pub report_level: Option<f32>,
     /// The level Glint's filter reads ([`ImageTexture::mip_level`]): trilinear
     /// from half the longer axis (never below the shorter one), EWA from the
     /// (clamped) minor axis.
@@ -57,7 +55,6 @@ impl Texture {
             st: None,
             dst_dx: None,
             dst_dy: None,
-            report_level: None,
             glint_level: None,
             texels: Vec::new(),
             second_color_fraction: None,
@@ -92,8 +89,6 @@ fn explain_image(t: &ImageTexture, tc: &TexCoord, out: &mut LookupExplained) {
     out.dst_dx = Some(dst0);
     out.dst_dy = Some(dst1);
     let image = t.image.image();
-    let side = image.width().max(image.height()) as f32;
-    out.report_level = Some((dst0.length().max(dst1.length()) * side).log2());
     out.glint_level = Some(t.mip_level(tc));
     let reduced = reduce_st(st, t.wrap);
     let mut bilinear = |level: usize, weight: f32| {
@@ -242,14 +237,6 @@ mod tests {
                 }
             }
         }
-        // The report's level is the longer axis in texels, log2(0.0906 · 16).
-        let t = Texture::Image(ImageTexture::new(
-            image,
-            WrapMode::Repeat,
-            TextureFilter::Trilinear,
-        ));
-        let level = t.explain(&tc).report_level.unwrap();
-        assert!((level - (Vec2::new(0.09, -0.01).length() * 16.0).log2()).abs() < 1e-5);
     }
 
     #[test]

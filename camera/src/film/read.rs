@@ -21,6 +21,7 @@ enum InputFormat {
     Jpeg,
     Exr,
     Pfm,
+    Ppm,
 }
 
 impl InputFormat {
@@ -30,6 +31,7 @@ impl InputFormat {
             Some("jpg" | "jpeg") => Ok(Self::Jpeg),
             Some("exr") => Ok(Self::Exr),
             Some("pfm") => Ok(Self::Pfm),
+            Some("ppm") => Ok(Self::Ppm),
             _ => Err(FilmError::UnknownInputFormat(path.to_path_buf())),
         }
     }
@@ -49,6 +51,8 @@ impl Film {
     ///   scale) and grayscale `Pf` files are read too. Values are multiplied by
     ///   the absolute value of the scale (so ±1.0, as Glint writes, keeps them bit
     ///   for bit).
+    /// - `.ppm`: Netpbm PPM, binary (`P6`) or ASCII (`P3`), any maxval up to
+    ///   65535: codes taken to be sRGB-encoded, `code / maxval` decoded to linear.
     ///
     /// Float values are kept exactly as stored: NaN, infinite and negative values
     /// are not cleaned up. Images wider or taller than [`MAX_LOAD_SIDE`], or
@@ -62,6 +66,7 @@ impl Film {
         };
         match format {
             InputFormat::Pfm => read_pfm(path).map_err(fail),
+            InputFormat::Ppm => super::ppm::read_ppm(path).map_err(fail),
             InputFormat::Png => read_with_image_crate(path, image::ImageFormat::Png).map_err(fail),
             InputFormat::Jpeg => {
                 read_with_image_crate(path, image::ImageFormat::Jpeg).map_err(fail)
@@ -70,6 +75,60 @@ impl Film {
                 read_with_image_crate(path, image::ImageFormat::OpenExr).map_err(fail)
             }
         }
+    }
+}
+
+/// How an image file stores its samples: what [`Film::load`] had to undo, and
+/// so how much a loaded value can differ from the radiance it was written from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampleEncoding {
+    /// Integer codes `0..=max_code` of the sRGB curve (PNG, JPEG, PPM): values
+    /// were clamped to [0, 1] and rounded to a step of `1 / max_code` in the
+    /// encoded domain.
+    Srgb { max_code: u32 },
+    /// Linear floats (OpenEXR, PFM), kept as written.
+    Linear,
+}
+
+impl Film {
+    /// [`Film::load`], and how the file stored its samples.
+    pub fn load_with_encoding(path: &Path) -> Result<(Film, SampleEncoding), FilmError> {
+        let format = InputFormat::from_path(path)?;
+        let film = Film::load(path)?;
+        let encoding = match format {
+            InputFormat::Exr | InputFormat::Pfm => SampleEncoding::Linear,
+            InputFormat::Ppm => SampleEncoding::Srgb {
+                max_code: super::ppm::maxval(path).map_err(|message| FilmError::Read {
+                    path: path.to_path_buf(),
+                    message,
+                })?,
+            },
+            InputFormat::Png | InputFormat::Jpeg => SampleEncoding::Srgb {
+                max_code: integer_max_code(path, format),
+            },
+        };
+        Ok((film, encoding))
+    }
+}
+
+/// 65535 for a 16-bit PNG, 255 otherwise (JPEG is always 8-bit).
+fn integer_max_code(path: &Path, format: InputFormat) -> u32 {
+    let sixteen_bit = format == InputFormat::Png
+        && open(path)
+            .ok()
+            .and_then(|r| {
+                image::ImageReader::with_format(r, image::ImageFormat::Png)
+                    .into_decoder()
+                    .ok()
+            })
+            .is_some_and(|d| {
+                use image::ImageDecoder;
+                d.color_type().bytes_per_pixel() / d.color_type().channel_count() == 2
+            });
+    if sixteen_bit {
+        65535
+    } else {
+        255
     }
 }
 
@@ -84,7 +143,7 @@ pub fn srgb_to_linear(encoded: f32) -> f32 {
     }
 }
 
-fn check_size(width: u64, height: u64) -> Result<(), String> {
+pub(super) fn check_size(width: u64, height: u64) -> Result<(), String> {
     if width == 0 || height == 0 {
         return Err(format!("the image is {width}x{height}: it has no pixels"));
     }

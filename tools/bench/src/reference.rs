@@ -256,6 +256,18 @@ impl CachePaths {
     /// The cached reference, if all three files are there and agree; anything
     /// else (missing, truncated, another size) counts as no cache.
     pub fn load(&self, key: &str, width: u32, height: u32) -> Option<Reference> {
+        self.load_rounds(key, width, height, FIRST_ROUNDS)
+    }
+
+    /// [`CachePaths::load`], accepting references of at least `min_rounds`
+    /// rounds (one for a deterministic render, whose variance is zero).
+    pub fn load_rounds(
+        &self,
+        key: &str,
+        width: u32,
+        height: u32,
+        min_rounds: u32,
+    ) -> Option<Reference> {
         let entry: CacheEntry =
             serde_json::from_str(&std::fs::read_to_string(&self.entry).ok()?).ok()?;
         let mean = Film::load(&self.mean).ok()?;
@@ -263,7 +275,7 @@ impl CachePaths {
         let size = glam::UVec2::new(width, height);
         let fits = entry.key == key
             && (entry.width, entry.height) == (width, height)
-            && entry.rounds >= FIRST_ROUNDS
+            && entry.rounds >= min_rounds
             && mean.resolution() == size
             && variance.resolution() == size;
         fits.then(|| Reference {

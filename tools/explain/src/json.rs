@@ -4,6 +4,7 @@
 use crate::Stage;
 use glam::{Vec2, Vec3};
 use glint_geometry::{BvhRef, BvhVisit};
+use glint_integrator::ReportLevel;
 use glint_texture::LookupExplained;
 use serde_json::{json, Value};
 
@@ -73,16 +74,20 @@ pub(crate) fn bvh_path(visits: &[BvhVisit]) -> Value {
     Value::Array(visits.iter().map(step).collect())
 }
 
-/// What a texture lookup read.
-pub(crate) fn lookup(l: &LookupExplained) -> Value {
+/// What a texture lookup read; for an image, with the report's level
+/// `report` (`None`: not a camera ray's hit, or not finite).
+pub(crate) fn lookup(l: &LookupExplained, report: Option<ReportLevel>) -> Value {
     let mut out = json!({ "kind": l.kind, "value": v3(l.value) });
     if let (Some(st), Some(dx), Some(dy)) = (l.st, l.dst_dx, l.dst_dy) {
         out["st"] = v2(st);
         out["dst_dx"] = v2(dx);
         out["dst_dy"] = v2(dy);
-    }
-    if let Some(level) = l.report_level {
-        out["report_level"] = num(level);
+        out["report_level"] = report.map_or(Value::Null, |r| num(r.level));
+        if let Some(r) = report {
+            out["report_l"] = num(r.l);
+            out["report_w"] = num(r.w);
+            out["report_m"] = json!(r.m);
+        }
     }
     if let Some(level) = l.glint_level {
         out["glint_level"] = num(level);

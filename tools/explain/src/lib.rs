@@ -10,7 +10,9 @@
 //! lookup read, every texel of an EWA ellipse included
 //! ([`glint_texture::Texture::explain`]). The result is a JSON
 //! document (schema `glint-explain/1`, documented in
-//! `docs/checking-your-ray-tracer.md`) and its text form.
+//! `docs/checking-your-ray-tracer.md`) and its text form. [`against`]
+//! compares a student's document with it, stage by stage in pipeline order
+//! (`glint explain --against`).
 //!
 //! # Conventions
 //! - World space, right-handed, y up; angles in radians; radiance linear RGB.
@@ -19,6 +21,7 @@
 //! - Raster positions are in pixels from the image's top left corner; normalised
 //!   device coordinates run from −1 to 1 with y up.
 
+pub mod against;
 mod json;
 mod text;
 
@@ -28,13 +31,16 @@ struct ReadmeDoctests;
 
 use glam::Vec3;
 use glint_integrator::trace::{Event, SampleSelection, Shadow, Skip, Technique};
-use glint_integrator::{explain_pixel, ExplainError, RenderSettings, Scene, SurfaceKind};
+use glint_integrator::{
+    explain_pixel, report_level, ExplainError, RenderSettings, Scene, SurfaceKind,
+};
 use glint_lighting::Light;
+use glint_texture::Texture;
 use json::{num, v2, v3};
 use serde_json::{json, Map, Value};
 
-/// A stage of the pipeline, to limit the output to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// A stage of the pipeline, to limit the output to; in pipeline order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Stage {
     Camera,
     Intersect,
@@ -44,17 +50,43 @@ pub enum Stage {
 }
 
 impl Stage {
+    /// The stages in pipeline order.
+    pub const ALL: [Stage; 5] = [
+        Stage::Camera,
+        Stage::Intersect,
+        Stage::Texture,
+        Stage::Light,
+        Stage::Film,
+    ];
+
+    /// The names `--stage` takes, in pipeline order.
     pub const NAMES: [&'static str; 5] = ["camera", "intersect", "texture", "light", "film"];
 
+    /// The stage named `name`: one of [`Self::NAMES`], or the heading the text
+    /// output prints for it ([`Self::heading`]: `intersection`, `lighting`).
     pub fn from_name(name: &str) -> Option<Stage> {
         Some(match name {
             "camera" => Stage::Camera,
-            "intersect" => Stage::Intersect,
+            "intersect" | "intersection" => Stage::Intersect,
             "texture" => Stage::Texture,
-            "light" => Stage::Light,
+            "light" | "lighting" => Stage::Light,
             "film" => Stage::Film,
             _ => return None,
         })
+    }
+
+    /// The name `--stage` takes for this stage.
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+
+    /// The heading the text output prints for this stage.
+    pub fn heading(self) -> &'static str {
+        match self {
+            Stage::Intersect => "intersection",
+            Stage::Light => "lighting",
+            other => other.name(),
+        }
     }
 }
 
@@ -131,6 +163,9 @@ fn sample_document(scene: &Scene, sample: u64, events: &[Event]) -> Value {
     let mut root = Value::Null;
     let mut radiance = Value::Null;
     let mut running = Running::default();
+    // The camera ray and its hit, while the event being read belongs to it:
+    // the report's MIP level is defined for camera rays only.
+    let mut camera_hit: Option<(glint_geometry::Ray, glint_geometry::Hit)> = None;
     let close_to = |stack: &mut Vec<Map<String, Value>>, root: &mut Value, depth: usize| {
         while stack.len() > depth {
             let ray = Value::Object(stack.pop().expect("non-empty"));
@@ -168,6 +203,7 @@ fn sample_document(scene: &Scene, sample: u64, events: &[Event]) -> Value {
             Event::Ray { depth, ray, hit } => {
                 close_to(&mut stack, &mut root, *depth as usize);
                 stack.push(ray_record(scene, *depth, ray, hit.as_deref()));
+                camera_hit = hit.as_deref().filter(|_| *depth == 0).map(|h| (*ray, *h));
             }
             Event::SampleRadiance { value } => radiance = v3(*value),
             other => {
@@ -175,7 +211,7 @@ fn sample_document(scene: &Scene, sample: u64, events: &[Event]) -> Value {
                     close_to(&mut stack, &mut root, *depth as usize + 1);
                 }
                 if let Some(ray) = stack.last_mut() {
-                    ray_event(scene, ray, other, &mut running);
+                    ray_event(scene, ray, other, &mut running, camera_hit.as_ref());
                 }
             }
         }
@@ -280,8 +316,15 @@ fn shadow(s: &Shadow) -> Value {
     }
 }
 
-/// Attaches one event to the ray it belongs to.
-fn ray_event(scene: &Scene, ray: &mut Map<String, Value>, event: &Event, running: &mut Running) {
+/// Attaches one event to the ray it belongs to; `camera_hit` is the camera
+/// ray and its hit when the event is that ray's.
+fn ray_event(
+    scene: &Scene,
+    ray: &mut Map<String, Value>,
+    event: &Event,
+    running: &mut Running,
+    camera_hit: Option<&(glint_geometry::Ray, glint_geometry::Hit)>,
+) {
     match event {
         Event::Environment {
             direction,
@@ -312,11 +355,14 @@ fn ray_event(scene: &Scene, ray: &mut Map<String, Value>, event: &Event, running
                 "ks": v3(*ks),
             });
             if let SurfaceKind::Material(m) = scene.surface_of_primitive(object, triangle) {
+                let report = |t: &Texture| {
+                    camera_hit.and_then(|(r, h)| report_level(&scene.camera, r, h, m, t))
+                };
                 let tc = m.uv_transform.apply(tc);
                 texture["material_uv"] = json!(v2(tc.uv));
-                texture["diffuse"] = json::lookup(&m.diffuse.explain(&tc));
+                texture["diffuse"] = json::lookup(&m.diffuse.explain(&tc), report(&m.diffuse));
                 texture["specular"] = match &m.specular {
-                    Some(t) => json::lookup(&t.explain(&tc)),
+                    Some(t) => json::lookup(&t.explain(&tc), report(t)),
                     None => json!("the diffuse texture's (ks = kd)"),
                 };
             }

@@ -320,19 +320,36 @@ fn texture(out: &mut String, t: &Value, indent: &str) {
             l,
             &[("st", "st"), ("dst_dx", "dst/dx"), ("dst_dy", "dst/dy")],
         );
-        pairs(
-            out,
-            &deeper,
-            l,
-            &[
-                ("report_level", "level log2(L/W)"),
-                ("glint_level", "Glint's level"),
-                ("second_color_fraction", "second color's fraction"),
-            ],
-        );
+        levels_text(out, &deeper, l);
         texels_text(out, &deeper, &l["texels"]);
     }
     pairs(out, &sub, t, &[("kd", "kd"), ("ks", "ks")]);
+}
+
+/// A lookup's levels on one line: the report's `log2(L/W)` with its `L`, `W`
+/// and `m`, Glint's, and a checkerboard's second color's fraction.
+fn levels_text(out: &mut String, indent: &str, l: &Value) {
+    let mut parts = Vec::new();
+    if !l["report_level"].is_null() {
+        parts.push(format!(
+            "level log2(L/W) {} (L {}, W {}, m {})",
+            f(&l["report_level"]),
+            f(&l["report_l"]),
+            f(&l["report_w"]),
+            f(&l["report_m"])
+        ));
+    }
+    for (key, label) in [
+        ("glint_level", "Glint's level"),
+        ("second_color_fraction", "second color's fraction"),
+    ] {
+        if !l[key].is_null() {
+            parts.push(format!("{label} {}", f(&l[key])));
+        }
+    }
+    if !parts.is_empty() {
+        writeln!(out, "{indent}{}", parts.join("   ")).unwrap();
+    }
 }
 
 /// Texels listed in full up to this many; beyond (an EWA ellipse), each

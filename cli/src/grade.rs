@@ -1,0 +1,442 @@
+//! `glint grade`: whether submitted images are unbiased renders of their
+//! scenes (one scene's images, or a class by folder or manifest), and the
+//! stages of a student's ray tracer against test vectors. The work is in
+//! glint-grade; this file reads the flags and writes what it returns.
+
+use crate::output::check_writable;
+use crate::{named, progress_bar, Failure};
+use clap::{Args, ValueEnum};
+use glint_grade::class::{self, ClassGrades, Entry, Progress};
+use glint_grade::course::{Course, Scenes};
+use glint_grade::{Cache, GradeError, StatedSettings, TestOptions};
+use glint_integrator::SamplePattern;
+use indicatif::ProgressBar;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+#[command(
+    after_help = "Exit status: 0 when every submission passes, 1 when one fails or \
+                  cannot be read, 2 for bad input (flags, scene, manifest, output paths), \
+                  3 for a failure of Glint's own. The test and its assumptions: \
+                  docs/grading.md."
+)]
+pub(crate) struct GradeArgs {
+    /// The scene the submissions render (TOML), then the submitted images
+    /// (PNG, PPM, EXR, PFM or JPEG), each graded at its own resolution
+    #[arg(value_name = "SCENE.toml SUBMISSION")]
+    inputs: Vec<PathBuf>,
+
+    /// Grade a class: a folder of DIR/STUDENT/SCENE.png (the scene named by
+    /// the file's stem) or a CSV manifest with the columns student, scene,
+    /// file and optionally spp, sampler, light_samples, light_sampler, note
+    #[arg(long, value_name = "DIR|MANIFEST.csv", conflicts_with = "inputs")]
+    class: Option<PathBuf>,
+
+    /// Where a class's scene names are looked up (NAME is DIR/NAME.toml)
+    /// [default: the folder holding the class folder or manifest]
+    #[arg(
+        long,
+        value_name = "DIR",
+        requires = "class",
+        conflicts_with = "course"
+    )]
+    scenes: Option<PathBuf>,
+
+    /// The course's scenes at the report's settings: scene names are those of
+    /// course/course.toml (set1, set2, set3, environment), each graded with
+    /// the settings it gives (the report's 256 samples per pixel and 256 light
+    /// samples) unless a manifest or these flags say otherwise
+    #[arg(long, requires = "class")]
+    course: bool,
+
+    /// The submissions' camera samples per pixel, if known
+    #[arg(long, value_name = "N")]
+    spp: Option<u32>,
+
+    /// Where the submissions' camera samples fall in the pixel, if known (the
+    /// pixel pattern only; the light's is --light-sampler): grid (cell centres
+    /// of a √N × √N grid: its expected value is that quadrature's, so a grid
+    /// must be stated), random, stratified or sobol (unbiased: any of them
+    /// has the same expected value)
+    #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
+    sampler: Option<SamplePattern>,
+
+    /// The submissions' samples per area light per camera sample, if known
+    #[arg(long, value_name = "N")]
+    light_samples: Option<u32>,
+
+    /// Where the submissions' light samples fall, if known (grid, random,
+    /// stratified, sobol)
+    #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
+    light_sampler: Option<SamplePattern>,
+
+    /// The chance of failing a correct submission the test allows, over all
+    /// its regions
+    #[arg(long, value_name = "A", default_value_t = 0.01, value_parser = parse_alpha)]
+    alpha: f64,
+
+    /// The side of the test's fine blocks in pixels [default: a 32nd of the
+    /// image's shorter side, at least 8]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(4..=4096))]
+    block: Option<u32>,
+
+    /// Where rendered references are kept between runs [default:
+    /// $XDG_CACHE_HOME/glint/grade or ~/.cache/glint/grade]
+    #[arg(long, value_name = "DIR")]
+    cache: Option<PathBuf>,
+
+    /// Render the references again instead of reading the cache
+    #[arg(long)]
+    no_cache: bool,
+
+    /// What to print: table (and, for one submission, every rejected region),
+    /// csv or json
+    #[arg(long, value_name = "FORMAT", value_enum, default_value_t = Format::Table)]
+    format: Format,
+
+    /// Write the heat map of the one submission to this PNG file
+    #[arg(long, value_name = "FILE.png")]
+    heatmap: Option<PathBuf>,
+
+    /// Write a report folder: index.html (thumbnails, heat maps, a verdict per
+    /// scene, sortable columns; works offline), grades.csv, grades.json
+    #[arg(long, value_name = "DIR")]
+    report: Option<PathBuf>,
+
+    /// Stage by stage: with --write, write test vectors of SCENE's stages
+    /// (camera, intersection, texture, lighting, film: inputs and Glint's
+    /// outputs, JSON and CSV); with --answers, check a student's answers
+    /// (docs/grading-stages.md)
+    #[arg(long, conflicts_with_all = ["class", "report", "heatmap"])]
+    stages: bool,
+
+    /// With --stages: the folder to write the test vectors to
+    #[arg(
+        long,
+        value_name = "DIR",
+        requires = "stages",
+        conflicts_with = "answers"
+    )]
+    write: Option<PathBuf>,
+
+    /// With --stages: the folder of the student's answers (STAGE.csv or
+    /// STAGE.json)
+    #[arg(long, value_name = "DIR", requires = "stages")]
+    answers: Option<PathBuf>,
+
+    /// With --stages --write: cases per stage [default: 64]
+    #[arg(long, value_name = "N", requires = "write", value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    cases: Option<u32>,
+}
+
+impl GradeArgs {
+    /// The flags `--stages` reads.
+    fn stage_args(&self) -> Result<crate::grade_stages::StageArgs, Failure> {
+        let [scene] = &self.inputs[..] else {
+            return Err(Failure::Input(
+                "glint grade --stages takes one scene: glint grade --stages SCENE.toml --write DIR (or --answers DIR)".into(),
+            ));
+        };
+        if self.write.is_none() == self.answers.is_none() {
+            return Err(Failure::Input(
+                "glint grade --stages needs --write DIR (test vectors) or --answers DIR (a student's answers)".into(),
+            ));
+        }
+        Ok(crate::grade_stages::StageArgs {
+            scene: scene.clone(),
+            write: self.write.clone(),
+            answers: self.answers.clone(),
+            cases: self.cases,
+            format_json: self.format == Format::Json,
+        })
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Format {
+    Table,
+    Csv,
+    Json,
+}
+
+fn parse_alpha(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(a) if a > 0.0 && a < 1.0 => Ok(a),
+        _ => Err(format!(
+            "expected a probability between 0 and 1 (exclusive), got \"{}\"",
+            class::shorten(text)
+        )),
+    }
+}
+
+pub(crate) fn grade(args: &GradeArgs) -> Result<(), Failure> {
+    if args.stages {
+        return crate::grade_stages::run(&args.stage_args()?);
+    }
+    let stated = stated(args)?;
+    let (entries, scenes, base) = entries(args, &stated)?;
+    check_outputs(args, &entries)?;
+    let options = class::ClassOptions {
+        test: TestOptions {
+            alpha: args.alpha,
+            block: args.block,
+        },
+        cache: cache(args),
+    };
+    let bar = GradeProgress::new();
+    let report = args.report.as_deref();
+    let on_graded = |i: usize, row: &class::Row, s: &glint_grade::Submission, g: &class::Group| {
+        if let Some(dir) = report {
+            glint_grade::html::write_images(dir, i, row, s, g)?;
+        }
+        Ok(())
+    };
+    let grades = class::grade_class(&entries, &scenes, &base, &options, &bar, &on_graded)
+        .map_err(failure)?;
+    bar.finish();
+    if let Some(path) = &args.heatmap {
+        write_heatmap(path, &grades)?;
+    }
+    if let Some(dir) = report {
+        glint_grade::html::write_report(dir, &grades).map_err(failure)?;
+    }
+    print(args, &grades)?;
+    if grades.all_passed() {
+        Ok(())
+    } else {
+        Err(Failure::Graded)
+    }
+}
+
+/// The settings the command line states for every submission (a manifest's
+/// cells and a course's presets fill what it leaves unknown).
+fn stated(args: &GradeArgs) -> Result<StatedSettings, Failure> {
+    let stated = StatedSettings {
+        spp: args.spp,
+        pixel_pattern: args.sampler,
+        light_samples: args.light_samples,
+        light_pattern: args.light_sampler,
+    };
+    // A grid without its count may be completed by a manifest or a course.
+    if let Err(e @ glint_grade::hypothesis::StatedError::Zero { .. }) = stated.validate() {
+        return Err(Failure::Input(format!("the submissions' settings: {e}")));
+    }
+    Ok(stated)
+}
+
+/// The submissions, where their scenes are looked up, and what scene paths
+/// are relative to.
+fn entries(
+    args: &GradeArgs,
+    stated: &StatedSettings,
+) -> Result<(Vec<Entry>, Scenes, PathBuf), Failure> {
+    if let Some(class) = &args.class {
+        let base = class
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."))
+            .to_owned();
+        let scenes = match (&args.scenes, args.course) {
+            (Some(dir), _) if !dir.is_dir() => {
+                return Err(Failure::Input(format!(
+                    "{}: --scenes: not a folder",
+                    dir.display()
+                )))
+            }
+            (Some(dir), _) => Scenes::Folder(dir.clone()),
+            (None, true) => Scenes::Course(Course::load(&course_index()?).map_err(failure)?),
+            (None, false) => Scenes::Folder(base.clone()),
+        };
+        let entries = match class.is_dir() {
+            true => class::entries_from_folder(class, stated),
+            false if class.is_file() => class::entries_from_manifest(class, stated),
+            false => Err(GradeError::Input(format!(
+                "{}: --class: no such folder or manifest",
+                class.display()
+            ))),
+        }
+        .map_err(failure)?;
+        return Ok((entries, scenes, base));
+    }
+    let Some((scene, submissions)) = args.inputs.split_first() else {
+        return Err(Failure::Input(
+            "give a scene and the images to grade (glint grade SCENE.toml IMAGE…), or --class"
+                .into(),
+        ));
+    };
+    if scene.extension().and_then(|e| e.to_str()) != Some("toml") {
+        return Err(Failure::Input(format!(
+            "{}: the first argument is the scene, a .toml file",
+            scene.display()
+        )));
+    }
+    if submissions.is_empty() {
+        return Err(Failure::Input(format!(
+            "{}: no images to grade; give them after the scene",
+            scene.display()
+        )));
+    }
+    let entries = submissions
+        .iter()
+        .map(|file| Entry {
+            student: file
+                .file_stem()
+                .map_or(String::new(), |s| s.to_string_lossy().into_owned()),
+            scene: scene.display().to_string(),
+            file: file.clone(),
+            stated: *stated,
+        })
+        .collect();
+    // The scene and images are named on the command line: a bad one is bad
+    // input, found before any reference is rendered.
+    glint_grade::GradeScene::load(scene).map_err(failure)?;
+    for file in submissions {
+        glint_grade::Submission::load(file).map_err(Failure::Input)?;
+    }
+    Ok((entries, Scenes::Folder(PathBuf::new()), PathBuf::new()))
+}
+
+/// The course index: `course/course.toml` in the current folder, else in
+/// the repository this binary was built from.
+fn course_index() -> Result<PathBuf, Failure> {
+    let here = PathBuf::from("course/course.toml");
+    let built = Path::new(env!("CARGO_MANIFEST_DIR")).join("../course/course.toml");
+    [here, built].into_iter().find(|p| p.is_file()).ok_or_else(|| {
+        Failure::Input(
+            "--course: no course/course.toml here or in the repository Glint was built from; give --scenes DIR".into(),
+        )
+    })
+}
+
+fn cache(args: &GradeArgs) -> Cache {
+    if args.no_cache {
+        return Cache { dir: None };
+    }
+    let default = || {
+        let base = std::env::var_os("XDG_CACHE_HOME")
+            .map(PathBuf::from)
+            .filter(|p| p.is_absolute())
+            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
+        Some(base.join("glint").join("grade"))
+    };
+    Cache {
+        dir: args.cache.clone().or_else(default),
+    }
+}
+
+/// Every output path, before any work.
+fn check_outputs(args: &GradeArgs, entries: &[Entry]) -> Result<(), Failure> {
+    if let Some(path) = &args.heatmap {
+        if entries.len() != 1 {
+            return Err(Failure::Input(format!(
+                "{}: --heatmap writes one submission's map, and there are {}; use --report DIR for many",
+                path.display(),
+                entries.len()
+            )));
+        }
+        let is_png = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !is_png {
+            return Err(Failure::Input(format!(
+                "{}: a heat map is written as PNG; expected a .png extension",
+                path.display()
+            )));
+        }
+        check_writable(path)?;
+        if path.canonicalize().ok() == entries[0].file.canonicalize().ok() {
+            return Err(Failure::Input(format!(
+                "{}: is the submission itself; choose another heat map file",
+                path.display()
+            )));
+        }
+    }
+    if let Some(dir) = &args.report {
+        glint_grade::html::check_report_dir(dir).map_err(failure)?;
+    }
+    if let Some(dir) = &cache(args).dir {
+        if dir.exists() && !dir.is_dir() {
+            return Err(Failure::Input(format!(
+                "{}: --cache: not a folder",
+                dir.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn write_heatmap(path: &Path, grades: &ClassGrades) -> Result<(), Failure> {
+    let row = &grades.rows[0];
+    let (class::Outcome::Graded(grade), Some(g)) = (&row.outcome, row.group) else {
+        return Ok(());
+    };
+    let submission = glint_grade::Submission::load(Path::new(&row.file)).map_err(Failure::Other)?;
+    let group = &grades.groups[g];
+    let pixels = glint_grade::heatmap::heatmap(grade, &submission.film, &group.references.objects);
+    glint_grade::html::save_png(path, submission.resolution(), &pixels).map_err(failure)
+}
+
+fn print(args: &GradeArgs, grades: &ClassGrades) -> Result<(), Failure> {
+    let text = match args.format {
+        Format::Csv => glint_grade::report::csv(grades),
+        Format::Json => {
+            serde_json::to_string_pretty(&glint_grade::report::json(grades)).expect("JSON") + "\n"
+        }
+        Format::Table => match (&grades.rows[..], args.class.is_some()) {
+            ([row], false) => match &row.outcome {
+                class::Outcome::Graded(g) => glint_grade::report::details(g, 10),
+                class::Outcome::Unreadable { message } => {
+                    format!("{}: error: {message}\n", row.file)
+                }
+            },
+            _ => glint_grade::report::table(grades),
+        },
+    };
+    // A reader that stops early (`| head`) is not an error.
+    let _ = std::io::stdout().write_all(text.as_bytes());
+    Ok(())
+}
+
+fn failure(e: GradeError) -> Failure {
+    match e {
+        GradeError::Input(m) => Failure::Input(m),
+        GradeError::Internal(m) => Failure::Internal(m),
+    }
+}
+
+/// A progress bar over the submissions, and the references' renders as
+/// lines above it (on a terminal only).
+struct GradeProgress {
+    bar: Option<ProgressBar>,
+}
+
+impl GradeProgress {
+    fn new() -> GradeProgress {
+        GradeProgress {
+            bar: progress_bar("{spinner} grading {pos}/{len} [{bar:30}] {elapsed}"),
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+impl Progress for GradeProgress {
+    fn rendering(&self, what: &str) {
+        if let Some(bar) = &self.bar {
+            bar.println(what);
+        }
+    }
+
+    fn graded(&self, done: usize, total: usize) {
+        if let Some(bar) = &self.bar {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        }
+    }
+}

@@ -1,0 +1,789 @@
+//! `glint explain --against`: a student's document in the `glint-explain/1`
+//! schema, possibly partial, compared with Glint's document for the same
+//! pixel and flags, stage by stage in pipeline order (camera, intersection,
+//! texture, lighting, film), to find the first stage where the student's
+//! numbers part from Glint's.
+//!
+//! Within a stage, keys are compared in the order the student's document
+//! lists them (the file is read keeping its order; a `serde_json::Value`
+//! would sort the keys), samples and mirror reflections in document order.
+//! Only the keys the student gives are compared; the keys that describe
+//! Glint's own work ([`SKIPPED`]) are not.
+//!
+//! Tolerances: numbers within [`RELATIVE`] of Glint's, plus [`FLOOR`];
+//! vectors component by component, relative to their largest component;
+//! unit directions within [`ANGLE`] radians; integers, booleans, strings
+//! (kinds, shadow verdicts) and nulls exactly; the 8-bit sRGB value within 1.
+
+use crate::Stage;
+use serde::de::{self, Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
+use serde_json::{json, Number, Value};
+use std::fmt;
+
+/// The relative tolerance of numbers and vectors.
+pub const RELATIVE: f64 = 1e-3;
+/// The absolute floor added to the relative tolerance, so that a value Glint
+/// rounds to almost nothing (a specular term of 1e-30) matches a zero.
+pub const FLOOR: f64 = 1e-6;
+/// The largest angle between two unit directions that agree, in radians.
+pub const ANGLE: f64 = 1e-3;
+/// Keys that describe Glint's own queries (every object's test, the BVH's
+/// work and path), not numbers a ray tracer must reproduce.
+pub const SKIPPED: [&str; 3] = ["tests", "work", "bvh"];
+/// Keys whose value is a unit direction, compared by angle.
+const DIRECTIONS: [&str; 10] = [
+    "direction",
+    "rx_direction",
+    "ry_direction",
+    "l",
+    "v",
+    "n",
+    "ng",
+    "reflection",
+    "geometric_normal",
+    "shading_normal",
+];
+/// The document's own keys besides `samples` and `film`.
+const HEADER: [&str; 5] = ["schema", "pixel", "resolution", "spp", "seed"];
+
+/// A JSON value whose objects keep their keys in the file's order.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Node {
+    Null,
+    Bool(bool),
+    Number(Number),
+    String(String),
+    Array(Vec<Node>),
+    Object(Vec<(String, Node)>),
+}
+
+impl Node {
+    /// Reads a JSON text; the error has the line and column.
+    pub fn parse(text: &str) -> Result<Node, serde_json::Error> {
+        serde_json::from_str(text)
+    }
+
+    /// The value of `key`, if this is an object that has it.
+    pub fn get(&self, key: &str) -> Option<&Node> {
+        match self {
+            Node::Object(entries) => entries.iter().find(|(k, _)| k == key).map(|(_, v)| v),
+            _ => None,
+        }
+    }
+
+    /// As a `serde_json::Value` (keys sorted), for printing.
+    pub fn to_value(&self) -> Value {
+        match self {
+            Node::Null => Value::Null,
+            Node::Bool(b) => Value::Bool(*b),
+            Node::Number(n) => Value::Number(n.clone()),
+            Node::String(s) => Value::String(s.clone()),
+            Node::Array(items) => Value::Array(items.iter().map(Node::to_value).collect()),
+            Node::Object(entries) => Value::Object(
+                entries
+                    .iter()
+                    .map(|(k, v)| (k.clone(), v.to_value()))
+                    .collect(),
+            ),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Node {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_any(NodeVisitor)
+    }
+}
+
+struct NodeVisitor;
+
+impl<'de> Visitor<'de> for NodeVisitor {
+    type Value = Node;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a JSON value")
+    }
+    fn visit_bool<E: de::Error>(self, v: bool) -> Result<Node, E> {
+        Ok(Node::Bool(v))
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<Node, E> {
+        Ok(Node::Number(v.into()))
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<Node, E> {
+        Ok(Node::Number(v.into()))
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<Node, E> {
+        Number::from_f64(v)
+            .map(Node::Number)
+            .ok_or_else(|| E::custom("a number that is not finite"))
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<Node, E> {
+        Ok(Node::String(v.to_owned()))
+    }
+    fn visit_unit<E: de::Error>(self) -> Result<Node, E> {
+        Ok(Node::Null)
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Node, A::Error> {
+        let mut items = Vec::new();
+        while let Some(item) = seq.next_element()? {
+            items.push(item);
+        }
+        Ok(Node::Array(items))
+    }
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Node, A::Error> {
+        let mut entries = Vec::new();
+        while let Some(entry) = map.next_entry::<String, Node>()? {
+            entries.push(entry);
+        }
+        Ok(Node::Object(entries))
+    }
+}
+
+/// How two values are compared.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tolerance {
+    /// A number: `|yours − Glint's| ≤ RELATIVE·|Glint's| + FLOOR`.
+    Relative,
+    /// A vector (a point, uv, a color): each component within `RELATIVE`
+    /// times Glint's largest component, plus `FLOOR`.
+    Vector,
+    /// A unit direction: at most `ANGLE` radians apart.
+    Angular,
+    /// Equal: ids, counts, booleans, strings, nulls, the kind of value.
+    Exact,
+    /// An 8-bit value: within 1 (a radiance within tolerance can round
+    /// either way).
+    WithinOne,
+}
+
+impl Tolerance {
+    /// Its name in the JSON report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Tolerance::Relative => "relative",
+            Tolerance::Vector => "relative to the largest component",
+            Tolerance::Angular => "angular",
+            Tolerance::Exact => "exact",
+            Tolerance::WithinOne => "within 1",
+        }
+    }
+
+    /// What it allows, in words.
+    pub fn describe(self) -> String {
+        match self {
+            Tolerance::Relative => format!("within {RELATIVE:e}·|Glint's| + {FLOOR:e}"),
+            Tolerance::Vector => format!(
+                "each component within {RELATIVE:e}·(Glint's largest |component|) + {FLOOR:e}"
+            ),
+            Tolerance::Angular => format!("at most {ANGLE:e} rad apart"),
+            Tolerance::Exact => "equal".to_owned(),
+            Tolerance::WithinOne => "each component within 1".to_owned(),
+        }
+    }
+}
+
+/// A key where the student's document parts from Glint's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Difference {
+    pub stage: Stage,
+    /// Where, as `samples[0].ray.intersect.hit.uv` (indices into the
+    /// student's arrays).
+    pub path: String,
+    pub yours: Value,
+    /// Glint's value; `None` where Glint's document has no such key.
+    pub glint: Option<Value>,
+    pub tolerance: Tolerance,
+    /// For numbers and directions: how far apart they are, and how far
+    /// the tolerance allows.
+    pub gap: Option<(f64, f64)>,
+}
+
+/// One stage's share of a comparison.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StageComparison {
+    pub stage: Stage,
+    /// Keys compared (a vector counts once).
+    pub compared: usize,
+    /// The keys that differ, in the order compared.
+    pub differences: Vec<Difference>,
+}
+
+/// A student's document against Glint's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    pub pixel: (u64, u64),
+    /// The one stage compared (`--stage`), if only one was.
+    pub only: Option<Stage>,
+    /// Every stage, in pipeline order.
+    pub stages: Vec<StageComparison>,
+}
+
+impl Comparison {
+    /// Whether every key the student gave agrees with Glint's.
+    pub fn agrees(&self) -> bool {
+        self.first().is_none()
+    }
+
+    /// The first difference in pipeline order: in the first stage that has
+    /// one, the first key compared.
+    pub fn first(&self) -> Option<&Difference> {
+        self.stages.iter().find_map(|s| s.differences.first())
+    }
+
+    /// The report as text, naming the student's file `file`: a line per
+    /// stage, and the first difference under its stage.
+    pub fn text(&self, file: &str) -> String {
+        let mut lines = vec![format!(
+            "{file} against Glint, pixel ({}, {}), stage by stage in pipeline order:",
+            self.pixel.0, self.pixel.1
+        )];
+        let first = self.first();
+        for s in &self.stages {
+            lines.push(self.stage_line(s, first.map(|d| d.stage)));
+            if let Some(d) = first.filter(|d| d.stage == s.stage) {
+                lines.extend(difference_text(d));
+            }
+        }
+        lines.push(match first {
+            None => "your document agrees with Glint's everywhere it gives a value".to_owned(),
+            Some(d) => format!(
+                "the first difference is in the {} stage: look there first",
+                d.stage.heading()
+            ),
+        });
+        lines.join("\n") + "\n"
+    }
+
+    /// One stage's line: not compared, agreeing, the first to part, or
+    /// differing after it.
+    fn stage_line(&self, s: &StageComparison, first: Option<Stage>) -> String {
+        let heading = s.stage.heading();
+        let (n, d) = (s.compared, s.differences.len());
+        match (first, d) {
+            _ if self.only.is_some_and(|only| only != s.stage) => {
+                format!("  {heading}: not compared (--stage)")
+            }
+            (_, 0) if n == 0 => format!("  {heading}: not in your document"),
+            (_, 0) => format!(
+                "  {heading}: agrees ({n} {})",
+                if n == 1 { "key" } else { "keys" }
+            ),
+            (Some(f), _) if f == s.stage => {
+                format!("  {heading}: PARTS from Glint ({})", differing(d, n))
+            }
+            (Some(f), _) => format!(
+                "  {heading}: {} (perhaps only because of the {} stage)",
+                differing(d, n),
+                f.heading()
+            ),
+            (None, _) => unreachable!("a stage with differences makes `first`"),
+        }
+    }
+
+    /// The report as JSON.
+    pub fn json(&self) -> Value {
+        let stages: Vec<Value> = self
+            .stages
+            .iter()
+            .map(|s| {
+                json!({
+                    "stage": s.stage.heading(),
+                    "compared": s.compared,
+                    "differing": s.differences.len(),
+                })
+            })
+            .collect();
+        json!({
+            "schema": "glint-explain-against/1",
+            "pixel": [self.pixel.0, self.pixel.1],
+            "agrees": self.agrees(),
+            "stages": stages,
+            "first_difference": self.first().map(difference_json),
+        })
+    }
+}
+
+fn difference_text(d: &Difference) -> Vec<String> {
+    let glint = match &d.glint {
+        Some(v) => v.to_string(),
+        None => "(no such key in Glint's document)".to_owned(),
+    };
+    let mut tolerance = format!("{}: {}", d.tolerance.name(), d.tolerance.describe());
+    if let Some((gap, allowed)) = d.gap {
+        tolerance += &format!("; apart by {}, allowed {}", sig5(gap), sig5(allowed));
+    }
+    vec![
+        format!("  first difference: {}", d.path),
+        format!("    yours:     {}", d.yours),
+        format!("    Glint's:   {glint}"),
+        format!("    tolerance: {tolerance}"),
+    ]
+}
+
+/// `x` to 5 significant digits, as the documents print numbers.
+fn sig5(x: f64) -> String {
+    format!("{x:.4e}").parse::<f64>().unwrap_or(x).to_string()
+}
+
+/// "1 of 1 key differs", "2 of 5 keys differ".
+fn differing(d: usize, n: usize) -> String {
+    let noun = if n == 1 { "key" } else { "keys" };
+    let verb = if d == 1 { "differs" } else { "differ" };
+    format!("{d} of {n} {noun} {verb}")
+}
+
+fn difference_json(d: &Difference) -> Value {
+    let mut out = json!({
+        "stage": d.stage.heading(),
+        "path": d.path,
+        "yours": d.yours,
+        "glint": d.glint.clone().unwrap_or(Value::Null),
+        "in_glint": d.glint.is_some(),
+        "tolerance": {
+            "kind": d.tolerance.name(),
+            "relative": RELATIVE,
+            "floor": FLOOR,
+            "radians": ANGLE,
+        },
+    });
+    if let Some((gap, allowed)) = d.gap {
+        out["apart"] = json!(gap);
+        out["allowed"] = json!(allowed);
+    }
+    out
+}
+
+/// The student's document `student` against Glint's `glint` (the whole
+/// document for the same pixel and flags), comparing only `only`'s keys if
+/// given. `Err` is an input error: not a `glint-explain/1` document,
+/// another pixel, resolution, spp or seed, an unknown key at the top, or a
+/// sample the flags do not follow.
+pub fn compare(student: &Node, glint: &Value, only: Option<Stage>) -> Result<Comparison, String> {
+    check_header(student, glint)?;
+    let mut walk = Walk {
+        only,
+        stages: Stage::ALL
+            .iter()
+            .map(|&stage| StageComparison {
+                stage,
+                compared: 0,
+                differences: Vec::new(),
+            })
+            .collect(),
+    };
+    let Node::Object(entries) = student else {
+        unreachable!("checked by check_header")
+    };
+    for (key, value) in entries {
+        match key.as_str() {
+            k if HEADER.contains(&k) => {}
+            "samples" => walk.samples(value, &glint["samples"])?,
+            "film" => walk.tree(Stage::Film, "film", "film", value, glint.get("film")),
+            other => {
+                return Err(format!(
+                    "unknown key \"{other}\" at the top of the document (a glint-explain/1 document holds {}, samples and film)",
+                    HEADER.join(", ")
+                ))
+            }
+        }
+    }
+    let pixel = &glint["pixel"];
+    Ok(Comparison {
+        only,
+        pixel: (
+            pixel[0].as_u64().unwrap_or(0),
+            pixel[1].as_u64().unwrap_or(0),
+        ),
+        stages: walk.stages,
+    })
+}
+
+/// The document is a `glint-explain/1` object for the same pixel,
+/// resolution, spp and seed as Glint's (each where it gives them).
+fn check_header(student: &Node, glint: &Value) -> Result<(), String> {
+    if !matches!(student, Node::Object(_)) {
+        return Err("not a JSON object: expected a glint-explain/1 document".to_owned());
+    }
+    match student.get("schema") {
+        Some(Node::String(s)) if s == "glint-explain/1" => {}
+        Some(other) => {
+            return Err(format!(
+                "schema is {}, expected \"glint-explain/1\"",
+                other.to_value()
+            ))
+        }
+        None => return Err("no \"schema\": expected \"schema\": \"glint-explain/1\"".to_owned()),
+    }
+    for key in ["pixel", "resolution", "spp", "seed"] {
+        let Some(yours) = student.get(key).map(Node::to_value) else {
+            continue;
+        };
+        if !same(&yours, &glint[key]) {
+            return Err(format!(
+                "the document is for {key} {yours}, but this command explains {key} {}: {}",
+                glint[key],
+                flag_for(key, &yours)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The flag that gives the command the document's `value` of `key`.
+fn flag_for(key: &str, value: &Value) -> String {
+    let pair = |separator: &str| match value.as_array().map(Vec::as_slice) {
+        Some([a, b]) => format!("{a}{separator}{b}"),
+        _ => value.to_string(),
+    };
+    match key {
+        "pixel" => format!("pass --pixel {}", pair(",")),
+        "resolution" => format!("pass --resolution {}", pair("x")),
+        other => format!("pass --{other} {value}"),
+    }
+}
+
+/// JSON values equal, numbers by value (`3` and `3.0` alike).
+fn same(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => x.as_f64() == y.as_f64(),
+        (Value::Array(x), Value::Array(y)) => {
+            x.len() == y.len() && x.iter().zip(y).all(|(a, b)| same(a, b))
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| same(v, w)))
+        }
+        _ => a == b,
+    }
+}
+
+/// The comparison so far: each stage's count and differences.
+struct Walk {
+    only: Option<Stage>,
+    stages: Vec<StageComparison>,
+}
+
+impl Walk {
+    /// The student's samples, each matched with Glint's sample of the same
+    /// index (its `sample` key, else its place in the array).
+    fn samples(&mut self, yours: &Node, glint: &Value) -> Result<(), String> {
+        let Node::Array(samples) = yours else {
+            return Err("samples is not an array".to_owned());
+        };
+        for (i, sample) in samples.iter().enumerate() {
+            let index = match sample.get("sample") {
+                Some(Node::Number(n)) => n.as_u64(),
+                None => Some(i as u64),
+                Some(_) => None,
+            }
+            .ok_or_else(|| format!("samples[{i}].sample is not a sample index"))?;
+            let theirs = glint
+                .as_array()
+                .into_iter()
+                .flatten()
+                .find(|s| s["sample"].as_u64() == Some(index))
+                .ok_or_else(|| {
+                    format!(
+                        "samples[{i}] is sample {index}, which this command does not follow: pass --sample {index} or --all-samples"
+                    )
+                })?;
+            self.sample(&format!("samples[{i}]"), sample, theirs)?;
+        }
+        Ok(())
+    }
+
+    fn sample(&mut self, path: &str, yours: &Node, glint: &Value) -> Result<(), String> {
+        let Node::Object(entries) = yours else {
+            return Err(format!("{path} is not an object"));
+        };
+        for (key, value) in entries {
+            let at = format!("{path}.{key}");
+            match key.as_str() {
+                "sample" => {}
+                "camera" => self.tree(Stage::Camera, &at, key, value, glint.get(key)),
+                "ray" => self.ray(&at, value, glint.get(key)),
+                // The sample's radiance is its camera ray's.
+                _ => self.tree(Stage::Light, &at, key, value, glint.get(key)),
+            }
+        }
+        Ok(())
+    }
+
+    /// A ray: its keys by stage, its reflection a ray again.
+    fn ray(&mut self, path: &str, yours: &Node, glint: Option<&Value>) {
+        let (Node::Object(entries), Some(glint @ Value::Object(_))) = (yours, glint) else {
+            return self.tree(Stage::Intersect, path, "ray", yours, glint);
+        };
+        for (key, value) in entries {
+            let at = format!("{path}.{key}");
+            match key.as_str() {
+                "reflection" if glint.get(key).is_some() => self.ray(&at, value, glint.get(key)),
+                "reflection" | "depth" | "intersect" | "object" | "triangle" => {
+                    self.tree(Stage::Intersect, &at, key, value, glint.get(key))
+                }
+                "texture" => self.tree(Stage::Texture, &at, key, value, glint.get(key)),
+                _ => self.tree(Stage::Light, &at, key, value, glint.get(key)),
+            }
+        }
+    }
+
+    /// Any value of `stage` under `key`: objects key by key, arrays of
+    /// objects element by element, anything else as one value.
+    fn tree(&mut self, stage: Stage, path: &str, key: &str, yours: &Node, glint: Option<&Value>) {
+        if self.only.is_some_and(|only| only != stage) {
+            return;
+        }
+        match (yours, glint) {
+            (Node::Object(entries), Some(Value::Object(theirs))) => {
+                for (k, v) in entries
+                    .iter()
+                    .filter(|(k, _)| !SKIPPED.contains(&k.as_str()))
+                {
+                    self.tree(stage, &format!("{path}.{k}"), k, v, theirs.get(k));
+                }
+            }
+            (Node::Array(items), Some(Value::Array(theirs))) if !is_vector(theirs) => {
+                for (i, item) in items.iter().enumerate() {
+                    self.tree(stage, &format!("{path}[{i}]"), key, item, theirs.get(i));
+                }
+            }
+            _ => self.leaf(stage, path, key, yours, glint),
+        }
+    }
+
+    /// One value compared as a whole.
+    fn leaf(&mut self, stage: Stage, path: &str, key: &str, yours: &Node, glint: Option<&Value>) {
+        let result = &mut self.stages[stage as usize];
+        result.compared += 1;
+        let yours = yours.to_value();
+        let verdict = match glint {
+            Some(g) => agree(key, &yours, g),
+            None => Err((Tolerance::Exact, None)),
+        };
+        if let Err((tolerance, gap)) = verdict {
+            result.differences.push(Difference {
+                stage,
+                path: path.to_owned(),
+                yours,
+                glint: glint.cloned(),
+                tolerance,
+                gap,
+            });
+        }
+    }
+}
+
+/// An array of numbers (or of nulls, Glint's non-finite numbers): a vector.
+fn is_vector(items: &[Value]) -> bool {
+    !items.is_empty() && items.iter().all(|v| v.is_number() || v.is_null())
+}
+
+type Verdict = Result<Tolerance, (Tolerance, Option<(f64, f64)>)>;
+
+/// Whether `yours` agrees with Glint's `glint` under `key`, and by which
+/// tolerance; on a failure, how far apart they are where that is a number.
+fn agree(key: &str, yours: &Value, glint: &Value) -> Verdict {
+    match (yours, glint) {
+        (Value::Array(a), Value::Array(g)) if is_vector(g) => vector(key, a, g),
+        (Value::Number(a), Value::Number(g)) => number(key, a, g),
+        _ if same(yours, glint) => Ok(Tolerance::Exact),
+        _ => Err((Tolerance::Exact, None)),
+    }
+}
+
+/// A number: integers exactly (Glint writes ids and counts as integers),
+/// floats relatively.
+fn number(key: &str, yours: &Number, glint: &Number) -> Verdict {
+    let (a, g) = (
+        yours.as_f64().unwrap_or(f64::NAN),
+        glint.as_f64().unwrap_or(0.0),
+    );
+    if !glint.is_f64() {
+        let tolerance = if key == "srgb8" {
+            Tolerance::WithinOne
+        } else {
+            Tolerance::Exact
+        };
+        let allowed = if key == "srgb8" { 1.0 } else { 0.0 };
+        return within(tolerance, (a - g).abs(), allowed);
+    }
+    within(
+        Tolerance::Relative,
+        (a - g).abs(),
+        RELATIVE * g.abs() + FLOOR,
+    )
+}
+
+/// A vector: a unit direction by angle, integers exactly (or within 1 for
+/// the 8-bit value), anything else component by component relative to its
+/// largest component.
+fn vector(key: &str, yours: &[Value], glint: &[Value]) -> Verdict {
+    let numbers = |v: &[Value]| v.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>();
+    let (Some(a), Some(g)) = (numbers(yours), numbers(glint)) else {
+        // A null (a number that is not finite) must be matched exactly.
+        return match same(&Value::from(yours.to_vec()), &Value::from(glint.to_vec())) {
+            true => Ok(Tolerance::Exact),
+            false => Err((Tolerance::Exact, None)),
+        };
+    };
+    if a.len() != g.len() {
+        return Err((Tolerance::Exact, None));
+    }
+    if glint
+        .iter()
+        .all(|v| !v.as_number().is_some_and(Number::is_f64))
+    {
+        let gap = a
+            .iter()
+            .zip(&g)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        return match key {
+            "srgb8" => within(Tolerance::WithinOne, gap, 1.0),
+            _ => within(Tolerance::Exact, gap, 0.0),
+        };
+    }
+    if DIRECTIONS.contains(&key) {
+        if let Some(angle) = angle_between(&a, &g) {
+            return within(Tolerance::Angular, angle, ANGLE);
+        }
+    }
+    let largest = g.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let gap = a
+        .iter()
+        .zip(&g)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    within(Tolerance::Vector, gap, RELATIVE * largest + FLOOR)
+}
+
+/// The angle between two vectors; `None` if either has no length.
+fn angle_between(a: &[f64], b: &[f64]) -> Option<f64> {
+    let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+    let length = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let (la, lb) = (length(a), length(b));
+    if la == 0.0 || lb == 0.0 {
+        return None;
+    }
+    // The cross product's length keeps small angles accurate, where acos
+    // of a dot product near 1 loses them.
+    let cross = match (a, b) {
+        ([ax, ay, az], [bx, by, bz]) => {
+            let c = [ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx];
+            length(&c)
+        }
+        _ => ((la * lb).powi(2) - dot * dot).max(0.0).sqrt(),
+    };
+    Some(cross.atan2(dot))
+}
+
+fn within(tolerance: Tolerance, gap: f64, allowed: f64) -> Verdict {
+    if gap <= allowed {
+        Ok(tolerance)
+    } else {
+        // NaN (a student's value that is no number) never agrees.
+        Err((tolerance, Some((gap, allowed))))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn glint() -> Value {
+        json!({
+            "schema": "glint-explain/1", "pixel": [3, 4], "resolution": [8, 8],
+            "spp": 1, "seed": 0,
+            "samples": [{
+                "sample": 0,
+                "camera": {"raster": [3.5, 4.5], "direction": [0.0, 0.6, -0.8]},
+                "ray": {
+                    "depth": 0,
+                    "intersect": {"tests": [{"object": 0}], "hit": {"object": 2, "t": 10.0, "uv": [0.5, 0.25]}},
+                    "texture": {"kd": [0.5, 0.5, 0.5]},
+                    "light": {"lights": [{"samples": [{"shadow": "unoccluded", "specular": [1.7e-30, 0.0, 0.0]}]}]},
+                    "radiance": {"value": [0.3, 0.3, 0.3]}
+                },
+                "radiance": [0.3, 0.3, 0.3]
+            }],
+            "film": {"radiance": [0.3, 0.3, 0.3], "srgb8": [149, 149, 149]}
+        })
+    }
+
+    fn against(student: &str) -> Result<Comparison, String> {
+        compare(&Node::parse(student).unwrap(), &glint(), None)
+    }
+
+    #[test]
+    fn glints_own_document_agrees_and_keys_keep_the_files_order() {
+        let doc = glint().to_string();
+        let c = against(&doc).unwrap();
+        assert!(c.agrees(), "{}", c.text("x"));
+        // Every stage was compared, the BVH's tests skipped.
+        let compared: Vec<usize> = c.stages.iter().map(|s| s.compared).collect();
+        assert_eq!(compared, [2, 4, 1, 4, 2]);
+        let node = Node::parse(r#"{"b": 1, "a": 2}"#).unwrap();
+        let Node::Object(entries) = node else {
+            panic!()
+        };
+        assert_eq!(entries[0].0, "b");
+    }
+
+    #[test]
+    fn the_first_difference_is_in_pipeline_order_and_in_the_files_order_within_a_stage() {
+        // The film and the uv both differ, and the film comes first in the
+        // file: the intersection is reported.
+        let c = against(
+            r#"{"schema": "glint-explain/1", "pixel": [3, 4],
+                "film": {"radiance": [0.9, 0.3, 0.3]},
+                "samples": [{"sample": 0, "ray": {"intersect": {"hit": {"t": 10.0, "uv": [0.6, 0.25], "object": 3}}}}]}"#,
+        )
+        .unwrap();
+        let first = c.first().unwrap();
+        assert_eq!(first.stage, Stage::Intersect);
+        assert_eq!(first.path, "samples[0].ray.intersect.hit.uv");
+        assert_eq!(first.tolerance, Tolerance::Vector);
+        assert_eq!(c.stages[Stage::Intersect as usize].differences.len(), 2);
+        assert_eq!(c.stages[Stage::Film as usize].differences.len(), 1);
+    }
+
+    #[test]
+    fn tolerances_relative_angular_and_exact() {
+        // 1e-4 relative passes; a tiny specular against zero passes; a
+        // direction 0.5 mrad off passes and 5 mrad off does not.
+        let ok = against(
+            r#"{"schema": "glint-explain/1", "pixel": [3, 4], "samples": [{"sample": 0,
+                "camera": {"raster": [3.5001, 4.5], "direction": [0.0004, 0.6, -0.8]},
+                "ray": {"light": {"lights": [{"samples": [{"shadow": "unoccluded", "specular": [0.0, 0.0, 0.0]}]}]}}}]}"#,
+        )
+        .unwrap();
+        assert!(ok.agrees(), "{}", ok.text("x"));
+        let off = against(
+            r#"{"schema": "glint-explain/1", "pixel": [3, 4], "samples": [{"sample": 0,
+                "camera": {"direction": [0.004, 0.6, -0.8]}}]}"#,
+        )
+        .unwrap();
+        assert_eq!(off.first().unwrap().tolerance, Tolerance::Angular);
+        let blocked = against(
+            r#"{"schema": "glint-explain/1", "pixel": [3, 4], "samples": [{"sample": 0,
+                "ray": {"light": {"lights": [{"samples": [{"shadow": {"blocked_by": 1, "t": 0.5}}]}]}}}]}"#,
+        )
+        .unwrap();
+        assert_eq!(blocked.first().unwrap().tolerance, Tolerance::Exact);
+    }
+
+    #[test]
+    fn another_pixel_schema_or_sample_is_an_input_error() {
+        let err = against(r#"{"schema": "glint-explain/1", "pixel": [4, 4]}"#).unwrap_err();
+        assert!(err.contains("pass --pixel 4,4"), "{err}");
+        let err = against(r#"{"schema": "glint-explain/2", "pixel": [3, 4]}"#).unwrap_err();
+        assert!(err.contains("glint-explain/1"), "{err}");
+        let err = against(
+            r#"{"schema": "glint-explain/1", "pixel": [3, 4], "samples": [{"sample": 2}]}"#,
+        )
+        .unwrap_err();
+        assert!(err.contains("--sample 2"), "{err}");
+        let err = against(r#"{"schema": "glint-explain/1", "pixel": [3, 4], "author": "me"}"#)
+            .unwrap_err();
+        assert!(err.contains("author"), "{err}");
+    }
+}

@@ -1,0 +1,488 @@
+//! A class at once: submissions listed by a folder (`DIR/STUDENT/SCENE.png`)
+//! or a CSV manifest, graded in parallel, each scene's references rendered
+//! (or read from the cache) once per resolution and settings.
+
+use crate::course::Scenes;
+use crate::hypothesis::{ReferencePlan, StatedSettings};
+use crate::reference::{references, Cache, GradeScene, References};
+use crate::submission::Submission;
+use crate::test::TestOptions;
+use crate::{grade_image, GradeError, ImageGrade};
+use glam::UVec2;
+use glint_integrator::SamplePattern;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+
+/// The image extensions a submission may have.
+pub const IMAGE_EXTENSIONS: [&str; 6] = ["png", "ppm", "jpg", "jpeg", "exr", "pfm"];
+
+/// The columns a manifest may have; the first three are required.
+pub const MANIFEST_COLUMNS: [&str; 8] = [
+    "student",
+    "scene",
+    "file",
+    "spp",
+    "sampler",
+    "light_samples",
+    "light_sampler",
+    "note",
+];
+
+/// One submission of a class.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Entry {
+    pub student: String,
+    /// The scene as the class names it (a name in the scenes folder, or a path).
+    pub scene: String,
+    pub file: PathBuf,
+    /// The settings it is judged under (the command's, or its manifest row's).
+    pub stated: StatedSettings,
+}
+
+/// The submissions of a folder: every image `DIR/STUDENT/SCENE.EXT`, the
+/// scene named by the file's stem, students and files in name order.
+pub fn entries_from_folder(dir: &Path, stated: &StatedSettings) -> Result<Vec<Entry>, GradeError> {
+    let read = |d: &Path| {
+        std::fs::read_dir(d)
+            .and_then(|entries| {
+                entries
+                    .map(|e| e.map(|e| e.path()))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .map_err(|e| GradeError::Input(format!("{}: cannot read the folder: {e}", d.display())))
+    };
+    let mut students = read(dir)?;
+    students.retain(|p| p.is_dir());
+    students.sort();
+    let mut entries = Vec::new();
+    for student_dir in students {
+        let student = file_name(&student_dir);
+        let mut files = read(&student_dir)?;
+        files.retain(|p| p.is_file() && is_image(p));
+        files.sort();
+        for file in files {
+            let scene = file
+                .file_stem()
+                .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+            entries.push(Entry {
+                student: student.clone(),
+                scene,
+                file,
+                stated: *stated,
+            });
+        }
+    }
+    if entries.is_empty() {
+        return Err(GradeError::Input(format!(
+            "{}: no submissions found; expected images at {}/STUDENT/SCENE.png (or .ppm, .exr, .pfm, .jpg)",
+            dir.display(),
+            dir.display()
+        )));
+    }
+    Ok(entries)
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map_or(String::new(), |n| n.to_string_lossy().into_owned())
+}
+
+fn is_image(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| IMAGE_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
+}
+
+/// The submissions a CSV manifest lists: a header row naming its columns
+/// ([`MANIFEST_COLUMNS`]; `student`, `scene` and `file` required), then one
+/// row per submission. Files are relative to the manifest; empty settings
+/// cells take `stated`'s values.
+pub fn entries_from_manifest(
+    path: &Path,
+    stated: &StatedSettings,
+) -> Result<Vec<Entry>, GradeError> {
+    let input = |message: String| GradeError::Input(format!("{}: {message}", path.display()));
+    let text = std::fs::read(path).map_err(|e| input(format!("cannot read the manifest: {e}")))?;
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_slice());
+    let header = reader
+        .headers()
+        .map_err(|e| input(csv_problem(&e)))?
+        .clone();
+    let columns = Columns::new(&header).map_err(|e| input(format!("line 1: {e}")))?;
+    let base = path.parent().unwrap_or(Path::new(""));
+    let mut entries = Vec::new();
+    for record in reader.records() {
+        let record = record.map_err(|e| input(csv_problem(&e)))?;
+        let line = record.position().map_or(0, |p| p.line());
+        let at = |message: String| input(format!("line {line}: {message}"));
+        entries.push(columns.entry(&record, base, stated).map_err(at)?);
+    }
+    if entries.is_empty() {
+        return Err(input("the manifest lists no submissions".into()));
+    }
+    Ok(entries)
+}
+
+fn csv_problem(e: &csv::Error) -> String {
+    match e.position() {
+        Some(p) => format!(
+            "line {}: not valid CSV: {}",
+            p.line(),
+            shorten(&e.to_string())
+        ),
+        None => format!("not valid CSV: {}", shorten(&e.to_string())),
+    }
+}
+
+/// At most 60 characters of `text`, with "…" where it was cut.
+pub fn shorten(text: &str) -> String {
+    const LIMIT: usize = 60;
+    if text.chars().count() <= LIMIT {
+        text.to_owned()
+    } else {
+        text.chars().take(LIMIT).collect::<String>() + "…"
+    }
+}
+
+/// Where each known column is in a manifest's rows.
+struct Columns {
+    index: BTreeMap<&'static str, usize>,
+}
+
+impl Columns {
+    fn new(header: &csv::StringRecord) -> Result<Columns, String> {
+        let mut index = BTreeMap::new();
+        for (i, name) in header.iter().enumerate() {
+            let known = MANIFEST_COLUMNS
+                .iter()
+                .find(|c| c.eq_ignore_ascii_case(name))
+                .ok_or_else(|| {
+                    format!(
+                        "unknown column \"{}\"; expected {}",
+                        shorten(name),
+                        MANIFEST_COLUMNS.join(", ")
+                    )
+                })?;
+            if index.insert(*known, i).is_some() {
+                return Err(format!("the column \"{known}\" appears twice"));
+            }
+        }
+        if let Some(missing) = MANIFEST_COLUMNS[..3]
+            .iter()
+            .find(|c| !index.contains_key(*c))
+        {
+            return Err(format!(
+                "no \"{missing}\" column; a manifest needs student, scene and file"
+            ));
+        }
+        Ok(Columns { index })
+    }
+
+    fn cell<'r>(&self, record: &'r csv::StringRecord, column: &str) -> Option<&'r str> {
+        self.index
+            .get(column)
+            .and_then(|&i| record.get(i))
+            .filter(|cell| !cell.is_empty())
+    }
+
+    fn entry(
+        &self,
+        record: &csv::StringRecord,
+        base: &Path,
+        defaults: &StatedSettings,
+    ) -> Result<Entry, String> {
+        let required = |column: &str| {
+            self.cell(record, column)
+                .map(str::to_owned)
+                .ok_or_else(|| format!("the {column} cell is empty"))
+        };
+        let count = |column: &str| -> Result<Option<u32>, String> {
+            self.cell(record, column)
+                .map(|cell| {
+                    cell.parse::<u32>().ok().filter(|&n| n >= 1).ok_or_else(|| {
+                        format!(
+                            "{column} is \"{}\"; expected a whole number, 1 or more",
+                            shorten(cell)
+                        )
+                    })
+                })
+                .transpose()
+        };
+        let pattern = |column: &str| -> Result<Option<SamplePattern>, String> {
+            self.cell(record, column)
+                .map(|cell| {
+                    SamplePattern::from_name(cell).ok_or_else(|| {
+                        format!(
+                            "{column} is \"{}\"; expected one of {}",
+                            shorten(cell),
+                            SamplePattern::NAMES.join(", ")
+                        )
+                    })
+                })
+                .transpose()
+        };
+        let stated = StatedSettings {
+            spp: count("spp")?,
+            pixel_pattern: pattern("sampler")?,
+            light_samples: count("light_samples")?,
+            light_pattern: pattern("light_sampler")?,
+        };
+        Ok(Entry {
+            student: required("student")?,
+            scene: required("scene")?,
+            file: base.join(required("file")?),
+            stated: stated.or(defaults),
+        })
+    }
+}
+
+/// How a class is graded.
+#[derive(Clone, Debug, Default)]
+pub struct ClassOptions {
+    pub test: TestOptions,
+    pub cache: Cache,
+}
+
+/// What becomes of one submission.
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum Outcome {
+    /// Graded: passed or failed.
+    Graded(ImageGrade),
+    /// Not graded: the file could not be read, or its scene not found.
+    Unreadable { message: String },
+}
+
+/// One row of a class's results.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    pub student: String,
+    pub scene: String,
+    pub file: String,
+    #[serde(flatten)]
+    pub outcome: Outcome,
+    /// Which of the class's reference sets it was judged against.
+    #[serde(skip)]
+    pub group: Option<usize>,
+}
+
+impl Row {
+    pub fn passed(&self) -> bool {
+        matches!(&self.outcome, Outcome::Graded(g) if g.passed)
+    }
+}
+
+/// A graded class: a row per submission, and the references they used.
+pub struct ClassGrades {
+    pub rows: Vec<Row>,
+    pub groups: Vec<Group>,
+}
+
+impl ClassGrades {
+    pub fn all_passed(&self) -> bool {
+        self.rows.iter().all(Row::passed)
+    }
+}
+
+/// Submissions judged against the same references: one scene, resolution
+/// and set of stated settings.
+pub struct Group {
+    pub scene: Arc<GradeScene>,
+    pub stated: StatedSettings,
+    pub references: References,
+}
+
+/// What a class run reports as it goes.
+pub trait Progress: Sync {
+    /// A reference is being rendered (a line of text).
+    fn rendering(&self, what: &str);
+    /// `done` of `total` submissions are graded.
+    fn graded(&self, done: usize, total: usize);
+}
+
+/// Called with each graded submission, its image and references (to write
+/// its heat map, say), from worker threads.
+pub type OnGraded<'a> =
+    dyn Fn(usize, &Row, &Submission, &Group) -> Result<(), GradeError> + Sync + 'a;
+
+/// Grades every entry; scenes are looked up in `scenes` (relative to `base`),
+/// whose presets fill the settings an entry leaves unknown.
+pub fn grade_class(
+    entries: &[Entry],
+    scenes: &Scenes,
+    base: &Path,
+    options: &ClassOptions,
+    progress: &dyn Progress,
+    on_graded: &OnGraded,
+) -> Result<ClassGrades, GradeError> {
+    let entries = &with_presets(entries, scenes, base)?[..];
+    // Each scene once; a scene that is missing or does not load fails only
+    // its rows.
+    let mut loaded: BTreeMap<PathBuf, Result<Arc<GradeScene>, String>> = BTreeMap::new();
+    for (_, found) in entries {
+        let Ok(path) = found else { continue };
+        loaded.entry(path.clone()).or_insert_with(|| {
+            if path.is_file() {
+                GradeScene::load(path)
+                    .map(Arc::new)
+                    .map_err(|e| e.to_string())
+            } else {
+                Err(format!("no scene file {}", path.display()))
+            }
+        });
+    }
+    // What each submission needs: its scene and resolution, read from the
+    // file (and dropped: grading reads it again).
+    let probes: Vec<Result<(PathBuf, UVec2), String>> = entries
+        .par_iter()
+        .map(|(entry, found)| {
+            let path = found.clone()?;
+            loaded[&path].as_ref().map_err(Clone::clone)?;
+            let submission = Submission::load(&entry.file)?;
+            Ok((path, submission.resolution()))
+        })
+        .collect();
+    let mut groups: Vec<Group> = Vec::new();
+    let mut keys: Vec<(PathBuf, UVec2, StatedSettings)> = Vec::new();
+    let mut row_groups = Vec::with_capacity(entries.len());
+    for ((entry, _), probe) in entries.iter().zip(&probes) {
+        let Ok((path, resolution)) = probe else {
+            row_groups.push(None);
+            continue;
+        };
+        let key = (path.clone(), *resolution, entry.stated);
+        let index = match keys.iter().position(|k| *k == key) {
+            Some(i) => i,
+            None => {
+                let scene = loaded[path].as_ref().expect("probed").clone();
+                let plan = ReferencePlan::new(&entry.stated, scene.settings());
+                let references = references(&scene, *resolution, &plan, &options.cache, &|what| {
+                    progress.rendering(what)
+                })?;
+                keys.push(key);
+                groups.push(Group {
+                    scene,
+                    stated: entry.stated,
+                    references,
+                });
+                groups.len() - 1
+            }
+        };
+        row_groups.push(Some(index));
+    }
+    let done = AtomicUsize::new(0);
+    let rows: Vec<Row> = entries
+        .par_iter()
+        .zip(probes.par_iter())
+        .zip(row_groups.par_iter())
+        .enumerate()
+        .map(|(i, (((entry, _), probe), group))| {
+            let row = grade_row(i, entry, probe, *group, &groups, options, on_graded);
+            progress.graded(done.fetch_add(1, Ordering::Relaxed) + 1, entries.len());
+            row
+        })
+        .collect::<Result<_, GradeError>>()?;
+    Ok(ClassGrades { rows, groups })
+}
+
+/// What a report calls a scene: its name, or a scene file's stem.
+fn display_name(scene: &str) -> String {
+    match scene.strip_suffix(".toml") {
+        Some(path) => Path::new(path)
+            .file_name()
+            .map_or(scene.to_owned(), |n| n.to_string_lossy().into_owned()),
+        None => scene.to_owned(),
+    }
+}
+
+/// An entry, and its scene file or why it has none.
+type Located = (Entry, Result<PathBuf, String>);
+
+/// Each entry with its settings completed by its scene's preset (checked),
+/// and its scene file or why there is none.
+fn with_presets(
+    entries: &[Entry],
+    scenes: &Scenes,
+    base: &Path,
+) -> Result<Vec<Located>, GradeError> {
+    entries
+        .iter()
+        .map(|entry| {
+            let (found, preset) = match scenes.resolve(&entry.scene, base) {
+                Ok((path, preset)) => (Ok(path), preset),
+                Err(message) => (Err(message), StatedSettings::default()),
+            };
+            let stated = entry.stated.or(&preset);
+            stated.validate().map_err(|e| {
+                GradeError::Input(format!(
+                    "{} ({}, {}): the settings: {e}",
+                    entry.file.display(),
+                    shorten(&entry.student),
+                    shorten(&entry.scene)
+                ))
+            })?;
+            Ok((
+                Entry {
+                    stated,
+                    ..entry.clone()
+                },
+                found,
+            ))
+        })
+        .collect()
+}
+
+fn grade_row(
+    index: usize,
+    entry: &Entry,
+    probe: &Result<(PathBuf, UVec2), String>,
+    group: Option<usize>,
+    groups: &[Group],
+    options: &ClassOptions,
+    on_graded: &OnGraded,
+) -> Result<Row, GradeError> {
+    let mut row = Row {
+        student: entry.student.clone(),
+        scene: display_name(&entry.scene),
+        file: entry.file.display().to_string(),
+        outcome: Outcome::Unreadable {
+            message: String::new(),
+        },
+        group,
+    };
+    let (Ok(_), Some(g)) = (probe, group) else {
+        let message = probe.as_ref().err().cloned().unwrap_or_default();
+        row.outcome = Outcome::Unreadable { message };
+        return Ok(row);
+    };
+    let group = &groups[g];
+    let submission = match Submission::load(&entry.file) {
+        Ok(s) if s.resolution() == group.references.resolution => s,
+        Ok(_) => {
+            row.outcome = Outcome::Unreadable {
+                message: "the file changed while it was being graded".into(),
+            };
+            return Ok(row);
+        }
+        Err(message) => {
+            row.outcome = Outcome::Unreadable { message };
+            return Ok(row);
+        }
+    };
+    let grade = grade_image(
+        &group.scene,
+        &group.references,
+        &submission,
+        &entry.stated,
+        &options.test,
+    );
+    row.outcome = Outcome::Graded(grade);
+    on_graded(index, &row, &submission, group)?;
+    Ok(row)
+}

@@ -1,0 +1,246 @@
+//! The report folder of a class: `index.html` (one row per student; per
+//! scene a verdict, the submission, the reference and the heat map as
+//! thumbnails; columns sortable by a click; no external scripts, styles or
+//! fonts, so it works offline), `grades.csv`, `grades.json`, and `images/`.
+
+use crate::class::{ClassGrades, Group, Outcome, Row};
+use crate::report::{self, verdict};
+use crate::submission::Submission;
+use crate::GradeError;
+use glam::{UVec2, Vec3};
+use glint_camera::linear_to_srgb8;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// The longest side of a thumbnail, in pixels.
+pub const THUMBNAIL: u32 = 160;
+
+/// Checks, before any work, that `dir` can hold the report: it is a folder or
+/// can be made as one in an existing folder, and files can be written there.
+pub fn check_report_dir(dir: &Path) -> Result<(), GradeError> {
+    let input = |m: String| GradeError::Input(format!("{}: --report: {m}", dir.display()));
+    if dir.exists() && !dir.is_dir() {
+        return Err(input("not a folder".into()));
+    }
+    let probe_in = if dir.is_dir() {
+        dir.to_owned()
+    } else {
+        let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
+        let parent = parent.unwrap_or(Path::new("."));
+        if !parent.is_dir() {
+            return Err(input(format!(
+                "the folder it would be made in, {}, does not exist",
+                parent.display()
+            )));
+        }
+        parent.to_owned()
+    };
+    tempfile::Builder::new()
+        .prefix(".glint-probe-")
+        .tempfile_in(&probe_in)
+        .map_err(|e| input(format!("cannot write there: {e}")))?;
+    Ok(())
+}
+
+fn images_dir(dir: &Path) -> PathBuf {
+    dir.join("images")
+}
+
+fn internal(path: &Path) -> impl Fn(String) -> GradeError + '_ {
+    move |m| GradeError::Internal(format!("{}: {m}", path.display()))
+}
+
+/// Saves 8-bit RGB rows as a PNG, atomically.
+pub fn save_png(path: &Path, size: UVec2, rgb: &[u8]) -> Result<(), GradeError> {
+    let image = image::RgbImage::from_raw(size.x, size.y, rgb.to_vec()).expect("size matches");
+    save_image(path, &image)
+}
+
+fn save_image(path: &Path, image: &image::RgbImage) -> Result<(), GradeError> {
+    let fail = internal(path);
+    glint_camera::write_atomically(
+        path,
+        |e: std::io::Error| fail(e.to_string()),
+        |out| {
+            image
+                .write_to(out, image::ImageFormat::Png)
+                .map_err(|e| fail(e.to_string()))
+        },
+    )
+}
+
+/// A PNG and its thumbnail, from linear RGB pixels (clamped, sRGB).
+fn save_with_thumbnail(path: &Path, size: UVec2, rgb: Vec<u8>) -> Result<(), GradeError> {
+    let image = image::RgbImage::from_raw(size.x, size.y, rgb).expect("size matches");
+    save_image(path, &image)?;
+    let scale = THUMBNAIL as f32 / size.x.max(size.y) as f32;
+    let thumbnail = if scale < 1.0 {
+        let (w, h) = (
+            ((size.x as f32 * scale).round() as u32).max(1),
+            ((size.y as f32 * scale).round() as u32).max(1),
+        );
+        image::imageops::thumbnail(&image, w, h)
+    } else {
+        image
+    };
+    save_image(&thumbnail_path(path), &thumbnail)
+}
+
+fn thumbnail_path(path: &Path) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+    path.with_file_name(format!("{stem}-small.png"))
+}
+
+fn srgb8(pixels: &[Vec3]) -> Vec<u8> {
+    pixels
+        .iter()
+        .flat_map(|p| p.to_array())
+        .map(linear_to_srgb8)
+        .collect()
+}
+
+/// Writes the images of graded submission `index`: the submission and its
+/// heat map (full size and thumbnails), and its group's reference once.
+pub fn write_images(
+    dir: &Path,
+    index: usize,
+    row: &Row,
+    submission: &Submission,
+    group: &Group,
+) -> Result<(), GradeError> {
+    let Outcome::Graded(grade) = &row.outcome else {
+        return Ok(());
+    };
+    let images = images_dir(dir);
+    std::fs::create_dir_all(&images).map_err(|e| internal(&images)(e.to_string()))?;
+    let size = submission.resolution();
+    save_with_thumbnail(
+        &images.join(format!("{index}-submission.png")),
+        size,
+        srgb8(submission.film.pixels()),
+    )?;
+    let heat = crate::heatmap::heatmap(grade, &submission.film, &group.references.objects);
+    save_with_thumbnail(&images.join(format!("{index}-heatmap.png")), size, heat)?;
+    let reference = images.join(format!("reference-{}.png", row.group.unwrap_or(0)));
+    if !reference.exists() {
+        save_with_thumbnail(&reference, size, srgb8(&group.references.mean.mean))?;
+    }
+    Ok(())
+}
+
+/// Writes `index.html`, `grades.csv` and `grades.json` into `dir`.
+pub fn write_report(dir: &Path, grades: &ClassGrades) -> Result<(), GradeError> {
+    std::fs::create_dir_all(dir).map_err(|e| internal(dir)(e.to_string()))?;
+    let json = serde_json::to_string_pretty(&report::json(grades)).expect("JSON") + "\n";
+    for (name, text) in [
+        ("grades.csv", report::csv(grades)),
+        ("grades.json", json),
+        ("index.html", page(grades)),
+    ] {
+        let path = dir.join(name);
+        let fail = internal(&path);
+        glint_camera::write_atomically(
+            &path,
+            |e: std::io::Error| fail(e.to_string()),
+            |out| std::io::Write::write_all(out, text.as_bytes()).map_err(|e| fail(e.to_string())),
+        )?;
+    }
+    Ok(())
+}
+
+/// HTML-escaped text.
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The page: students as rows, scenes as columns.
+fn page(grades: &ClassGrades) -> String {
+    let scenes: Vec<&str> = {
+        let mut seen = Vec::new();
+        for row in &grades.rows {
+            if !seen.contains(&row.scene.as_str()) {
+                seen.push(row.scene.as_str());
+            }
+        }
+        seen
+    };
+    let mut students: BTreeMap<&str, Vec<(usize, &Row)>> = BTreeMap::new();
+    for (i, row) in grades.rows.iter().enumerate() {
+        students.entry(&row.student).or_default().push((i, row));
+    }
+    let mut body = String::new();
+    for (student, rows) in &students {
+        let passed = rows.iter().filter(|(_, r)| r.passed()).count();
+        body += &format!(
+            "<tr><td data-sort=\"{0}\">{0}</td><td data-sort=\"{1}\">{1}/{2}</td>",
+            escape(student),
+            passed,
+            scenes.len()
+        );
+        for scene in &scenes {
+            body += &match rows.iter().find(|(_, r)| r.scene == *scene) {
+                Some((i, row)) => cell(*i, row),
+                None => "<td data-sort=\"-1\" class=\"missing\">no submission</td>".into(),
+            };
+        }
+        body += "</tr>\n";
+    }
+    let header: String = scenes
+        .iter()
+        .enumerate()
+        .map(|(k, s)| format!("<th data-column=\"{}\">{}</th>", k + 2, escape(s)))
+        .collect();
+    let count = |v: &str| grades.rows.iter().filter(|r| verdict(r) == v).count();
+    format!(
+        include_str!("report.html"),
+        summary = format!(
+            "{} submissions from {} students: {} pass, {} fail, {} not graded",
+            grades.rows.len(),
+            students.len(),
+            count("pass"),
+            count("fail"),
+            count("error")
+        ),
+        header = header,
+        body = body,
+    )
+}
+
+/// One submission's cell: verdict, thumbnails, and what failed. Its sort key
+/// orders failures by their evidence, then errors, then passes.
+fn cell(index: usize, row: &Row) -> String {
+    let v = verdict(row);
+    let key = match &row.outcome {
+        Outcome::Graded(g) if g.passed => 1e9 - g.largest_accepted_z,
+        Outcome::Graded(g) => g
+            .rejected
+            .first()
+            .map_or(0.0, |f| -f.strongest().z.abs().min(1e8)),
+        Outcome::Unreadable { .. } => 5e8,
+    };
+    let images = match (&row.outcome, row.group) {
+        (Outcome::Graded(_), Some(g)) => format!(
+            "<div class=\"thumbs\">{}{}{}</div>",
+            thumb(&format!("images/{index}-submission"), "submission"),
+            thumb(&format!("images/reference-{g}"), "reference"),
+            thumb(&format!("images/{index}-heatmap"), "heat map"),
+        ),
+        _ => String::new(),
+    };
+    format!(
+        "<td data-sort=\"{key}\" class=\"{v}\"><span class=\"verdict\">{v}</span>{images}<div class=\"note\">{}</div><div class=\"file\">{}</div></td>",
+        escape(&report::summary(row)),
+        escape(&row.file),
+    )
+}
+
+fn thumb(stem: &str, label: &str) -> String {
+    format!(
+        "<a href=\"{stem}.png\" title=\"{label}\"><img src=\"{stem}-small.png\" alt=\"{label}\"></a>"
+    )
+}

@@ -1,0 +1,293 @@
+//! The Glint renders a submission is judged against, at the submission's
+//! resolution: the mean reference `M` and the clamp-gap reference `G` (see
+//! [`hypothesis`](crate::hypothesis)), each the mean of independent rounds
+//! with the variance of that mean; and the object seen at each pixel's
+//! centre, which names the regions of a report. Rendered references are
+//! cached (the same files and key as `glint bench`'s), so that a class's
+//! submissions of one scene pay for them once.
+
+use crate::hypothesis::ReferencePlan;
+use crate::GradeError;
+use glam::{UVec2, Vec3};
+use glint_bench::reference::{cache_key, round_seed, CachePaths, Origin, RoundSums};
+use glint_geometry::Ray;
+use glint_integrator::RenderSettings;
+use glint_scene::SceneDescription;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// The object index of a pixel whose centre sees no object.
+pub const BACKGROUND: u32 = u32::MAX;
+
+/// A scene to grade against: its description and every file it was read
+/// from (the cache's key hashes them).
+pub struct GradeScene {
+    pub path: PathBuf,
+    pub description: SceneDescription,
+    /// The scene file and its assets.
+    pub inputs: Vec<PathBuf>,
+}
+
+impl GradeScene {
+    pub fn load(path: &Path) -> Result<GradeScene, GradeError> {
+        let description = glint_scene::load(path).map_err(|e| GradeError::Input(e.to_string()))?;
+        let inputs = std::iter::once(path.to_owned())
+            .chain(description.assets.iter().cloned())
+            .collect();
+        Ok(GradeScene {
+            path: path.to_owned(),
+            description,
+            inputs,
+        })
+    }
+
+    /// The scene's own render settings (its `[render]` table).
+    pub fn settings(&self) -> &RenderSettings {
+        &self.description.settings
+    }
+
+    /// What reports call object `i` (or the background).
+    pub fn object_name(&self, object: u32) -> &str {
+        match object {
+            BACKGROUND => "background",
+            i => &self.description.object_names[i as usize],
+        }
+    }
+}
+
+/// One reference: per pixel, a mean and the variance of that mean.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Estimate {
+    pub mean: Vec<Vec3>,
+    pub variance: Vec<Vec3>,
+    pub rounds: u32,
+    /// Whether it was read from the cache rather than rendered.
+    pub cached: bool,
+}
+
+impl Estimate {
+    /// The variance of one round, per pixel: `rounds` times that of the mean.
+    pub fn round_variance(&self, pixel: usize) -> Vec3 {
+        self.variance[pixel] * self.rounds as f32
+    }
+}
+
+/// The sample reference: the submission's own estimator, rendered in rounds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampleEstimates {
+    /// Its radiance `X_s`.
+    pub radiance: Estimate,
+    /// `min(X_s, 1)`: what a clamped image stores.
+    pub clamped: Estimate,
+    /// The clamp gap `(X_s − 1)⁺`.
+    pub gap: Estimate,
+}
+
+/// Everything a submission of one resolution is judged against.
+#[derive(Clone, Debug)]
+pub struct References {
+    pub resolution: UVec2,
+    pub plan: ReferencePlan,
+    /// `M`, the expected value of the submission's renderer.
+    pub mean: Estimate,
+    /// The submission's own estimator: its noise and clamp gap.
+    pub samples: SampleEstimates,
+    /// Per pixel, the object its centre sees ([`BACKGROUND`] for none).
+    pub objects: Vec<u32>,
+    /// Time spent rendering (zero when everything came from the cache).
+    pub render_time: Duration,
+}
+
+/// Where rendered references are kept; `None` renders them every time.
+#[derive(Clone, Debug, Default)]
+pub struct Cache {
+    pub dir: Option<PathBuf>,
+}
+
+/// Renders (or reads from `cache`) the references of `scene` at `resolution`
+/// under `plan`. `progress` hears what is being rendered.
+pub fn references(
+    scene: &GradeScene,
+    resolution: UVec2,
+    plan: &ReferencePlan,
+    cache: &Cache,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<References, GradeError> {
+    let start = Instant::now();
+    let mut rendered = scene.description.scene.clone();
+    rendered.camera = rendered
+        .camera
+        .with_resolution(resolution)
+        .map_err(|e| GradeError::Input(format!("{}: {e}", scene.path.display())))?;
+    let job = Job {
+        scene,
+        rendered: &rendered,
+        resolution,
+        cache,
+        progress,
+    };
+    let [mean] = job.estimates("mean", &[identity], &plan.mean, plan.mean_rounds)?;
+    let [radiance, clamped, gap] = job.estimates(
+        "sample",
+        &[identity, clamp, excess],
+        &plan.samples,
+        plan.sample_rounds,
+    )?;
+    let cached = mean.cached && radiance.cached;
+    Ok(References {
+        resolution,
+        plan: plan.clone(),
+        mean,
+        samples: SampleEstimates {
+            radiance,
+            clamped,
+            gap,
+        },
+        objects: objects_at_pixel_centres(&rendered),
+        render_time: if cached {
+            Duration::ZERO
+        } else {
+            start.elapsed()
+        },
+    })
+}
+
+fn identity(x: Vec3) -> Vec3 {
+    x
+}
+
+fn clamp(x: Vec3) -> Vec3 {
+    x.min(Vec3::ONE)
+}
+
+fn excess(x: Vec3) -> Vec3 {
+    (x - Vec3::ONE).max(Vec3::ZERO)
+}
+
+/// Seeds of a reference's rounds, apart from each other's, from the other
+/// reference's and from any seed a user renders with.
+fn seed_of(name: &str) -> u64 {
+    name.bytes().fold(0x47_5241_4445_u64, |h, b| {
+        glint_integrator::sampling::mix64(h ^ b as u64)
+    })
+}
+
+struct Job<'a> {
+    scene: &'a GradeScene,
+    rendered: &'a glint_integrator::Scene,
+    resolution: UVec2,
+    cache: &'a Cache,
+    progress: &'a (dyn Fn(&str) + Sync),
+}
+
+impl Job<'_> {
+    /// The mean and variance of the mean of each of `transforms` of the
+    /// radiance, over `rounds` renders with `settings`: from the cache when
+    /// all are there, else rendered (and stored).
+    fn estimates<const K: usize>(
+        &self,
+        name: &str,
+        transforms: &[fn(Vec3) -> Vec3; K],
+        settings: &RenderSettings,
+        rounds: u32,
+    ) -> Result<[Estimate; K], GradeError> {
+        let (w, h) = (self.resolution.x, self.resolution.y);
+        let fingerprint = |k: usize| {
+            format!(
+                "glint-grade {name} reference, transform {k} of {K}, rounds={rounds} {}",
+                glint_bench::reference::settings_fingerprint(settings, w, h)
+            )
+        };
+        let keys = (0..K)
+            .map(|k| {
+                cache_key(
+                    env!("CARGO_PKG_VERSION"),
+                    &fingerprint(k),
+                    &self.scene.inputs,
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| GradeError::Input(format!("{}: {e}", self.scene.path.display())))?;
+        let paths: Option<Vec<CachePaths>> = self
+            .cache
+            .dir
+            .as_ref()
+            .map(|d| keys.iter().map(|k| CachePaths::new(d, k)).collect());
+        if let Some(paths) = &paths {
+            let cached: Vec<Estimate> = paths
+                .iter()
+                .zip(&keys)
+                .filter_map(|(p, key)| p.load_rounds(key, w, h, rounds))
+                .map(|r| Estimate {
+                    mean: r.mean,
+                    variance: r.variance_of_mean.expect("cached with a variance"),
+                    rounds,
+                    cached: true,
+                })
+                .collect();
+            if let Ok(all) = <[Estimate; K]>::try_from(cached) {
+                return Ok(all);
+            }
+        }
+        let mut sums: Vec<RoundSums> = (0..K).map(|_| RoundSums::new(w, h, settings.spp)).collect();
+        let mut buffer = Vec::new();
+        for round in 0..rounds {
+            (self.progress)(&format!(
+                "rendering the {name} reference of {} at {w}x{h}: round {} of {rounds} ({} spp × {} light samples)",
+                self.scene.path.display(),
+                round + 1,
+                settings.spp,
+                settings.light_samples,
+            ));
+            let mut round_settings = settings.clone();
+            round_settings.seed = round_seed(seed_of(name), round);
+            let output = glint_integrator::render(self.rendered, &round_settings, &|_, _| {})
+                .map_err(|e| GradeError::Internal(format!("reference render: {e}")))?;
+            for (sum, transform) in sums.iter_mut().zip(transforms) {
+                buffer.clear();
+                buffer.extend(output.film.pixels().iter().map(|&p| transform(p)));
+                sum.add(&buffer);
+            }
+        }
+        let mut estimates = Vec::with_capacity(K);
+        for (k, sum) in sums.iter().enumerate() {
+            let origin = Origin::Rendered {
+                cached: false,
+                key: keys[k].clone(),
+            };
+            let mut reference = sum.reference(origin, Duration::ZERO);
+            let variance = reference
+                .variance_of_mean
+                .get_or_insert_with(|| vec![Vec3::ZERO; (w * h) as usize])
+                .clone();
+            if let Some(paths) = &paths {
+                paths[k]
+                    .store(&keys[k], &fingerprint(k), &reference)
+                    .map_err(|e| GradeError::Internal(format!("reference cache: {e}")))?;
+            }
+            estimates.push(Estimate {
+                mean: reference.mean,
+                variance,
+                rounds,
+                cached: false,
+            });
+        }
+        Ok(estimates.try_into().expect("K estimates"))
+    }
+}
+
+/// Per pixel, the object the ray through its centre hits first.
+pub fn objects_at_pixel_centres(scene: &glint_integrator::Scene) -> Vec<u32> {
+    let size = scene.camera.resolution();
+    let mut objects = Vec::with_capacity((size.x * size.y) as usize);
+    for y in 0..size.y {
+        for x in 0..size.x {
+            let c = scene.camera.generate_ray(x as f32 + 0.5, y as f32 + 0.5);
+            let hit = scene
+                .shapes
+                .closest_hit(&Ray::new(c.origin, c.direction), f32::INFINITY);
+            objects.push(hit.map_or(BACKGROUND, |h| h.shape));
+        }
+    }
+    objects
+}

@@ -125,8 +125,9 @@ pub(crate) struct GradeArgs {
     #[arg(long, value_name = "DIR", requires = "stages")]
     answers: Option<PathBuf>,
 
-    /// With --stages --write: cases per stage [default: 64]
-    #[arg(long, value_name = "N", requires = "write", value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    /// With --stages: cases per stage [default: 64]; --answers must be given
+    /// the N the test vectors were written with
+    #[arg(long, value_name = "N", requires = "stages", value_parser = clap::value_parser!(u32).range(1..=10_000))]
     cases: Option<u32>,
 }
 
@@ -138,6 +139,11 @@ impl GradeArgs {
                 "glint grade --stages takes one scene: glint grade --stages SCENE.toml --write DIR (or --answers DIR)".into(),
             ));
         };
+        if self.format == Format::Csv {
+            return Err(Failure::Input(
+                "glint grade --stages prints a table or JSON (--format json); its CSV files are the test vectors themselves".into(),
+            ));
+        }
         if self.write.is_none() == self.answers.is_none() {
             return Err(Failure::Input(
                 "glint grade --stages needs --write DIR (test vectors) or --answers DIR (a student's answers)".into(),

@@ -36,7 +36,9 @@ pub(crate) struct RenderArgs {
     /// mip-level (the level Glint reads the diffuse texture at),
     /// report-mip-level (the course report's level log2(L/W), from a whole
     /// pixel's footprint), normal, depth (distance from the camera), albedo
-    /// (filtered diffuse color), reflection-depth (mirror reflections taken). Raw
+    /// (filtered diffuse color), reflection-depth (mirror reflections taken),
+    /// object (the object hit first: its index in the shape list plus one; use
+    /// --spp 1 --sampler grid for the object at each pixel's centre). Raw
     /// values in .exr/.pfm, false color in .png (normals as 0.5·n + 0.5, uv as its
     /// fractional part, depth as gray from near to far, MIP levels and reflection
     /// depth as a blue-green-red ramp)

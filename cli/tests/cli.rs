@@ -344,6 +344,37 @@ fn aovs_write_raw_values_to_float_files_and_false_color_to_png() {
     let (_, _, refl) = read_pfm(&dir.path().join("refl.pfm"));
     let deepest = refl.iter().map(|p| p[0]).fold(0.0f32, f32::max);
     assert!((1.0..=3.0).contains(&deepest), "{deepest}");
+    // Objects at the pixel centres of Set 1: the centre pixel sees the back
+    // wall (object 4 after the four spheres), a corner of the image nothing.
+    let set1 = scene("cornell-set1");
+    let args = [
+        "render",
+        &set1,
+        "-o",
+        "objects.pfm",
+        "--aov",
+        "object",
+        "--resolution",
+        "32x32",
+        "--spp",
+        "1",
+        "--sampler",
+        "grid",
+    ];
+    let o = glint(&args, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (w, _, objects) = read_pfm(&dir.path().join("objects.pfm"));
+    assert_eq!(
+        objects[16 * w + 16],
+        [5.0; 3],
+        "the back wall, object 4, plus one"
+    );
+    let ids: std::collections::BTreeSet<u32> = objects.iter().map(|p| p[0] as u32).collect();
+    assert_eq!(
+        ids,
+        (1..=10).collect(),
+        "every wall, sphere and the light; no miss"
+    );
     let o = glint(
         &["render", point_light.as_str(), "--aov", "bogus"],
         dir.path(),

@@ -7,7 +7,7 @@ mod common;
 
 use common::{assert_input_error, glint, scene, stderr, stdout};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::sync::{LazyLock, OnceLock};
 
 /// Each stage's files.
 const STAGES: [&str; 5] = ["camera", "intersection", "texture", "lighting", "film"];
@@ -15,19 +15,15 @@ const STAGES: [&str; 5] = ["camera", "intersection", "texture", "lighting", "fil
 /// The vectors of Set 1 at the default 64 cases per stage (what `--answers`
 /// checks against), written once for the tests that answer them.
 fn vectors() -> &'static Path {
-    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
-    DIR.get_or_init(|| {
+    static DIR: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    let (_, path) = DIR.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();
-        let o = glint(
-            &["grade", "--stages", &scene("cornell-set1"), "--write", "v"],
-            dir.path(),
-        );
+        let o = glint(&["grade", "--stages", &SET1, "--write", "v"], dir.path());
         assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-        dir
-    })
-    .path()
-    .join("v")
-    .leak()
+        let path = dir.path().join("v");
+        (dir, path)
+    });
+    path
 }
 
 /// A folder of answers: `files` copied from the vectors, each through `edit`.
@@ -40,15 +36,29 @@ fn answers(files: &[&str], edit: impl Fn(&str, String) -> String) -> tempfile::T
     dir
 }
 
+/// `glint grade --stages` on Set 1 with the answers in `answers`.
 fn check(answers: &Path, extra: &[&str]) -> std::process::Output {
-    let mut args = vec!["grade", "--stages", &*SET1, "--answers"];
-    let answers = answers.to_str().unwrap();
-    args.push(answers);
+    let mut args = vec![
+        "grade",
+        "--stages",
+        &SET1,
+        "--answers",
+        answers.to_str().unwrap(),
+    ];
     args.extend(extra);
-    glint(&args, answers.as_ref())
+    glint(&args, &std::env::temp_dir())
 }
 
-static SET1: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| scene("cornell-set1"));
+static SET1: LazyLock<String> = LazyLock::new(|| scene("cornell-set1"));
+
+/// The words of the report's line for `stage`.
+fn score_row(out: &str, stage: &str) -> Vec<String> {
+    let row = out
+        .lines()
+        .find(|l| l.split_whitespace().next() == Some(stage))
+        .unwrap_or_else(|| panic!("no {stage} row in {out}"));
+    row.split_whitespace().map(String::from).collect()
+}
 
 fn header(path: &Path) -> Vec<String> {
     let text = std::fs::read_to_string(path).unwrap();
@@ -64,7 +74,11 @@ fn writes_every_stages_files_with_the_documented_columns() {
         dir.path(),
     );
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    assert!(stdout(&o).contains("out/camera.csv (6 cases)"), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains("out/camera.csv (6 cases)"),
+        "{}",
+        stdout(&o)
+    );
     let out = dir.path().join("out");
     let mut names: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
@@ -73,17 +87,128 @@ fn writes_every_stages_files_with_the_documented_columns() {
     names.sort();
     let mut want: Vec<String> = STAGES
         .iter()
-        .flat_map(|s| [format!("{s}.json"), format!("{s}.csv"), format!("{s}-inputs.csv")])
+        .flat_map(|s| {
+            [
+                format!("{s}.json"),
+                format!("{s}.csv"),
+                format!("{s}-inputs.csv"),
+            ]
+        })
         .collect();
     want.sort();
     assert_eq!(names, want);
     // The columns docs/grading-stages.md lists, in order.
     let documented: [(&str, &[&str], &[&str]); 5] = [
-        ("camera", &["x", "y", "width", "height"], &["origin_x", "origin_y", "origin_z", "direction_x", "direction_y", "direction_z"]),
-        ("intersection", &["origin_x", "origin_y", "origin_z", "direction_x", "direction_y", "direction_z"], &["hit", "t", "point_x", "point_y", "point_z", "geometric_normal_x", "geometric_normal_y", "geometric_normal_z", "shading_normal_x", "shading_normal_y", "shading_normal_z", "u", "v", "object", "name"]),
-        ("texture", &["object", "texture", "kind", "u", "v", "scale_u", "scale_v", "offset_u", "offset_v", "t", "n_dot_d", "r", "fov", "m"], &["l", "jacobian", "w", "level", "value_r", "value_g", "value_b"]),
-        ("lighting", &["object", "point_x", "point_y", "point_z", "n_x", "n_y", "n_z", "ng_x", "ng_y", "ng_z", "v_x", "v_y", "v_z", "kd_r", "kd_g", "kd_b", "ks_r", "ks_g", "ks_b", "shininess", "lobe", "ambient_r", "ambient_g", "ambient_b", "light0_kind", "light0_r", "light0_g", "light0_b", "light0_normal_x", "light0_normal_y", "light0_normal_z", "s00_light", "s00_x", "s00_y", "s00_z", "s01_light"], &["ambient_term_r", "ambient_term_g", "ambient_term_b", "s00_verdict", "s00_blocker", "s00_diffuse_r", "s00_diffuse_g", "s00_diffuse_b", "s00_specular_r", "s00_specular_g", "s00_specular_b", "s01_verdict"]),
-        ("film", &["radiance_r", "radiance_g", "radiance_b"], &["srgb8_r", "srgb8_g", "srgb8_b"]),
+        (
+            "camera",
+            &["x", "y", "width", "height"],
+            &[
+                "origin_x",
+                "origin_y",
+                "origin_z",
+                "direction_x",
+                "direction_y",
+                "direction_z",
+            ],
+        ),
+        (
+            "intersection",
+            &[
+                "origin_x",
+                "origin_y",
+                "origin_z",
+                "direction_x",
+                "direction_y",
+                "direction_z",
+            ],
+            &[
+                "hit",
+                "t",
+                "point_x",
+                "point_y",
+                "point_z",
+                "geometric_normal_x",
+                "geometric_normal_y",
+                "geometric_normal_z",
+                "shading_normal_x",
+                "shading_normal_y",
+                "shading_normal_z",
+                "u",
+                "v",
+                "object",
+                "name",
+            ],
+        ),
+        (
+            "texture",
+            &[
+                "object", "texture", "kind", "u", "v", "scale_u", "scale_v", "offset_u",
+                "offset_v", "t", "n_dot_d", "r", "fov", "m",
+            ],
+            &[
+                "l", "jacobian", "w", "level", "value_r", "value_g", "value_b",
+            ],
+        ),
+        (
+            "lighting",
+            &[
+                "object",
+                "point_x",
+                "point_y",
+                "point_z",
+                "n_x",
+                "n_y",
+                "n_z",
+                "ng_x",
+                "ng_y",
+                "ng_z",
+                "v_x",
+                "v_y",
+                "v_z",
+                "kd_r",
+                "kd_g",
+                "kd_b",
+                "ks_r",
+                "ks_g",
+                "ks_b",
+                "shininess",
+                "lobe",
+                "ambient_r",
+                "ambient_g",
+                "ambient_b",
+                "light0_kind",
+                "light0_r",
+                "light0_g",
+                "light0_b",
+                "light0_normal_x",
+                "light0_normal_y",
+                "light0_normal_z",
+                "s00_light",
+                "s00_x",
+                "s00_y",
+                "s00_z",
+                "s01_light",
+            ],
+            &[
+                "ambient_term_r",
+                "ambient_term_g",
+                "ambient_term_b",
+                "s00_verdict",
+                "s00_blocker",
+                "s00_diffuse_r",
+                "s00_diffuse_g",
+                "s00_diffuse_b",
+                "s00_specular_r",
+                "s00_specular_g",
+                "s00_specular_b",
+                "s01_verdict",
+            ],
+        ),
+        (
+            "film",
+            &["radiance_r", "radiance_g", "radiance_b"],
+            &["srgb8_r", "srgb8_g", "srgb8_b"],
+        ),
     ];
     let from = ["pixel_x", "pixel_y", "sample", "spp", "why"];
     for (stage, inputs, expected) in documented {
@@ -92,12 +217,18 @@ fn writes_every_stages_files_with_the_documented_columns() {
         assert_eq!(given[0], "id");
         assert_eq!(&given[1..=inputs.len()], inputs, "{stage}");
         assert_eq!(all[..given.len()], given[..], "{stage}");
-        assert_eq!(&all[given.len()..given.len() + expected.len()], expected, "{stage}");
+        assert_eq!(
+            &all[given.len()..given.len() + expected.len()],
+            expected,
+            "{stage}"
+        );
         assert_eq!(&all[all.len() - 5..], from, "{stage}");
         let rows = std::fs::read_to_string(out.join(format!("{stage}.csv"))).unwrap();
         assert_eq!(rows.lines().count(), 7, "{stage}: a header and 6 cases");
-        let json: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join(format!("{stage}.json"))).unwrap()).unwrap();
+        let json: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join(format!("{stage}.json"))).unwrap(),
+        )
+        .unwrap();
         assert_eq!(json["schema"], "glint-stages/1");
         assert_eq!(json["scene"], "cornell-set1.toml");
         assert_eq!(json["cases"].as_array().unwrap().len(), 6);
@@ -113,8 +244,9 @@ fn glints_own_answers_pass_every_stage() {
     assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
     let out = stdout(&o);
     for stage in STAGES {
-        let row = out.lines().find(|l| l.trim_start().starts_with(stage)).unwrap();
-        assert!(row.contains(&format!("{stage:<13}     64        64     64")), "{row}");
+        let row = score_row(&out, stage);
+        assert_eq!(row[1..4], ["64", "64", "64"], "{out}");
+        assert!(row[4].ends_with(&format!("{stage}.csv")), "{out}");
     }
     assert!(out.ends_with("every answered case passes\n"), "{out}");
     // As JSON.
@@ -144,7 +276,10 @@ fn a_wrong_sign_of_the_spheres_u_fails_the_intersection_stage() {
         out.join("\n") + "\n"
     });
     // The first case on a sphere, whose u is not 0 or ½ (where −u is u).
-    for line in std::fs::read_to_string(vectors().join("intersection.csv")).unwrap().lines() {
+    for line in std::fs::read_to_string(vectors().join("intersection.csv"))
+        .unwrap()
+        .lines()
+    {
         if line.contains(",sphere ") && first_sphere.is_none() {
             first_sphere = Some(line.split(',').next().unwrap().to_owned());
         }
@@ -154,12 +289,21 @@ fn a_wrong_sign_of_the_spheres_u_fails_the_intersection_stage() {
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(o.stderr.is_empty(), "{}", stderr(&o));
     let out = stdout(&o);
-    assert!(out.contains(&format!("; the first is {first_sphere}\n")), "{out}");
+    assert!(
+        out.contains(&format!("; the first is {first_sphere}\n")),
+        "{out}"
+    );
     assert!(out.contains("intersection: "), "{out}");
     assert!(out.contains("uv [u, v]: Glint's ("), "{out}");
     assert!(out.contains("--stage intersect"), "{out}");
     assert!(out.contains("    |     hit object "), "{out}");
-    assert!(out.contains("camera        -         -      -  not answered"), "{out}");
+    assert_eq!(
+        score_row(&out, "camera")[1..],
+        ["-", "-", "-", "not", "answered"]
+    );
+    let row = score_row(&out, "intersection");
+    assert_eq!(row[2..4], ["64", "64"], "{out}");
+    assert!(row[1].parse::<u32>().unwrap() < 64, "{out}");
     assert!(out.ends_with("1 stage fails: intersection\n"), "{out}");
 }
 
@@ -177,7 +321,9 @@ fn unreadable_answers_are_bad_input() {
     let o = check(dir.path(), &[]);
     assert_input_error(&o, ": column srgb8_");
     assert_input_error(&o, "expected a whole number, got \"abc\"");
-    let dir = answers(&["camera.csv"], |_, text| text.replace("camera-007,", "camera-700,"));
+    let dir = answers(&["camera.csv"], |_, text| {
+        text.replace("camera-007,", "camera-700,")
+    });
     assert_input_error(
         &check(dir.path(), &[]),
         "camera.csv:8: unknown id \"camera-700\": the camera cases are camera-001 to camera-064",
@@ -185,7 +331,10 @@ fn unreadable_answers_are_bad_input() {
     // No answers at all, and a folder that is not there.
     let empty = tempfile::tempdir().unwrap();
     assert_input_error(&check(empty.path(), &[]), "no answers here");
-    assert_input_error(&check(&empty.path().join("nowhere"), &[]), "--answers: no such folder");
+    assert_input_error(
+        &check(&empty.path().join("nowhere"), &[]),
+        "--answers: no such folder",
+    );
 }
 
 #[test]
@@ -195,12 +344,69 @@ fn a_write_folder_that_cannot_be_made_is_refused_before_any_work() {
         &["grade", "--stages", &SET1, "--write", "no/such/folder"],
         dir.path(),
     );
-    assert_input_error(&o, "no/such/folder: --write: the folder it would be made in, no/such, does not exist");
+    assert_input_error(
+        &o,
+        "no/such/folder: --write: the folder it would be made in, no/such, does not exist",
+    );
     let o = glint(
-        &["grade", "--stages", &scene("no-such-scene"), "--write", "out"],
+        &[
+            "grade",
+            "--stages",
+            &scene("no-such-scene"),
+            "--write",
+            "out",
+        ],
         dir.path(),
     );
     assert_input_error(&o, "no-such-scene.toml");
     assert!(!dir.path().join("out").exists());
-    let _: PathBuf = dir.path().join("unused");
+}
+
+/// The Python program of docs/grading-stages.md's worked example.
+fn python_example() -> String {
+    let doc = std::fs::read_to_string(common::repo().join("docs/grading-stages.md")).unwrap();
+    let example = doc.split("## A worked example").nth(1).unwrap();
+    let code = example.split("```python\n").nth(1).unwrap();
+    code.split("```").next().unwrap().to_owned()
+}
+
+#[test]
+fn the_python_example_in_the_docs_answers_the_camera_stage() {
+    let python = std::process::Command::new("python3")
+        .arg("--version")
+        .output();
+    if !python.is_ok_and(|o| o.status.success()) {
+        eprintln!("skipped: no python3");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let given = dir.path().join("vectors");
+    std::fs::create_dir(&given).unwrap();
+    std::fs::copy(
+        vectors().join("camera-inputs.csv"),
+        given.join("camera-inputs.csv"),
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("camera.py"), python_example()).unwrap();
+    let ran = std::process::Command::new("python3")
+        .arg("camera.py")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(ran.status.success(), "{}", stderr(&ran));
+    let o = check(&dir.path().join("answers"), &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    assert_eq!(score_row(&stdout(&o), "camera")[1..4], ["64", "64", "64"]);
+    // The slip the page shows: y not flipped fails every case.
+    let slip = python_example().replace("ndc_y = 1 - 2 * y / height", "ndc_y = 2 * y / height - 1");
+    std::fs::write(dir.path().join("camera.py"), slip).unwrap();
+    let ran = std::process::Command::new("python3")
+        .arg("camera.py")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(ran.status.success());
+    let o = check(&dir.path().join("answers"), &[]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stdout(&o).contains("camera: 64 of 64 answered cases fail; the first is camera-001"));
 }

@@ -33,10 +33,16 @@ pub enum Aov {
     /// `(n, n, n)`: how many mirror reflections the camera ray's path took (0 when
     /// it stops at its first hit or misses), up to the render's max depth.
     ReflectionDepth,
+    /// `(i + 1, i + 1, i + 1)`: the object the camera ray hits first, by its
+    /// index in the scene's shape list (0 for a miss). Samples are averaged
+    /// like every AOV's, so a pixel whose samples see two objects holds no
+    /// index: render it with one sample at the pixel's centre (`--spp 1
+    /// --sampler grid`) to read the object at each pixel.
+    Object,
 }
 
 impl Aov {
-    pub const NAMES: [&'static str; 7] = [
+    pub const NAMES: [&'static str; 8] = [
         "uv",
         "mip-level",
         "report-mip-level",
@@ -44,6 +50,7 @@ impl Aov {
         "depth",
         "albedo",
         "reflection-depth",
+        "object",
     ];
 
     pub fn from_name(name: &str) -> Option<Self> {
@@ -55,6 +62,7 @@ impl Aov {
             "depth" => Some(Self::Depth),
             "albedo" => Some(Self::Albedo),
             "reflection-depth" => Some(Self::ReflectionDepth),
+            "object" => Some(Self::Object),
             _ => None,
         }
     }
@@ -90,6 +98,7 @@ impl Aov {
             Aov::ReflectionDepth => {
                 Vec3::splat(reflection_depth(scene, *ray, hit, max_depth) as f32)
             }
+            Aov::Object => Vec3::splat((hit.shape + 1) as f32),
             Aov::Albedo => match surface {
                 SurfaceKind::Material(m) => m.reflectances(&texture_footprint(m, &hit, diff)).0,
                 SurfaceKind::Emitter(Light::Area(a)) => a.color,
@@ -102,7 +111,8 @@ impl Aov {
     /// The buffer mapped to displayable colors, for 8-bit output: normals to
     /// `0.5·n + 0.5`, uv to its fractional part, depth to gray (near bright, far
     /// dark, 0 for misses), MIP levels and reflection depths to a blue → green → red
-    /// ramp over 0 … the highest value seen; albedo unchanged. These are display
+    /// ramp over 0 … the highest value seen; objects to colours of their own
+    /// (misses black); albedo unchanged. These are display
     /// values: they are stored decoded from sRGB, so that an sRGB writer (the PNG
     /// output) stores exactly them (0.5 as 128). Albedo is a linear color, kept as is.
     pub fn false_color(self, film: &Film) -> Film {
@@ -117,6 +127,7 @@ impl Aov {
                 Aov::MipLevel | Aov::ReportMipLevel | Aov::ReflectionDepth => {
                     ramp(if max > 0.0 { p.x / max } else { 0.0 })
                 }
+                Aov::Object => object_colour(p.x),
                 Aov::Albedo => *p,
             };
             if self != Aov::Albedo {
@@ -149,6 +160,25 @@ fn reflection_depth(scene: &Scene, mut ray: Ray, first: Hit, max_depth: u32) -> 
         }
     }
     depth
+}
+
+/// A colour for object id `id` (0, a miss, is black): hues a golden angle
+/// apart, so that neighbouring indices differ.
+fn object_colour(id: f32) -> Vec3 {
+    if id < 0.5 {
+        return Vec3::ZERO;
+    }
+    let hue = (id * 0.618_034).fract() * 6.0;
+    let x = 1.0 - (hue % 2.0 - 1.0).abs();
+    let (r, g, b) = match hue as u32 {
+        0 => (1.0, x, 0.0),
+        1 => (x, 1.0, 0.0),
+        2 => (0.0, 1.0, x),
+        3 => (0.0, x, 1.0),
+        4 => (x, 0.0, 1.0),
+        _ => (1.0, 0.0, x),
+    };
+    0.25 + 0.75 * Vec3::new(r, g, b)
 }
 
 /// Blue (0) → green (0.5) → red (1).

@@ -467,7 +467,8 @@ impl<'a> PixelRenderer<'a> {
         }
     }
 
-    /// The radiance of pixel `(x, y)`: the mean of its finite camera samples.
+    /// The radiance of pixel `(x, y)`: the sum of its finite camera samples
+    /// over `spp` (a sample that is not finite counts as zero).
     /// It depends only on the scene, the settings and `(x, y)`. With a tracer
     /// on (`T::ON`), every sample takes the scalar path and the tracer sees
     /// each step; the lanes the render takes otherwise give the same bits.

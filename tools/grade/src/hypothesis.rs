@@ -51,6 +51,10 @@ pub const MEAN_ROUNDS: u32 = 4;
 pub const SAMPLE_BUDGET: u32 = 256;
 /// The most rounds of the sample reference (few samples each: cheap).
 pub const SAMPLE_ROUNDS: u32 = 64;
+/// Light-sample paths per pixel the sample reference aims at over all its
+/// rounds: enough for its per-pixel variance (at least 8 rounds) and its clamp
+/// gap, a quarter of the mean reference's.
+pub const SAMPLE_PATHS: u32 = 1024;
 /// The fewest, for a good estimate of its per-pixel variance.
 pub const MIN_SAMPLE_ROUNDS: u32 = 8;
 
@@ -206,7 +210,7 @@ impl ReferencePlan {
         let sample_rounds = if deterministic {
             1
         } else {
-            (4096 / per_round).clamp(MIN_SAMPLE_ROUNDS, SAMPLE_ROUNDS)
+            (SAMPLE_PATHS / per_round).clamp(MIN_SAMPLE_ROUNDS, SAMPLE_ROUNDS)
         };
         let variance_scale = match (stated.spp, stated.light_samples) {
             (Some(n), Some(l)) => Some(per_round as f64 / (n as f64 * l as f64)),
@@ -301,7 +305,7 @@ mod tests {
         let plan = ReferencePlan::new(&s, &RenderSettings::default());
         assert_eq!((plan.samples.spp, plan.samples.light_samples), (64, 4));
         assert_eq!(plan.variance_scale, Some(256.0 / 4096.0));
-        assert_eq!(plan.sample_rounds, 16);
+        assert_eq!(plan.sample_rounds, MIN_SAMPLE_ROUNDS);
 
         let s = stated(Some(16), Some("grid"), Some(64), Some("grid"));
         let scene = RenderSettings {

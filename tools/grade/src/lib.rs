@@ -3,9 +3,9 @@
 //! a whole class.
 //!
 //! The verdict is a statistical test, not a threshold on an error metric
-//! ([`test`]): the submission's mean over each block of pixels and over each
+//! ([`test`](mod@test)): the submission's mean over each block of pixels and over each
 //! object is compared with the band its expected value must lie in, given
-//! Glint's references at the submission's resolution ([`reference`]), the
+//! Glint's references at the submission's resolution ([`reference`](mod@reference)), the
 //! settings the submission is stated to use ([`hypothesis`]) and what its file
 //! format did to it ([`submission`]); the noise is estimated from the
 //! submission itself, and Holm's procedure keeps the chance of failing a
@@ -32,6 +32,7 @@ pub mod html;
 pub mod hypothesis;
 pub mod reference;
 pub mod report;
+pub mod stages;
 pub mod submission;
 pub mod test;
 
@@ -192,3 +193,7 @@ fn describe(scene: &GradeScene, region: &test::Region, objects: &[u32]) -> Strin
         }
     }
 }
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

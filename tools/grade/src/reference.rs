@@ -10,7 +10,6 @@ use crate::hypothesis::ReferencePlan;
 use crate::GradeError;
 use glam::{UVec2, Vec3};
 use glint_bench::reference::{cache_key, round_seed, CachePaths, Origin, RoundSums};
-use glint_geometry::Ray;
 use glint_integrator::RenderSettings;
 use glint_scene::SceneDescription;
 use std::path::{Path, PathBuf};
@@ -143,7 +142,7 @@ pub fn references(
             clamped,
             gap,
         },
-        objects: objects_at_pixel_centres(&rendered),
+        objects: objects_at_pixel_centres(&rendered)?,
         render_time: if cached {
             Duration::ZERO
         } else {
@@ -276,18 +275,24 @@ impl Job<'_> {
     }
 }
 
-/// Per pixel, the object the ray through its centre hits first.
-pub fn objects_at_pixel_centres(scene: &glint_integrator::Scene) -> Vec<u32> {
-    let size = scene.camera.resolution();
-    let mut objects = Vec::with_capacity((size.x * size.y) as usize);
-    for y in 0..size.y {
-        for x in 0..size.x {
-            let c = scene.camera.generate_ray(x as f32 + 0.5, y as f32 + 0.5);
-            let hit = scene
-                .shapes
-                .closest_hit(&Ray::new(c.origin, c.direction), f32::INFINITY);
-            objects.push(hit.map_or(BACKGROUND, |h| h.shape));
-        }
-    }
-    objects
+/// Per pixel, the object the ray through its centre hits first: the
+/// `object` AOV of a render with one sample at each pixel's centre.
+pub fn objects_at_pixel_centres(scene: &glint_integrator::Scene) -> Result<Vec<u32>, GradeError> {
+    let settings = RenderSettings {
+        spp: 1,
+        pixel_pattern: glint_integrator::SamplePattern::Grid,
+        aov: Some(glint_integrator::Aov::Object),
+        ..RenderSettings::default()
+    };
+    let output = glint_integrator::render(scene, &settings, &|_, _| {})
+        .map_err(|e| GradeError::Internal(format!("object ids: {e}")))?;
+    Ok(output
+        .film
+        .pixels()
+        .iter()
+        .map(|p| match p.x as u32 {
+            0 => BACKGROUND,
+            id => id - 1,
+        })
+        .collect())
 }

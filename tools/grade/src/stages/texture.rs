@@ -1,0 +1,173 @@
+//! The texture stage (report sections 2.6 and 2.8): at a hit on a textured
+//! object, the MIP level the report chooses, `log2(L/W)` with its `L` and
+//! `W` ([`glint_integrator::report_level`]), and the filtered value.
+//!
+//! "The filtered value" is the report's: for an image, trilinear at the
+//! report's level (bilinear lookups in the two levels around it, blended by
+//! its fraction; the level clamped to the pyramid, so a level below 0 reads
+//! the image bilinearly) through the texture's wrap mode
+//! ([`glint_texture::MipMap::trilinear_at_level`]), whatever filter the
+//! scene sets for Glint's render; for the course's procedural checkerboard,
+//! which has no texels and so no level, the check's color at the point (the
+//! course's point sampling), even where the scene box-filters it.
+
+use super::probe::{collect, Plan, Probe};
+use super::table::{Case, Check, Field, Kind, Layout, Value};
+use super::Context;
+use crate::GradeError;
+use glam::Vec2;
+use glint_integrator::{pixel_height_on_surface, report_level, uv_unit_length, SurfaceKind};
+use glint_lighting::PhongMaterial;
+use glint_texture::{Checkerboard, TexCoord, Texture};
+
+/// How near (in checks, relative to the coordinate's size) a uv may come to
+/// a check's edge: nearer, a correct program in other arithmetic may read the
+/// other check.
+const CHECK_EDGE: f32 = 1e-4;
+
+/// The input columns: see `docs/grading-stages.md`.
+pub const INPUTS: [&str; 14] = [
+    "object", "texture", "kind", "u", "v", "scale_u", "scale_v", "offset_u", "offset_v", "t",
+    "n_dot_d", "r", "fov", "m",
+];
+
+/// Inputs: the `object`, which of its material's textures (`texture`:
+/// `diffuse`, or `specular` where only that one varies) and its `kind`
+/// (`checkerboard` or `image`), the hit's `u`, `v`, the material's uv
+/// transform (`uv' = uv · scale + offset`), the hit's distance `t` along the
+/// unit camera ray, `n_dot_d` (`N·D`, geometric normal and ray direction),
+/// the image's rows `r`, the vertical field of view `fov` in degrees, and
+/// the texture's resolution `m` (its larger side in texels; empty for a
+/// checkerboard). Expected: `l`, `jacobian` (`|J_T|`), `w` and `level`
+/// (empty for a checkerboard), and the filtered `value`.
+pub fn layout() -> Layout {
+    Layout {
+        inputs: INPUTS.map(String::from).to_vec(),
+        expected: vec![
+            Field::scalar("l", Kind::Float, Check::Relative),
+            Field::scalar("jacobian", Kind::Float, Check::Relative),
+            Field::scalar("w", Kind::Float, Check::Relative),
+            Field::scalar("level", Kind::Float, Check::Level),
+            Field::rgb("value", Check::Vector),
+        ],
+    }
+}
+
+/// `n` cases at hits on textured objects: spread over them, and at their
+/// silhouettes (high levels), grazing angles and the sphere's u seam.
+pub fn cases(cx: &Context, n: usize) -> Result<Vec<Case>, GradeError> {
+    let s = &cx.survey;
+    let textured = |p| s.info(p).textured;
+    let plans = vec![
+        Plan::new("spread over textured objects", 0.0, s.stratified(textured)),
+        Plan::new(
+            "a sphere's silhouette",
+            0.2,
+            s.awkward(|p| textured(p) && s.on_silhouette(p)).into_iter(),
+        ),
+        Plan::new(
+            "a grazing angle",
+            0.15,
+            s.awkward(|p| textured(p) && s.grazing(p)).into_iter(),
+        ),
+        Plan::new(
+            "near the sphere's u seam",
+            0.15,
+            s.awkward(|p| textured(p) && s.near_seam(p)).into_iter(),
+        ),
+    ];
+    collect(cx.scene, cx.settings, n, plans, |p| case(cx, p))
+}
+
+/// The texture a case reads: the diffuse one if it varies, else the specular.
+fn varying(m: &PhongMaterial) -> Option<(&'static str, &Texture)> {
+    let varies = |t: &&Texture| !matches!(t, Texture::Constant(_));
+    match (
+        Some(&m.diffuse).filter(varies),
+        m.specular.as_ref().filter(varies),
+    ) {
+        (Some(t), _) => Some(("diffuse", t)),
+        (None, Some(t)) => Some(("specular", t)),
+        (None, None) => None,
+    }
+}
+
+fn case(cx: &Context, p: &Probe) -> Option<Case> {
+    let hit = p.hit?;
+    let SurfaceKind::Material(m) = cx.scene.surface_of(&hit) else {
+        return None;
+    };
+    let (which, texture) = varying(m)?;
+    let camera = &cx.scene.camera;
+    let uv = m.uv_transform.apply(&TexCoord::point(hit.uv)).uv;
+    let l = pixel_height_on_surface(camera, &p.ray, &hit);
+    let jacobian = uv_unit_length(&hit, m);
+    let mut case = Case::new(Some(p.from.clone()));
+    match texture {
+        Texture::Checkerboard(c) => {
+            if near_check_edge(c, uv) {
+                return None;
+            }
+            case.set("kind", Value::Text("checkerboard".into()))
+                .rgb("value", c.evaluate(uv));
+        }
+        Texture::Image(image) => {
+            let report = report_level(camera, &p.ray, &hit, m, texture)?;
+            // Image coordinates st = (u', 1 − v'), t down the image
+            // (glint-texture's convention).
+            let st = Vec2::new(uv.x, 1.0 - uv.y);
+            let pyramid = image.image.pyramid();
+            case.set("kind", Value::Text("image".into()))
+                .int("m", report.m.into())
+                .float("w", report.w)
+                .float("level", report.level)
+                .rgb(
+                    "value",
+                    pyramid.trilinear_at_level(st, report.level, image.wrap),
+                );
+        }
+        Texture::Constant(_) => return None,
+    }
+    let d = p.ray.direction;
+    let fov = f64::from(camera.fov_y()).to_degrees() as f32;
+    case.int("object", hit.shape.into())
+        .set("texture", Value::Text(which.into()))
+        .uv(hit.uv)
+        .float("scale_u", m.uv_transform.scale.x)
+        .float("scale_v", m.uv_transform.scale.y)
+        .float("offset_u", m.uv_transform.offset.x)
+        .float("offset_v", m.uv_transform.offset.y)
+        .float("t", hit.t * d.length())
+        .float("n_dot_d", hit.geometric_normal.dot(d) / d.length())
+        .int("r", camera.resolution().y.into())
+        .float("fov", fov)
+        .float("l", l)
+        .float("jacobian", jacobian);
+    let finite = case.values.values().all(|v| match v {
+        Value::Float(x) => x.is_finite(),
+        _ => true,
+    });
+    finite.then_some(case)
+}
+
+/// Whether `uv` lies within [`CHECK_EDGE`] of a check's edge.
+fn near_check_edge(c: &Checkerboard, uv: Vec2) -> bool {
+    let q = uv * c.checks as f32;
+    [q.x, q.y]
+        .iter()
+        .any(|&x| (x - x.round()).abs() < CHECK_EDGE * x.abs().max(1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn uvs_on_a_checks_edge_are_not_used() {
+        let c = Checkerboard::new(Vec3::ZERO, Vec3::ONE, 4);
+        assert!(near_check_edge(&c, Vec2::new(0.25, 0.6)));
+        assert!(near_check_edge(&c, Vec2::new(0.6, 0.50001)));
+        assert!(!near_check_edge(&c, Vec2::new(0.3, 0.6)));
+    }
+}

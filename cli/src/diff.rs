@@ -1,7 +1,7 @@
 //! `glint diff`: two images compared by the metrics of glint-metrics, printed as
 //! a table, with an optional heat map and an exit status that gates a script.
 
-use crate::output::check_writable;
+use crate::output::check_heatmap_path;
 use crate::Failure;
 use clap::{Args, ValueEnum};
 use glint_camera::Film;
@@ -9,18 +9,18 @@ use glint_metrics::{
     compare_with_flip_map, flip, heatmap, non_finite_count, rel_mse_map, save_heatmap, Comparison,
     ErrorMap, ImageView, Region,
 };
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Args)]
 #[command(
-    after_help = "Compares TEST with REFERENCE (PNG, JPEG, EXR or PFM; the same size): \
+    after_help = "Compares TEST with REFERENCE (PNG, PPM, JPEG, EXR or PFM; the same size): \
                   per-channel means, RMSE, relative MSE, mean FLIP and the largest \
                   difference, printed as a table, then whether the difference is within \
                   the tolerance. Metrics are computed on linear RGB (PNG and JPEG decoded \
                   from sRGB); docs/comparing-images.md defines them.\n\n\
-                  Exit status: 0 within the tolerance, 1 beyond it (or for a failure such \
-                  as a failed write), 2 for bad input (unreadable or invalid files, \
-                  different sizes, a bad region, tolerance or heat map path)."
+                  Exit status: 0 within the tolerance, 1 beyond it, 2 for bad input \
+                  (unreadable or invalid files, different sizes, a bad region, tolerance \
+                  or heat map path), 3 for a failure of Glint's own (a failed write)."
 )]
 pub(crate) struct DiffArgs {
     /// The image to judge (.png, .jpg, .exr or .pfm)
@@ -54,6 +54,11 @@ pub(crate) struct DiffArgs {
     /// (per-pixel relative squared error)
     #[arg(long, value_name = "METRIC", value_enum, default_value_t = HeatmapMetric::Flip)]
     heatmap_metric: HeatmapMetric,
+
+    /// Print the comparison as JSON (schema glint-diff/1: the same numbers as
+    /// the table, the verdict as within_tolerance) instead of the table
+    #[arg(long)]
+    json: bool,
 
     /// The error drawn as the top color of the heat map [default: 1 for flip; for
     /// relmse the 99th percentile of the region's per-pixel values]
@@ -113,7 +118,7 @@ fn parse_scale(text: &str) -> Result<f32, String> {
 
 pub(crate) fn diff(args: &DiffArgs) -> Result<(), Failure> {
     if let Some(path) = &args.heatmap {
-        check_heatmap_path(path, args)?;
+        check_heatmap_path(path, &[&args.test, &args.reference])?;
     }
     let test = Film::load(&args.test).map_err(|e| Failure::Input(e.to_string()))?;
     let reference = Film::load(&args.reference).map_err(|e| Failure::Input(e.to_string()))?;
@@ -138,6 +143,86 @@ pub(crate) fn diff(args: &DiffArgs) -> Result<(), Failure> {
     let flip_map = flip(t, r);
     let c = compare_with_flip_map(t, r, region, &flip_map);
 
+    let heat = match &args.heatmap {
+        Some(path) => Some(write_heatmap(path, args, (t, r), flip_map, region)?),
+        None => None,
+    };
+    let value = args.metric.value(&c);
+    // NaN (a NaN or infinity in one image only) is never within tolerance.
+    let within = value <= args.tolerance;
+    let label = args.metric.label();
+    let out = match args.json {
+        true => {
+            let document = json_document(args, (&test, &reference), region, &c, &heat, within);
+            serde_json::to_string_pretty(&document).expect("JSON of numbers and strings") + "\n"
+        }
+        false => {
+            let mut text = table(args, (&test, &reference), region, &c, &heat);
+            text += &match within {
+                true => format!("within tolerance: {label} {value} <= {}\n", args.tolerance),
+                false => format!(
+                    "beyond tolerance: {label} {value} > tolerance {}\n",
+                    args.tolerance
+                ),
+            };
+            text
+        }
+    };
+    print!("{out}");
+    if within {
+        Ok(())
+    } else {
+        Err(Failure::Verdict(Some(format!(
+            "{}: differs from {}: {label} {value} > tolerance {}",
+            args.test.display(),
+            args.reference.display(),
+            args.tolerance
+        ))))
+    }
+}
+
+/// The heat map written: its file, the error it shows and its scale.
+struct Heat {
+    path: PathBuf,
+    name: &'static str,
+    scale: f32,
+}
+
+fn write_heatmap(
+    path: &std::path::Path,
+    args: &DiffArgs,
+    (t, r): (ImageView, ImageView),
+    flip_map: ErrorMap,
+    region: Region,
+) -> Result<Heat, Failure> {
+    let (map, name) = match args.heatmap_metric {
+        HeatmapMetric::Flip => (flip_map, "FLIP"),
+        HeatmapMetric::Relmse => (rel_mse_map(t, r), "relMSE per pixel"),
+    };
+    let scale = args
+        .heatmap_scale
+        .unwrap_or_else(|| match args.heatmap_metric {
+            HeatmapMetric::Flip => 1.0,
+            HeatmapMetric::Relmse => percentile_99(&map, region),
+        });
+    save_heatmap(path, map.width, map.height, &heatmap(&map, scale)).map_err(Failure::Other)?;
+    Ok(Heat {
+        path: path.to_owned(),
+        name,
+        scale,
+    })
+}
+
+/// The comparison as the table `glint diff` prints.
+fn table(
+    args: &DiffArgs,
+    (test, reference): (&Film, &Film),
+    region: Region,
+    c: &Comparison,
+    heat: &Option<Heat>,
+) -> String {
+    let size = test.resolution();
+    let (t, r) = (ImageView::from(test), ImageView::from(reference));
     let mut table = Table::default();
     table.row("A (test)", [args.test.display().to_string()]);
     table.row("B (reference)", [args.reference.display().to_string()]);
@@ -173,79 +258,71 @@ pub(crate) fn diff(args: &DiffArgs) -> Result<(), Failure> {
             m.x,
             m.y,
             m.channel_name(),
-            number(channel(&test)),
-            number(channel(&reference))
+            number(channel(test)),
+            number(channel(reference))
         )
     };
     table.row("max difference", [max_text]);
-    print!("{}", table.render());
-
-    if let Some(path) = &args.heatmap {
-        let (map, name) = match args.heatmap_metric {
-            HeatmapMetric::Flip => (flip_map, "FLIP"),
-            HeatmapMetric::Relmse => (rel_mse_map(t, r), "relMSE per pixel"),
-        };
-        let scale = args
-            .heatmap_scale
-            .unwrap_or_else(|| match args.heatmap_metric {
-                HeatmapMetric::Flip => 1.0,
-                HeatmapMetric::Relmse => percentile_99(&map, region),
-            });
-        save_heatmap(path, size.x, size.y, &heatmap(&map, scale)).map_err(Failure::Other)?;
-        let mut line = Table::default();
-        line.row(
+    if let Some(h) = heat {
+        table.row(
             "heat map",
             [format!(
-                "{} ({name}, scale {})",
-                path.display(),
-                number(scale as f64)
+                "{} ({}, scale {})",
+                h.path.display(),
+                h.name,
+                number(h.scale as f64)
             )],
         );
-        print!("{}", line.render());
     }
-
-    let value = args.metric.value(&c);
-    let label = args.metric.label();
-    if value <= args.tolerance {
-        println!("within tolerance: {label} {value} <= {}", args.tolerance);
-        Ok(())
-    } else {
-        // NaN (a NaN or infinity in one image only) is never within tolerance.
-        let verdict = format!("{label} {value} > tolerance {}", args.tolerance);
-        println!("beyond tolerance: {verdict}");
-        Err(Failure::Other(format!(
-            "{}: differs from {}: {verdict}",
-            args.test.display(),
-            args.reference.display()
-        )))
-    }
+    table.render()
 }
 
-/// The heat map path, before any work: a .png name, in a writable directory,
-/// and not one of the images being compared.
-fn check_heatmap_path(path: &Path, args: &DiffArgs) -> Result<(), Failure> {
-    let is_png = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    if !is_png {
-        return Err(Failure::Input(format!(
-            "{}: a heat map is written as PNG; expected a .png extension",
-            path.display()
-        )));
-    }
-    check_writable(path)?;
-    if let Ok(target) = path.canonicalize() {
-        for input in [&args.test, &args.reference] {
-            if input.canonicalize().is_ok_and(|i| i == target) {
-                return Err(Failure::Input(format!(
-                    "{}: is one of the images being compared; choose another heat map file",
-                    path.display()
-                )));
-            }
-        }
-    }
-    Ok(())
+/// The comparison as JSON (schema `glint-diff/1`); non-finite numbers are
+/// `null`.
+fn json_document(
+    args: &DiffArgs,
+    (test, reference): (&Film, &Film),
+    region: Region,
+    c: &Comparison,
+    heat: &Option<Heat>,
+    within: bool,
+) -> serde_json::Value {
+    use serde_json::json;
+    let finite = |v: f64| v.is_finite().then_some(v);
+    let (t, r) = (ImageView::from(test), ImageView::from(reference));
+    let m = c.max_difference;
+    let size = test.resolution();
+    json!({
+        "schema": "glint-diff/1",
+        "test": args.test.display().to_string(),
+        "reference": args.reference.display().to_string(),
+        "size": [size.x, size.y],
+        "region": [region.x0, region.y0, region.x1, region.y1],
+        "means": {
+            "test": c.means_test.to_array().map(finite),
+            "reference": c.means_reference.to_array().map(finite),
+        },
+        "non_finite": {"test": non_finite_count(t, region), "reference": non_finite_count(r, region)},
+        "rmse": finite(c.rmse),
+        "rel_mse": finite(c.rel_mse),
+        "flip": finite(c.flip),
+        "max_difference": {
+            "value": finite(m.value as f64),
+            "pixel": [m.x, m.y],
+            "channel": m.channel_name(),
+            "test": finite(test.pixel(m.x, m.y)[m.channel] as f64),
+            "reference": finite(reference.pixel(m.x, m.y)[m.channel] as f64),
+        },
+        "heatmap": heat.as_ref().map(|h| json!({
+            "file": h.path.display().to_string(),
+            "error": h.name,
+            "scale": h.scale,
+        })),
+        "metric": args.metric.label(),
+        "value": finite(args.metric.value(c)),
+        "tolerance": args.tolerance,
+        "within_tolerance": within,
+    })
 }
 
 /// The 99th percentile of the finite values of `map` in `region`, or 1 if it is

@@ -3,7 +3,7 @@
 //! stages of a student's ray tracer against test vectors. The work is in
 //! glint-grade; this file reads the flags and writes what it returns.
 
-use crate::output::check_writable;
+use crate::output::check_heatmap_path;
 use crate::{named, progress_bar, Failure};
 use clap::{Args, ValueEnum};
 use glint_grade::class::{self, ClassGrades, Entry, Progress};
@@ -211,7 +211,7 @@ pub(crate) fn grade(args: &GradeArgs) -> Result<(), Failure> {
     if grades.all_passed() {
         Ok(())
     } else {
-        Err(Failure::Graded)
+        Err(Failure::Verdict(None))
     }
 }
 
@@ -341,26 +341,10 @@ fn check_outputs(args: &GradeArgs, entries: &[Entry]) -> Result<(), Failure> {
                 entries.len()
             )));
         }
-        let is_png = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-        if !is_png {
-            return Err(Failure::Input(format!(
-                "{}: a heat map is written as PNG; expected a .png extension",
-                path.display()
-            )));
-        }
-        check_writable(path)?;
-        if path.canonicalize().ok() == entries[0].file.canonicalize().ok() {
-            return Err(Failure::Input(format!(
-                "{}: is the submission itself; choose another heat map file",
-                path.display()
-            )));
-        }
+        check_heatmap_path(path, &[entries[0].file.as_path()])?;
     }
     if let Some(dir) = &args.report {
-        glint_grade::html::check_report_dir(dir).map_err(failure)?;
+        glint_grade::output::check_dir(dir, "--report").map_err(failure)?;
     }
     if let Some(dir) = &cache(args).dir {
         if dir.exists() && !dir.is_dir() {

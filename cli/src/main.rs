@@ -84,11 +84,12 @@ pub(crate) enum Failure {
     /// Stopped by a signal after writing what was finished, which the message
     /// says; the exit status is the signal's (130 for Ctrl-C, 143 for SIGTERM).
     Interrupted { message: String, status: u8 },
-    /// `glint grade`: a submission failed or could not be read (the report
-    /// says which). Exit status 1.
-    Graded,
-    /// `glint grade`: a failure of Glint's own, told apart from a failed
-    /// submission. Exit status 3.
+    /// A negative verdict of a command that judges (`diff`: beyond the
+    /// tolerance; `grade`: a submission failed or could not be read), said on
+    /// stdout, and on stderr when there is a message. Exit status 1.
+    Verdict(Option<String>),
+    /// A failure of Glint's own in a command that judges (`diff`, `grade`),
+    /// told apart from a negative verdict. Exit status 3.
     Internal(String),
 }
 
@@ -113,8 +114,8 @@ fn main() -> ExitCode {
         Command::Grade(args) => grade::grade(args),
     })
     .unwrap_or(Err(Failure::Panicked));
-    // A grader must tell Glint's own failures from a failed submission.
-    let grading = matches!(cli.command, Command::Grade(_));
+    // A command that judges must tell Glint's own failures from its verdict.
+    let judging = matches!(cli.command, Command::Grade(_) | Command::Diff(_));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(message)) => {
@@ -123,10 +124,15 @@ fn main() -> ExitCode {
         }
         Err(Failure::Other(message)) => {
             eprintln!("glint: error: {message}");
-            ExitCode::from(if grading { 3 } else { 1 })
+            ExitCode::from(if judging { 3 } else { 1 })
         }
-        Err(Failure::Panicked) => ExitCode::from(if grading { 3 } else { 1 }),
-        Err(Failure::Graded) => ExitCode::from(1),
+        Err(Failure::Panicked) => ExitCode::from(if judging { 3 } else { 1 }),
+        Err(Failure::Verdict(message)) => {
+            if let Some(message) = message {
+                eprintln!("glint: error: {message}");
+            }
+            ExitCode::from(1)
+        }
         Err(Failure::Internal(message)) => {
             eprintln!("glint: internal error: {message}");
             ExitCode::from(3)

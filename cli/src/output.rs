@@ -45,3 +45,31 @@ pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), Failure> {
         out.write_all(text.as_bytes()).map_err(fail)
     })
 }
+
+/// A heat map's path, before any work: a .png name, in a writable directory,
+/// and not one of `inputs` (the images being compared).
+pub(crate) fn check_heatmap_path(path: &Path, inputs: &[&Path]) -> Result<(), Failure> {
+    let is_png = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png {
+        return Err(Failure::Input(format!(
+            "{}: a heat map is written as PNG; expected a .png extension",
+            path.display()
+        )));
+    }
+    check_writable(path)?;
+    if let Ok(target) = path.canonicalize() {
+        if inputs
+            .iter()
+            .any(|input| input.canonicalize().is_ok_and(|i| i == target))
+        {
+            return Err(Failure::Input(format!(
+                "{}: is one of the images being compared; choose another heat map file",
+                path.display()
+            )));
+        }
+    }
+    Ok(())
+}

@@ -1,5 +1,6 @@
-//! `glint diff` as a user runs it: the table, the exit statuses (0 within the
-//! tolerance, 1 beyond it, 2 for bad input), heat maps, and one-line errors.
+//! `glint diff` as a user runs it: the table and its JSON, the exit statuses (0
+//! within the tolerance, 1 beyond it, 2 for bad input), heat maps, PPM input,
+//! and one-line errors.
 
 use glam::{UVec2, Vec3};
 use glint_camera::Film;
@@ -411,6 +412,40 @@ fn a_bad_heat_map_path_fails_before_any_work_and_a_failed_run_keeps_the_old_map(
     );
     assert!(!dir.path().join("no-such-dir").exists());
     assert!(!dir.path().join("map.jpg").exists());
+}
+
+#[test]
+fn json_gives_the_table_s_numbers_and_a_ppm_reads_like_its_png() {
+    let dir = images();
+    let o = glint(
+        &["diff", "a.pfm", "b.pfm", "--json", "--tolerance", "1"],
+        dir.path(),
+    );
+    assert_exit(&o, 0);
+    let doc: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(doc["schema"], "glint-diff/1");
+    assert_eq!(doc["size"], serde_json::json!([4, 2]));
+    assert_eq!(doc["max_difference"]["pixel"], serde_json::json!([3, 1]));
+    assert_eq!(doc["max_difference"]["channel"], "G");
+    assert_eq!(doc["within_tolerance"], true);
+    assert!(doc["rel_mse"].as_f64().unwrap() > 0.0);
+    let o = glint(&["diff", "a.pfm", "b.pfm", "--json"], dir.path());
+    assert_exit(&o, 1);
+    let doc: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(doc["within_tolerance"], false);
+    assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
+
+    // A P3 PPM of the PNG's codes is the same image.
+    write(dir.path(), "a.png", &changed());
+    let png = image::open(dir.path().join("a.png")).unwrap().to_rgb8();
+    let mut ppm = String::from("P3\n4 2\n255\n");
+    for p in png.pixels() {
+        ppm += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    std::fs::write(dir.path().join("a.ppm"), ppm).unwrap();
+    let o = glint(&["diff", "a.ppm", "a.png"], dir.path());
+    assert_exit(&o, 0);
+    assert!(stdout(&o).contains("0 (identical)"), "{}", stdout(&o));
 }
 
 #[test]

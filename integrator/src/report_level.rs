@@ -85,11 +85,9 @@ mod tests {
     use glint_lighting::UvTransform;
     use glint_texture::{Checkerboard, ImageTexture, TextureFilter, TextureImage, WrapMode};
 
-    /// Straight down onto a plane of 2 world units per uv unit, 3 above it:
-    /// `L = 2·3·tan(30°)/100`, `W = 2/256`, whatever the samples per pixel.
-    #[test]
-    fn straight_down_the_level_is_the_pixel_over_the_texel() {
-        let camera = Camera::new(
+    /// 3 units above the origin, looking straight down, 60° over 100 pixels.
+    fn top_down_camera() -> Camera {
+        Camera::new(
             Vec3::new(0.0, 3.0, 0.0),
             Vec3::ZERO,
             Vec3::Z,
@@ -97,7 +95,14 @@ mod tests {
             1.0,
             UVec2::new(100, 100),
         )
-        .unwrap();
+        .unwrap()
+    }
+
+    /// Straight down onto a plane of 2 world units per uv unit, 3 above it:
+    /// `L = 2·3·tan(30°)/100`, `W = 2/256`, whatever the samples per pixel.
+    #[test]
+    fn straight_down_the_level_is_the_pixel_over_the_texel() {
+        let camera = top_down_camera();
         let plane = Plane::new(Vec3::ZERO, Vec3::Y, false)
             .and_then(|p| p.with_tile_size(2.0))
             .unwrap();
@@ -163,15 +168,7 @@ mod tests {
             .unwrap();
         b.shape(plane, ground)
             .shape(Sphere::new(Vec3::new(1.2, 0.2, 1.2), 0.2).unwrap(), plain);
-        let camera = Camera::new(
-            Vec3::new(0.0, 3.0, 0.0),
-            Vec3::ZERO,
-            Vec3::Z,
-            60.0,
-            1.0,
-            UVec2::new(100, 100),
-        )
-        .unwrap();
+        let camera = top_down_camera();
         let scene = b.build(camera).unwrap();
         let level = (6.0 * 30f32.to_radians().tan() / 100.0 / (2.0 / 256.0)).log2();
         for spp in [1, 4] {

@@ -15,33 +15,6 @@ use std::path::{Path, PathBuf};
 /// The longest side of a thumbnail, in pixels.
 pub const THUMBNAIL: u32 = 160;
 
-/// Checks, before any work, that `dir` can hold the report: it is a folder or
-/// can be made as one in an existing folder, and files can be written there.
-pub fn check_report_dir(dir: &Path) -> Result<(), GradeError> {
-    let input = |m: String| GradeError::Input(format!("{}: --report: {m}", dir.display()));
-    if dir.exists() && !dir.is_dir() {
-        return Err(input("not a folder".into()));
-    }
-    let probe_in = if dir.is_dir() {
-        dir.to_owned()
-    } else {
-        let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
-        let parent = parent.unwrap_or(Path::new("."));
-        if !parent.is_dir() {
-            return Err(input(format!(
-                "the folder it would be made in, {}, does not exist",
-                parent.display()
-            )));
-        }
-        parent.to_owned()
-    };
-    tempfile::Builder::new()
-        .prefix(".glint-probe-")
-        .tempfile_in(&probe_in)
-        .map_err(|e| input(format!("cannot write there: {e}")))?;
-    Ok(())
-}
-
 fn images_dir(dir: &Path) -> PathBuf {
     dir.join("images")
 }
@@ -139,13 +112,7 @@ pub fn write_report(dir: &Path, grades: &ClassGrades) -> Result<(), GradeError> 
         ("grades.json", json),
         ("index.html", page(grades)),
     ] {
-        let path = dir.join(name);
-        let fail = internal(&path);
-        glint_camera::write_atomically(
-            &path,
-            |e: std::io::Error| fail(e.to_string()),
-            |out| std::io::Write::write_all(out, text.as_bytes()).map_err(|e| fail(e.to_string())),
-        )?;
+        crate::output::write_text(&dir.join(name), &text)?;
     }
     Ok(())
 }

@@ -30,6 +30,7 @@ pub mod course;
 pub mod heatmap;
 pub mod html;
 pub mod hypothesis;
+pub mod output;
 pub mod reference;
 pub mod report;
 pub mod stages;

@@ -5,10 +5,8 @@
 use super::probe::explain_flags;
 use super::table::{Case, Layout};
 use super::{StageVectors, COMMON_CONVENTIONS, SCHEMA};
-use crate::GradeError;
 use serde::ser::{Serialize, SerializeMap, Serializer};
 use serde_json::Value as Json;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The columns after the expected ones in `STAGE.csv`: where the case
@@ -45,51 +43,6 @@ fn value(v: impl Into<Json>) -> Ordered {
 
 fn object<const N: usize>(pairs: [(&str, Ordered); N]) -> Ordered {
     Ordered::Object(pairs.into_iter().map(|(k, v)| (k.to_owned(), v)).collect())
-}
-
-/// `--write DIR` can be used: a folder, or a name whose parent folder
-/// exists, where files can be made. Checked before any work.
-pub fn check_dir(dir: &Path) -> Result<(), GradeError> {
-    let input = |m: String| GradeError::Input(format!("{}: --write: {m}", dir.display()));
-    if dir.exists() && !dir.is_dir() {
-        return Err(input("not a folder".into()));
-    }
-    let probe_in = if dir.is_dir() {
-        dir.to_owned()
-    } else {
-        let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
-        let parent = parent.unwrap_or(Path::new("."));
-        if !parent.is_dir() {
-            return Err(input(format!(
-                "the folder it would be made in, {}, does not exist",
-                parent.display()
-            )));
-        }
-        parent.to_owned()
-    };
-    tempfile::Builder::new()
-        .prefix(".glint-probe-")
-        .tempfile_in(&probe_in)
-        .map_err(|e| input(format!("cannot write there: {e}")))?;
-    Ok(())
-}
-
-/// Makes `dir` if it does not exist yet.
-pub fn make_dir(dir: &Path) -> Result<(), GradeError> {
-    if dir.is_dir() {
-        return Ok(());
-    }
-    std::fs::create_dir(dir).map_err(|e| {
-        GradeError::Internal(format!("{}: cannot make the folder: {e}", dir.display()))
-    })
-}
-
-/// Writes `text` to `path` atomically.
-pub fn write(path: &Path, text: &str) -> Result<(), GradeError> {
-    let fail = |e: std::io::Error| GradeError::Internal(format!("{}: {e}", path.display()));
-    glint_camera::write_atomically(path, fail, |out| {
-        out.write_all(text.as_bytes()).map_err(fail)
-    })
 }
 
 /// A stage's three files in `dir`: path, text, and the number of cases.

@@ -234,7 +234,7 @@ pub fn check_case_count(cases: u32) -> Result<(), GradeError> {
 /// Checks that `dir` can take the vectors ([`write_vectors`] does too):
 /// for a caller that checks its output before loading the scene.
 pub fn check_write_dir(dir: &Path) -> Result<(), GradeError> {
-    files::check_dir(dir)
+    crate::output::check_dir(dir, "--write")
 }
 
 /// Writes every stage's vectors for `scene` into `dir` (made if missing;
@@ -247,16 +247,16 @@ pub fn write_vectors(
     dir: &Path,
 ) -> Result<Vec<(PathBuf, usize)>, GradeError> {
     check_case_count(cases)?;
-    files::check_dir(dir)?;
+    crate::output::check_dir(dir, "--write")?;
     let all = vectors(scene, &Stage::ALL, cases)?;
     let name = scene_name(scene);
     let documents: Vec<(PathBuf, String, usize)> = all
         .iter()
         .flat_map(|v| files::documents(&name, cases, v, dir))
         .collect();
-    files::make_dir(dir)?;
+    crate::output::make_dir(dir)?;
     for (path, text, _) in &documents {
-        files::write(path, text)?;
+        crate::output::write_text(path, text)?;
     }
     Ok(documents
         .into_iter()

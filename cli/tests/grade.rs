@@ -341,3 +341,101 @@ fn bad_input_is_refused_before_any_work() {
         "{names:?}"
     );
 }
+
+/// A fixture of `cli/tests/data/grade/` (renders by the independent tracer).
+fn fixture(name: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/grade")
+        .join(name);
+    path.to_str().unwrap().to_owned()
+}
+
+/// Every submission's verdict, from `--format csv`, by student.
+fn verdicts(o: &std::process::Output) -> Vec<(String, String)> {
+    stdout(o)
+        .lines()
+        .skip(1)
+        .map(|line| {
+            let cells: Vec<&str> = line.split(',').collect();
+            (cells[0].to_owned(), cells[3].to_owned())
+        })
+        .collect()
+}
+
+#[test]
+fn another_ray_tracer_s_correct_renders_pass_and_its_mistakes_fail() {
+    let dir = tempfile::tempdir().unwrap();
+    let set1 = scene("cornell-set1");
+    let stratified = ["--sampler", "stratified", "--light-sampler", "stratified"];
+    let mistakes: Vec<String> = [
+        "flipped-view.png",
+        "sphere-u-sign.png",
+        "no-shadow-offset.png",
+        "truncate-8bit.png",
+    ]
+    .into_iter()
+    .map(fixture)
+    .collect();
+    let mut args = vec![set1.as_str()];
+    args.extend(mistakes.iter().map(String::as_str));
+    args.extend(["--spp", "16", "--light-samples", "16", "--format", "csv"]);
+    args.extend(stratified);
+    let o = grade(&args, dir.path());
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let expected = [
+        ("flipped-view", "fail"),
+        ("sphere-u-sign", "fail"),
+        ("no-shadow-offset", "fail"),
+        // Half an 8-bit step darker: within what the format may have changed.
+        ("truncate-8bit", "pass"),
+    ];
+    let expected: Vec<(String, String)> = expected
+        .iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
+    assert_eq!(verdicts(&o), expected);
+
+    let (correct, first, corners) = (
+        fixture("correct.png"),
+        fixture("first-step.ppm"),
+        fixture("first-step-corners.ppm"),
+    );
+    let o = grade(
+        &[
+            &set1,
+            &correct,
+            "--spp",
+            "4",
+            "--light-samples",
+            "4",
+            stratified[0],
+            stratified[1],
+            stratified[2],
+            stratified[3],
+        ],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    // The first step, stated: rays through the pixels' centres pass, through
+    // their corners fail.
+    let first_step = [
+        "--spp",
+        "1",
+        "--sampler",
+        "grid",
+        "--light-samples",
+        "16",
+        "--light-sampler",
+        "stratified",
+        "--format",
+        "csv",
+    ];
+    let mut args = vec![set1.as_str(), &first, &corners];
+    args.extend(first_step);
+    let o = grade(&args, dir.path());
+    let expected: Vec<(String, String)> = [("first-step", "pass"), ("first-step-corners", "fail")]
+        .iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
+    assert_eq!(verdicts(&o), expected);
+}

@@ -188,10 +188,13 @@ pub(crate) fn grade(args: &GradeArgs) -> Result<(), Failure> {
             alpha: args.alpha,
             block: args.block,
         },
-        cache: cache(args),
+        cache: cache(args)?,
     };
     let bar = GradeProgress::new();
-    let report = args.report.as_deref();
+    // The report is made in a folder of its own beside the one asked for,
+    // and takes its place only when whole: a failed run leaves the old one.
+    let staging = args.report.as_deref().map(Staging::new).transpose()?;
+    let report = staging.as_ref().map(|s| s.dir.path());
     let on_graded = |i: usize, row: &class::Row, s: &glint_grade::Submission, g: &class::Group| {
         if let Some(dir) = report {
             glint_grade::html::write_images(dir, i, row, s, g)?;
@@ -204,14 +207,78 @@ pub(crate) fn grade(args: &GradeArgs) -> Result<(), Failure> {
     if let Some(path) = &args.heatmap {
         write_heatmap(path, &grades)?;
     }
-    if let Some(dir) = report {
-        glint_grade::html::write_report(dir, &grades).map_err(failure)?;
+    if let Some(staging) = staging {
+        glint_grade::html::write_report(staging.dir.path(), &grades).map_err(failure)?;
+        staging.finish()?;
     }
     print(args, &grades)?;
     if grades.all_passed() {
         Ok(())
     } else {
         Err(Failure::Verdict(None))
+    }
+}
+
+/// A report folder being made: a temporary folder beside `target`, moved into
+/// its place when finished (an old report moved aside first, then removed).
+struct Staging {
+    dir: tempfile::TempDir,
+    target: PathBuf,
+}
+
+impl Staging {
+    fn new(target: &Path) -> Result<Staging, Failure> {
+        let parent = target
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let dir = tempfile::Builder::new()
+            .prefix(".glint-report-")
+            .tempdir_in(parent)
+            .map_err(|e| {
+                Failure::Input(format!(
+                    "{}: --report: cannot write there: {e}",
+                    target.display()
+                ))
+            })?;
+        Ok(Staging {
+            dir,
+            target: target.to_owned(),
+        })
+    }
+
+    fn finish(self) -> Result<(), Failure> {
+        let fail = |e: std::io::Error| {
+            Failure::Internal(format!(
+                "{}: cannot put the report in place: {e}",
+                self.target.display()
+            ))
+        };
+        let old = self.target.exists().then(|| {
+            let parent = self.dir.path().parent().expect("made in a folder");
+            parent.join(format!(
+                ".glint-report-old-{}",
+                self.dir
+                    .path()
+                    .file_name()
+                    .map_or("".into(), |n| n.to_string_lossy())
+            ))
+        });
+        if let Some(old) = &old {
+            std::fs::rename(&self.target, old).map_err(fail)?;
+        }
+        let made = self.dir.keep();
+        if let Err(e) = std::fs::rename(&made, &self.target) {
+            if let Some(old) = &old {
+                let _ = std::fs::rename(old, &self.target);
+            }
+            let _ = std::fs::remove_dir_all(&made);
+            return Err(fail(e));
+        }
+        if let Some(old) = old {
+            let _ = std::fs::remove_dir_all(old);
+        }
+        Ok(())
     }
 }
 
@@ -315,20 +382,49 @@ fn course_index() -> Result<PathBuf, Failure> {
     })
 }
 
-fn cache(args: &GradeArgs) -> Cache {
+/// The reference cache, made ready before any work: `--cache DIR` must be
+/// a folder that can be made and written (else bad input); the default one
+/// that cannot is not used, with a note.
+fn cache(args: &GradeArgs) -> Result<Cache, Failure> {
     if args.no_cache {
-        return Cache { dir: None };
+        return Ok(Cache { dir: None });
     }
-    let default = || {
-        let base = std::env::var_os("XDG_CACHE_HOME")
-            .map(PathBuf::from)
-            .filter(|p| p.is_absolute())
-            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
-        Some(base.join("glint").join("grade"))
-    };
-    Cache {
-        dir: args.cache.clone().or_else(default),
+    if let Some(dir) = &args.cache {
+        usable_cache(dir)
+            .map_err(|e| Failure::Input(format!("{}: --cache: {e}", dir.display())))?;
+        return Ok(Cache {
+            dir: Some(dir.clone()),
+        });
     }
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .filter(|p| p.is_absolute())
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")));
+    let dir = base.map(|b| b.join("glint").join("grade"));
+    match dir.as_deref().map(usable_cache) {
+        Some(Ok(())) => Ok(Cache { dir }),
+        Some(Err(e)) => {
+            eprintln!(
+                "glint: note: not caching references: {}: {e}",
+                dir.expect("some").display()
+            );
+            Ok(Cache { dir: None })
+        }
+        None => Ok(Cache { dir: None }),
+    }
+}
+
+/// Makes `dir` if need be and checks that files can be written in it.
+fn usable_cache(dir: &Path) -> Result<(), String> {
+    if dir.exists() && !dir.is_dir() {
+        return Err("not a folder".into());
+    }
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot make the folder: {e}"))?;
+    tempfile::Builder::new()
+        .prefix(".glint-probe-")
+        .tempfile_in(dir)
+        .map_err(|e| format!("cannot write there: {e}"))?;
+    Ok(())
 }
 
 /// Every output path, before any work.
@@ -345,11 +441,11 @@ fn check_outputs(args: &GradeArgs, entries: &[Entry]) -> Result<(), Failure> {
     }
     if let Some(dir) = &args.report {
         glint_grade::output::check_dir(dir, "--report").map_err(failure)?;
-    }
-    if let Some(dir) = &cache(args).dir {
-        if dir.exists() && !dir.is_dir() {
+        // The report replaces the folder whole: only an earlier report's.
+        let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
+        if dir.is_dir() && !is_empty(dir) && !dir.join("grades.json").is_file() {
             return Err(Failure::Input(format!(
-                "{}: --cache: not a folder",
+                "{}: --report: the folder holds files that are not a report of glint grade's, and a report replaces its folder whole; choose a new folder",
                 dir.display()
             )));
         }

@@ -264,6 +264,26 @@ fn a_report_folder_holds_the_page_the_tables_and_the_images() {
     );
     let map = image::open(&heat).unwrap();
     assert_eq!((map.width(), map.height()), (32, 32));
+
+    // A second run replaces the report whole: nothing of the old one stays,
+    // and nothing is left beside it.
+    std::fs::write(report.join("notes.txt"), "the grader's own file").unwrap();
+    let o = grade(
+        &[
+            &set1,
+            good.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(report.join("index.html").is_file() && !report.join("notes.txt").exists());
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(!names.iter().any(|n| n.starts_with(".glint")), "{names:?}");
 }
 
 #[test]
@@ -306,11 +326,17 @@ fn bad_input_is_refused_before_any_work() {
             vec!["--class", "nowhere"],
             "--class: no such folder or manifest",
         ),
+        (
+            vec![&set1, good, "--report", "."],
+            "holds files that are not a report",
+        ),
     ];
     for (args, expected) in cases {
         let o = grade(&args, dir.path());
         assert_input_error(&o, expected);
     }
+    let o = glint(&["grade", &set1, good, "--cache", good], dir.path());
+    assert_input_error(&o, "--cache: not a folder");
     let manifest = dir.path().join("m.csv");
     for (text, expected) in [
         (

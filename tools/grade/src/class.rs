@@ -322,24 +322,10 @@ pub fn grade_class(
     on_graded: &OnGraded,
 ) -> Result<ClassGrades, GradeError> {
     let entries = &with_presets(entries, scenes, base)?[..];
-    // Each scene once; a scene that is missing or does not load fails only
-    // its rows.
-    let mut loaded: BTreeMap<PathBuf, Result<Arc<GradeScene>, String>> = BTreeMap::new();
-    for (_, found) in entries {
-        let Ok(path) = found else { continue };
-        loaded.entry(path.clone()).or_insert_with(|| {
-            if path.is_file() {
-                GradeScene::load(path)
-                    .map(Arc::new)
-                    .map_err(|e| e.to_string())
-            } else {
-                Err(format!("no scene file {}", path.display()))
-            }
-        });
-    }
+    let loaded = load_scenes(entries);
     // What each submission needs: its scene and resolution, read from the
     // file (and dropped: grading reads it again).
-    let probes: Vec<Result<(PathBuf, UVec2), String>> = entries
+    let probes: Vec<Probe> = entries
         .par_iter()
         .map(|(entry, found)| {
             let path = found.clone()?;
@@ -348,34 +334,7 @@ pub fn grade_class(
             Ok((path, submission.resolution()))
         })
         .collect();
-    let mut groups: Vec<Group> = Vec::new();
-    let mut keys: Vec<(PathBuf, UVec2, StatedSettings)> = Vec::new();
-    let mut row_groups = Vec::with_capacity(entries.len());
-    for ((entry, _), probe) in entries.iter().zip(&probes) {
-        let Ok((path, resolution)) = probe else {
-            row_groups.push(None);
-            continue;
-        };
-        let key = (path.clone(), *resolution, entry.stated);
-        let index = match keys.iter().position(|k| *k == key) {
-            Some(i) => i,
-            None => {
-                let scene = loaded[path].as_ref().expect("probed").clone();
-                let plan = ReferencePlan::new(&entry.stated, scene.settings());
-                let references = references(&scene, *resolution, &plan, &options.cache, &|what| {
-                    progress.rendering(what)
-                })?;
-                keys.push(key);
-                groups.push(Group {
-                    scene,
-                    stated: entry.stated,
-                    references,
-                });
-                groups.len() - 1
-            }
-        };
-        row_groups.push(Some(index));
-    }
+    let (groups, row_groups) = reference_groups(entries, &probes, &loaded, options, progress)?;
     let done = AtomicUsize::new(0);
     let rows: Vec<Row> = entries
         .par_iter()
@@ -389,6 +348,68 @@ pub fn grade_class(
         })
         .collect::<Result<_, GradeError>>()?;
     Ok(ClassGrades { rows, groups })
+}
+
+/// A submission's scene file and resolution, or why it cannot be graded.
+type Probe = Result<(PathBuf, UVec2), String>;
+
+/// The scenes, each loaded once, by file; one that is missing or does not
+/// load fails only its rows.
+type Loaded = BTreeMap<PathBuf, Result<Arc<GradeScene>, String>>;
+
+fn load_scenes(entries: &[Located]) -> Loaded {
+    let mut loaded = Loaded::new();
+    for (_, found) in entries {
+        let Ok(path) = found else { continue };
+        loaded.entry(path.clone()).or_insert_with(|| {
+            if path.is_file() {
+                GradeScene::load(path)
+                    .map(Arc::new)
+                    .map_err(|e| e.to_string())
+            } else {
+                Err(format!("no scene file {}", path.display()))
+            }
+        });
+    }
+    loaded
+}
+
+/// The references each readable submission is judged against, rendered (or
+/// read from the cache) once per scene, resolution and stated settings; and
+/// each row's group.
+fn reference_groups(
+    entries: &[Located],
+    probes: &[Probe],
+    loaded: &Loaded,
+    options: &ClassOptions,
+    progress: &dyn Progress,
+) -> Result<(Vec<Group>, Vec<Option<usize>>), GradeError> {
+    let mut groups: Vec<Group> = Vec::new();
+    let mut keys: Vec<(PathBuf, UVec2, StatedSettings)> = Vec::new();
+    let mut row_groups = Vec::with_capacity(entries.len());
+    for ((entry, _), probe) in entries.iter().zip(probes) {
+        let Ok((path, resolution)) = probe else {
+            row_groups.push(None);
+            continue;
+        };
+        let key = (path.clone(), *resolution, entry.stated);
+        if let Some(i) = keys.iter().position(|k| *k == key) {
+            row_groups.push(Some(i));
+            continue;
+        }
+        let scene = loaded[path].as_ref().expect("probed").clone();
+        let plan = ReferencePlan::new(&entry.stated, scene.settings());
+        let rendering = |what: &str| progress.rendering(what);
+        let references = references(&scene, *resolution, &plan, &options.cache, &rendering)?;
+        keys.push(key);
+        groups.push(Group {
+            scene,
+            stated: entry.stated,
+            references,
+        });
+        row_groups.push(Some(groups.len() - 1));
+    }
+    Ok((groups, row_groups))
 }
 
 /// What a report calls a scene: its name, or a scene file's stem.
@@ -441,7 +462,7 @@ fn with_presets(
 fn grade_row(
     index: usize,
     entry: &Entry,
-    probe: &Result<(PathBuf, UVec2), String>,
+    probe: &Probe,
     group: Option<usize>,
     groups: &[Group],
     options: &ClassOptions,

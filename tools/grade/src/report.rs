@@ -34,7 +34,10 @@ pub fn finding_phrase(f: &RegionFinding) -> String {
         .iter()
         .all(|c| (c.difference - first.difference).abs() <= 0.1 * first.difference.abs());
     let body = if same {
-        let names: Vec<&str> = f.channels.iter().map(|c| c.channel).collect();
+        let names: Vec<&str> = crate::CHANNELS
+            .into_iter()
+            .filter(|name| f.channels.iter().any(|c| c.channel == *name))
+            .collect();
         format!("{} {}", names.join(", "), how(first))
     } else {
         let parts: Vec<String> = f

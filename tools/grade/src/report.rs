@@ -69,11 +69,22 @@ pub fn summary(row: &Row) -> String {
     }
 }
 
+/// z with one decimal; a difference where there is no noise at all (a
+/// deterministic region) is infinitely many standard errors.
 fn z_text(z: f64) -> String {
     if z.is_infinite() {
-        if z > 0.0 { "inf" } else { "−inf" }.into()
+        if z > 0.0 { "∞" } else { "−∞" }.into()
     } else {
         format!("{z:.1}").replace('-', "−")
+    }
+}
+
+/// p with two significant digits; below what a double holds, a bound.
+fn p_text(p: f64) -> String {
+    if p < 1e-300 {
+        "< 1e-300".into()
+    } else {
+        format!("{p:.1e}")
     }
 }
 
@@ -160,13 +171,13 @@ pub fn details(grade: &ImageGrade, limit: usize) -> String {
         out += &format!("  {} ({} pixels)\n", finding_phrase(f), f.pixels);
         for c in &f.channels {
             out += &format!(
-                "    {} mean {}, expected {} to {}, z {}, p {:.1e}\n",
+                "    {} mean {}, expected {} to {}, z {}, p {}\n",
                 c.channel,
                 significant(c.observed),
                 significant(c.expected[0]),
                 significant(c.expected[1]),
                 z_text(c.z),
-                c.p,
+                p_text(c.p),
             );
         }
     }

@@ -258,6 +258,17 @@ def _pair(v):
     return np.array([_number(x) for x in v])
 
 
+def _edges_and_front(reader, noun):
+    """A parallelogram's or light's `edge1`, `edge2` (spanning an area) and
+    front normal (`normal`, or edge1 x edge2)."""
+    e1 = reader.get("edge1", _vec3, required=True)
+    e2 = reader.get("edge2", _vec3, required=True)
+    cross = np.cross(e1, e2)
+    if cross.dot(cross) <= 1e-12 * e1.dot(e1) * e2.dot(e2):
+        reader.fail("edge1", f"edge1 and edge2 are parallel or zero, so {noun} has no area")
+    return e1, e2, _front_side(reader, cross, reader.get("normal", _direction, None))
+
+
 def _front_side(r: _Reader, cross: np.ndarray, normal) -> np.ndarray:
     """Glint's front side: the unit cross product turned to `normal` if given
     (scene/src/build.rs `front_side`, geometry `Parallelogram::facing`)."""
@@ -400,12 +411,7 @@ def load_scene(path: str) -> Scene:
         pr = _Reader(path, p, f"parallelogram[{i}]")
         pr.get("name", _string)
         origin = pr.get("origin", _vec3, required=True)
-        e1 = pr.get("edge1", _vec3, required=True)
-        e2 = pr.get("edge2", _vec3, required=True)
-        cross = np.cross(e1, e2)
-        if cross.dot(cross) <= 1e-12 * e1.dot(e1) * e2.dot(e2):
-            pr.fail("edge1", "edge1 and edge2 are parallel or zero, so the shape has no area")
-        normal = _front_side(pr, cross, pr.get("normal", _direction, None))
+        e1, e2, normal = _edges_and_front(pr, "the shape")
         two_sided = pr.get("two_sided", _bool, False)
         parallelograms.append(Parallelogram(origin, e1, e2, normal, two_sided, material_of(pr), -1))
         pr.finish()
@@ -415,12 +421,7 @@ def load_scene(path: str) -> Scene:
         ar = _Reader(path, a, f"area_light[{i}]")
         ar.get("name", _string)
         center = ar.get("center", _vec3, required=True)
-        e1 = ar.get("edge1", _vec3, required=True)
-        e2 = ar.get("edge2", _vec3, required=True)
-        cross = np.cross(e1, e2)
-        if cross.dot(cross) <= 1e-12 * e1.dot(e1) * e2.dot(e2):
-            ar.fail("edge1", "edge1 and edge2 are parallel or zero, so the light has no area")
-        normal = _front_side(ar, cross, ar.get("normal", _direction, None))
+        e1, e2, normal = _edges_and_front(ar, "the light")
         color = ar.get("color", _color, np.ones(3))
         ar.finish()
         # The light's surface, for camera rays (and, as a mistake, shadow rays).

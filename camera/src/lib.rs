@@ -35,6 +35,7 @@
 mod atomic_file;
 mod camera;
 mod film;
+mod output_paths;
 
 pub use atomic_file::write_atomically;
 pub use camera::{
@@ -44,6 +45,7 @@ pub use film::{
     linear_to_srgb8, srgb_to_linear, Film, FilmError, ImageFormat, PartialFilm, SampleEncoding,
     MAX_LOAD_SIDE,
 };
+pub use output_paths::{check_output_file, check_output_folder, MAX_NAME_BYTES};
 
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]

@@ -318,6 +318,58 @@ fn a_png_claiming_a_huge_size_is_refused_from_its_header() {
     );
 }
 
+/// A PNG of `width × height` 8-bit RGB whose IDAT holds no pixels.
+fn empty_png(width: u32, height: u32) -> Vec<u8> {
+    let mut ihdr = b"IHDR".to_vec();
+    ihdr.extend(width.to_be_bytes());
+    ihdr.extend(height.to_be_bytes());
+    ihdr.extend([8, 2, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    for chunk in [ihdr, b"IDAT".to_vec(), b"IEND".to_vec()] {
+        png.extend((chunk.len() as u32 - 4).to_be_bytes());
+        png.extend(&chunk);
+        png.extend(crc32(&chunk).to_be_bytes());
+    }
+    png
+}
+
+#[test]
+fn a_header_claiming_more_pixels_than_its_file_holds_is_refused_before_allocating() {
+    // 16000 × 16000 is within the side limit, but 768 MB of pixels cannot come
+    // from a file of 57 bytes: refused from the header and the file's size
+    // (under a 4 GiB address space, decoding it aborted).
+    let png = empty_png(16000, 16000);
+    let message = error("claims.png", &png);
+    assert!(
+        message.ends_with(&format!(
+            "the header says 16000x16000 pixels (768000000 bytes decoded), more than a file of {} bytes can hold",
+            png.len()
+        )),
+        "{message}"
+    );
+    // An OpenEXR file whose windows are widened to 16000 × 16000 after it was
+    // written: Film::load and a resumed render's PartialFilm::load refuse it
+    // from the header (here the exr crate's own check of its chunk table
+    // comes first).
+    let dir = tempfile::tempdir().unwrap();
+    let path = saved(&gradient(), dir.path(), "claims.exr");
+    let mut exr = std::fs::read(&path).unwrap();
+    for window in [&b"dataWindow\0box2i\0"[..], b"displayWindow\0box2i\0"] {
+        let at = exr.windows(window.len()).position(|w| w == window).unwrap() + window.len() + 4;
+        exr[at + 8..at + 16]
+            .copy_from_slice(&[15999i32.to_le_bytes(), 15999i32.to_le_bytes()].concat());
+    }
+    std::fs::write(&path, &exr).unwrap();
+    for message in [
+        Film::load(&path).unwrap_err().to_string(),
+        glint_camera::PartialFilm::load(&path)
+            .unwrap_err()
+            .to_string(),
+    ] {
+        assert!(message.contains("cannot read the image"), "{message}");
+    }
+}
+
 /// The 8-bit sRGB codes of `film`, as a PPM in the layout `magic` names.
 fn ppm(film: &Film, magic: &str) -> Vec<u8> {
     let size = film.resolution();

@@ -166,36 +166,21 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<(), Failure> {
     std::fs::create_dir_all(&config.output_dir)
         .map_err(|e| Failure::Other(format!("{}: {e}", config.output_dir.display())))?;
     let written = bench.write(&config.output_dir).map_err(Failure::Other)?;
-    print!("{}", bench.report.table());
-    println!(
-        "wrote {} files to {}",
+    crate::output::say(&bench.report.table());
+    crate::output::say(&format!(
+        "wrote {} files to {}\n",
         written.len(),
         config.output_dir.display()
-    );
+    ));
     Ok(())
 }
 
 /// The output directory, before any work: an existing directory we may write
-/// in, or one we may create (its parent exists and is writable). It is created
-/// only when there is something to put in it.
+/// in, or one we may create ([`glint_camera::check_output_folder`]). It is
+/// created only when there is something to put in it.
 fn check_output_dir(dir: &Path) -> Result<(), Failure> {
-    if dir.exists() {
-        if !dir.is_dir() {
-            return Err(Failure::Input(format!(
-                "{}: is a file, expected a directory for the results",
-                dir.display()
-            )));
-        }
-        return crate::output::check_writable(&dir.join("results.json"));
-    }
-    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
-    crate::output::check_writable(&parent.unwrap_or(Path::new(".")).join("results.json"))
-        .map_err(|_| {
-            Failure::Input(format!(
-                "{}: cannot create the results directory here (its parent is missing or not writable)",
-                dir.display()
-            ))
-        })
+    glint_camera::check_output_folder(dir)
+        .map_err(|e| Failure::Input(format!("{}: the results directory {e}", dir.display())))
 }
 
 fn config(args: &BenchArgs) -> Result<BenchConfig, Failure> {

@@ -168,7 +168,7 @@ pub(crate) fn diff(args: &DiffArgs) -> Result<(), Failure> {
             text
         }
     };
-    print!("{out}");
+    crate::output::say(&out);
     if within {
         Ok(())
     } else {

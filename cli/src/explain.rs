@@ -8,7 +8,6 @@ use glint_explain::against::{self, Node};
 use glint_explain::{Explanation, Stage};
 use glint_integrator::trace::SampleSelection;
 use glint_integrator::ExplainError;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -113,7 +112,7 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
 /// Prints `text` on stdout; a reader that stops early (`| head`) is not an
 /// error.
 fn print(text: &str) {
-    let _ = std::io::stdout().write_all(text.as_bytes());
+    crate::output::say(&text);
 }
 
 /// `--against`: the student's document at `path` against Glint's; the

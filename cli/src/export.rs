@@ -61,6 +61,10 @@ pub(crate) fn export(args: &ExportArgs) -> Result<(), Failure> {
     mitsuba::check_output(&output).map_err(failure)?;
     let mut description =
         glint_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
+    let inputs: Vec<&Path> = std::iter::once(args.scene.as_path())
+        .chain(description.assets.iter().map(|p| p.as_path()))
+        .collect();
+    crate::output::check_outputs_apart(&[("-o", &output)], &inputs)?;
     let settings = &mut description.settings;
     if let Some(spp) = args.spp {
         settings.spp = spp;
@@ -80,7 +84,7 @@ pub(crate) fn export(args: &ExportArgs) -> Result<(), Failure> {
     }
     let exported = mitsuba::export(&description, &output).map_err(failure)?;
     for warning in &exported.warnings {
-        eprintln!("glint: warning: {warning}");
+        crate::output::tell(&format!("glint: warning: {warning}"));
     }
     let (settings, resolution) = (&description.settings, description.scene.camera.resolution());
     let assets = match &exported.assets {
@@ -91,8 +95,8 @@ pub(crate) fn export(args: &ExportArgs) -> Result<(), Failure> {
         ),
         None => String::new(),
     };
-    println!(
-        "wrote {}{assets} (Mitsuba 3): {}x{}, {} spp, direct integrator with {} emitter and {} BSDF samples, {} warning{}",
+    crate::output::say(&format!(
+        "wrote {}{assets} (Mitsuba 3): {}x{}, {} spp, direct integrator with {} emitter and {} BSDF samples, {} warning{}\n",
         output.display(),
         resolution.x,
         resolution.y,
@@ -101,6 +105,6 @@ pub(crate) fn export(args: &ExportArgs) -> Result<(), Failure> {
         exported.bsdf_samples,
         exported.warnings.len(),
         if exported.warnings.len() == 1 { "" } else { "s" },
-    );
+    ));
     Ok(())
 }

@@ -11,7 +11,6 @@ use glint_grade::course::{Course, Scenes};
 use glint_grade::{Cache, GradeError, StatedSettings, TestOptions};
 use glint_integrator::SamplePattern;
 use indicatif::ProgressBar;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -404,10 +403,10 @@ fn cache(args: &GradeArgs) -> Result<Cache, Failure> {
     match dir.as_deref().map(usable_cache) {
         Some(Ok(())) => Ok(Cache { dir }),
         Some(Err(e)) => {
-            eprintln!(
+            crate::output::tell(&format!(
                 "glint: note: not caching references: {}: {e}",
                 dir.expect("some").display()
-            );
+            ));
             Ok(Cache { dir: None })
         }
         None => Ok(Cache { dir: None }),
@@ -481,7 +480,7 @@ fn print(args: &GradeArgs, grades: &ClassGrades) -> Result<(), Failure> {
         },
     };
     // A reader that stops early (`| head`) is not an error.
-    let _ = std::io::stdout().write_all(text.as_bytes());
+    crate::output::say(&text);
     Ok(())
 }
 

@@ -6,7 +6,6 @@
 use crate::Failure;
 use glint_grade::stages::{self, DEFAULT_CASES};
 use glint_grade::{GradeError, GradeScene};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// What `glint grade --stages` was asked to do.
@@ -95,7 +94,7 @@ fn check(args: &StageArgs, dir: &Path, cases: u32) -> Result<(), Failure> {
 /// Prints `text` on stdout; a reader that stops early (`| head`) is not an
 /// error.
 fn print(text: &str) {
-    let _ = std::io::stdout().write_all(text.as_bytes());
+    crate::output::say(&text);
 }
 
 fn failure(e: GradeError) -> Failure {

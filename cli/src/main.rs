@@ -98,7 +98,7 @@ fn main() -> ExitCode {
     // exit with status 1 (caught below) instead of Rust's 101 and a backtrace hint.
     std::panic::set_hook(Box::new(|info| {
         let message = info.to_string().replace('\n', " ");
-        eprintln!("glint: internal error (please report): {message}");
+        output::tell(&format!("glint: internal error (please report): {message}"));
     }));
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -119,26 +119,26 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(message)) => {
-            eprintln!("glint: error: {message}");
+            output::tell(&format!("glint: error: {}", output::readable(&message)));
             ExitCode::from(2)
         }
         Err(Failure::Other(message)) => {
-            eprintln!("glint: error: {message}");
+            output::tell(&format!("glint: error: {}", output::readable(&message)));
             ExitCode::from(if judging { 3 } else { 1 })
         }
         Err(Failure::Panicked) => ExitCode::from(if judging { 3 } else { 1 }),
         Err(Failure::Verdict(message)) => {
             if let Some(message) = message {
-                eprintln!("glint: error: {message}");
+                output::tell(&format!("glint: error: {}", output::readable(&message)));
             }
             ExitCode::from(1)
         }
         Err(Failure::Internal(message)) => {
-            eprintln!("glint: internal error: {message}");
+            output::tell(&format!("glint: internal error: {message}"));
             ExitCode::from(3)
         }
         Err(Failure::Interrupted { message, status }) => {
-            eprintln!("glint: interrupted: {message}");
+            output::tell(&format!("glint: interrupted: {message}"));
             ExitCode::from(status)
         }
     }
@@ -151,6 +151,22 @@ fn usage_error(e: clap::Error) -> ExitCode {
     if !e.use_stderr() {
         let _ = e.print();
         return ExitCode::SUCCESS;
+    }
+    use clap::error::ErrorKind;
+    if matches!(
+        e.kind(),
+        ErrorKind::MissingSubcommand | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) && std::env::args_os().len() <= 1
+    {
+        let commands: Vec<String> = <Cli as clap::CommandFactory>::command()
+            .get_subcommands()
+            .map(|c| c.get_name().to_owned())
+            .collect();
+        output::tell(&format!(
+            "glint: error: no command given; give one of {} (see glint --help)",
+            commands.join(", ")
+        ));
+        return ExitCode::from(2);
     }
     let rendered = e.render().to_string();
     let mut lines = rendered.lines();
@@ -168,7 +184,10 @@ fn usage_error(e: clap::Error) -> ExitCode {
     if let Some(ContextValue::Strings(values)) = e.get(ContextKind::ValidValue) {
         problem = format!("{problem} [possible values: {}]", values.join(", "));
     }
-    eprintln!("glint: error: {problem} (see glint --help)");
+    output::tell(&format!(
+        "glint: error: {} (see glint --help)",
+        output::readable(&problem)
+    ));
     ExitCode::from(2)
 }
 

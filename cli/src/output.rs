@@ -5,36 +5,57 @@
 use crate::Failure;
 use std::path::Path;
 
-/// Checks that `path` can be written: its directory exists, it is not itself a
-/// directory, and we may create files there (probed with a temporary file that is
-/// removed at once, so an interrupted run leaves nothing behind).
+/// Checks that `path` can be written ([`glint_camera::check_output_file`]:
+/// its directory exists and takes files, it is not a directory, its name is
+/// not too long), before any work.
 pub(crate) fn check_writable(path: &Path) -> Result<(), Failure> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
-    if let Some(dir) = dir {
-        if !dir.is_dir() {
+    glint_camera::check_output_file(path)
+        .map_err(|e| Failure::Input(format!("{}: {e}", path.display())))
+}
+
+/// Refuses, before any work, outputs (each named by its flag) that are one
+/// of the command's `inputs` or each other: compared as real paths (links and
+/// `..` resolved), so that no spelling writes over what the run reads.
+pub(crate) fn check_outputs_apart(
+    outputs: &[(&str, &Path)],
+    inputs: &[&Path],
+) -> Result<(), Failure> {
+    for (i, (flag, output)) in outputs.iter().enumerate() {
+        let Some(target) = real(output) else {
+            continue; // its folder is checked elsewhere
+        };
+        if let Some(input) = inputs
+            .iter()
+            .find(|input| real(input).as_ref() == Some(&target))
+        {
             return Err(Failure::Input(format!(
-                "{}: the output directory {} does not exist",
-                path.display(),
-                dir.display()
+                "{}: {flag} would write over {}, which this run reads; choose another file",
+                output.display(),
+                input.display()
+            )));
+        }
+        if let Some((other, _)) = outputs[..i]
+            .iter()
+            .find(|(_, p)| real(p).as_ref() == Some(&target))
+        {
+            return Err(Failure::Input(format!(
+                "{}: {flag} and {other} name the same file; choose another",
+                output.display()
             )));
         }
     }
-    if path.is_dir() {
-        return Err(Failure::Input(format!(
-            "{}: is a directory, expected an image file name",
-            path.display()
-        )));
-    }
-    tempfile::Builder::new()
-        .prefix(".glint-probe-")
-        .tempfile_in(dir.unwrap_or(Path::new(".")))
-        .map_err(|e| {
-            Failure::Input(format!(
-                "{}: cannot write to the output directory: {e}",
-                path.display()
-            ))
-        })?;
     Ok(())
+}
+
+/// `path` with links and `..` resolved: the file itself if it exists, else
+/// its folder's real path and its name.
+fn real(path: &Path) -> Option<std::path::PathBuf> {
+    if let Ok(real) = path.canonicalize() {
+        return Some(real);
+    }
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty());
+    let folder = folder.unwrap_or(Path::new(".")).canonicalize().ok()?;
+    Some(folder.join(path.file_name()?))
 }
 
 /// Writes `text` to `path` atomically.
@@ -72,4 +93,94 @@ pub(crate) fn check_heatmap_path(path: &Path, inputs: &[&Path]) -> Result<(), Fa
         }
     }
     Ok(())
+}
+
+/// Prints `text` on stdout. A reader that stops early (`glint diff a b | head
+/// -1`) is not an error of Glint's: what it did not read is dropped, and the
+/// command ends as it would have.
+pub(crate) fn say(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let _ = out.write_all(text.as_bytes()).and_then(|()| out.flush());
+}
+
+/// Prints one line on stderr, dropping it if stderr is closed: a message that
+/// cannot be shown must not turn into a panic.
+pub(crate) fn tell(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
+}
+
+/// The most characters of one echoed value (a quoted name, key or argument)
+/// an error line shows.
+pub(crate) const ECHO_LIMIT: usize = 60;
+
+/// The most characters of an error line.
+pub(crate) const LINE_LIMIT: usize = 1000;
+
+/// `message` made readable: each value it quotes ("…", `…` or '…') cut to
+/// [`ECHO_LIMIT`] characters with "…", and the whole cut to [`LINE_LIMIT`]; a
+/// long name, key or list the user typed never makes a line of megabytes.
+pub(crate) fn readable(message: &str) -> String {
+    let chars: Vec<char> = message.chars().collect();
+    let mut out = String::with_capacity(message.len().min(LINE_LIMIT + 80));
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        out.push(c);
+        i += 1;
+        // An opening quote follows no letter or digit (an apostrophe in
+        // "it's" is not one); its closing one precedes none.
+        let opens = matches!(c, '"' | '`' | '\'') && (i < 2 || !chars[i - 2].is_alphanumeric());
+        if !opens {
+            continue;
+        }
+        let closes = (i..chars.len())
+            .find(|&j| chars[j] == c && chars.get(j + 1).is_none_or(|n| !n.is_alphanumeric()));
+        let Some(end) = closes else { continue };
+        out.extend(chars[i..end].iter().take(ECHO_LIMIT));
+        if end - i > ECHO_LIMIT {
+            out.push('…');
+        }
+        out.push(c);
+        i = end + 1;
+    }
+    let length = out.chars().count();
+    if length > LINE_LIMIT {
+        let kept: String = out.chars().take(LINE_LIMIT).collect();
+        return format!("{kept}… ({} more characters)", length - LINE_LIMIT);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn echoed_values_and_lines_are_cut_to_a_readable_length() {
+        let long = "x".repeat(100_000);
+        let line = readable(&format!(
+            "no material named \"{long}\" (defined: \"a\", `b`)"
+        ));
+        assert_eq!(
+            line,
+            format!(
+                "no material named \"{}…\" (defined: \"a\", `b`)",
+                "x".repeat(60)
+            )
+        );
+        assert_eq!(
+            readable("it's fine"),
+            "it's fine",
+            "an unmatched quote is text"
+        );
+        let prose = format!("the report's settings {} aren't quoted", "y".repeat(80));
+        assert_eq!(readable(&prose), prose, "apostrophes are not quotes");
+        let many: Vec<String> = (0..1000).map(|i| format!("\"name{i}\"")).collect();
+        let line = readable(&format!("defined: {}", many.join(", ")));
+        assert!(line.chars().count() < LINE_LIMIT + 40, "{}", line.len());
+        assert!(line.ends_with("more characters)"), "{line}");
+        assert_eq!(readable("plain"), "plain");
+    }
 }

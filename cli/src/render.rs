@@ -160,6 +160,17 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         assets,
         ..
     } = args.scene.load()?;
+    let outputs: Vec<(&str, &Path)> = [
+        Some(("-o", output.as_path())),
+        args.stats_json.as_deref().map(|p| ("--stats-json", p)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let inputs: Vec<&Path> = std::iter::once(args.scene.scene.as_path())
+        .chain(assets.iter().map(PathBuf::as_path))
+        .collect();
+    crate::output::check_outputs_apart(&outputs, &inputs)?;
     if args.threads.is_some() {
         settings.threads = args.threads;
     }
@@ -186,11 +197,19 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         .crop
         .map_or(scene.camera.resolution(), |crop| crop.size());
     let render_id = fingerprint(args, &assets, &settings, scene.camera.resolution())?;
+    let partial_file = partial_path(&output);
     let partial = match args.resume {
         true => {
-            let partial =
-                PartialFilm::load(&output).map_err(|e| Failure::Input(format!("--resume: {e}")))?;
-            check_same_render(&output, &partial, window, &render_id)?;
+            if !partial_file.exists() {
+                return Err(Failure::Input(format!(
+                    "--resume: there is no partial render {} to finish (an interrupted render of {} writes one)",
+                    partial_file.display(),
+                    output.display()
+                )));
+            }
+            let partial = PartialFilm::load(&partial_file)
+                .map_err(|e| Failure::Input(format!("--resume: {e}")))?;
+            check_same_render(&partial_file, &partial, window, &render_id)?;
             Some(partial)
         }
         false => None,
@@ -229,6 +248,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         let _writing = interrupts.writing();
         return Err(write_partial(
             &output,
+            &partial_file,
             film,
             rendered.finished,
             render_id,
@@ -240,6 +260,10 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         let _writing = interrupts.writing();
         film.save(&output)
             .map_err(|e| Failure::Other(e.to_string()))?;
+        if partial.is_some() {
+            // Finished: the partial render has served.
+            let _ = std::fs::remove_file(&partial_file);
+        }
     }
     let write = write_start.elapsed();
 
@@ -249,8 +273,8 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         Some(_) => format!(", {} environment samples", settings.environment_samples),
         None => String::new(),
     };
-    println!(
-        "wrote {}: {}x{}, {} spp, {} light samples{environment_samples}, {:.2} s wall ({:.2} s rendering), {} rays ({:.2} M rays/s)",
+    crate::output::say(&format!(
+        "wrote {}: {}x{}, {} spp, {} light samples{environment_samples}, {:.2} s wall ({:.2} s rendering), {} rays ({:.2} M rays/s)\n",
         output.display(),
         resolution.x,
         resolution.y,
@@ -260,7 +284,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         stats.elapsed.as_secs_f64(),
         stats.rays(),
         stats.rays_per_second() / 1e6,
-    );
+    ));
     let report = StatsReport {
         stats: &stats,
         scene: &scene,
@@ -268,7 +292,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         write,
     };
     if args.stats {
-        println!("{}", report.to_text());
+        crate::output::say(&format!("{}\n", report.to_text()));
     }
     if let Some(path) = &args.stats_json {
         let text = serde_json::to_string_pretty(&report.to_json()).expect("JSON of numbers");
@@ -276,48 +300,53 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         crate::output::write_text(path, &(text + "\n"))?;
     }
     if stats.shading.nonfinite_samples > 0 {
-        eprintln!(
-            "glint: warning: {} camera samples were NaN or infinite and were left out of their pixels",
-            stats.shading.nonfinite_samples
-        );
+        crate::output::tell(&format!("glint: warning: {} camera samples were NaN or infinite and were left out of their pixels",
+            stats.shading.nonfinite_samples));
     }
     Ok(())
 }
 
-/// Writes the pixels an interrupted render finished to `output` (atomically;
-/// what was there is only replaced by a complete write) and says so.
+/// Where an interrupted render of `output` keeps the pixels it finished, and
+/// where `--resume` finds them: beside it, `NAME.partial.exr` (OpenEXR, whose
+/// alpha channel marks the pixels rendered), so that the user's `output`
+/// stays as it was.
+fn partial_path(output: &Path) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .map_or("render".into(), |s| s.to_string_lossy().into_owned());
+    output.with_file_name(format!("{stem}.partial.exr"))
+}
+
+/// Writes the pixels an interrupted render finished to `partial` (atomically)
+/// and says so; `output` is left as it was.
 fn write_partial(
     output: &Path,
+    partial: &Path,
     film: glint_camera::Film,
     finished: Vec<bool>,
     fingerprint: String,
     status: u8,
 ) -> Failure {
     let total = finished.len();
-    let partial = PartialFilm {
+    let film = PartialFilm {
         film,
         finished,
         fingerprint: Some(fingerprint),
     };
-    let done = partial.finished_count();
-    if let Err(e) = partial.save(output) {
+    let done = film.finished_count();
+    if let Err(e) = film.save(partial) {
         return Failure::Other(format!(
             "interrupted, and could not write the partial image: {e}"
         ));
     }
-    let rest = match ImageFormat::from_path(output) {
-        Ok(ImageFormat::Exr) => {
-            "its alpha channel marks them; the same command with --resume finishes it".to_owned()
-        }
-        _ => format!(
-            "the other {} are black (write an .exr to be able to --resume)",
-            total - done
-        ),
+    let untouched = match output.exists() {
+        true => format!("; {} is as it was", output.display()),
+        false => String::new(),
     };
     Failure::Interrupted {
         message: format!(
-            "wrote {} with {done} of {total} pixels rendered; {rest}",
-            output.display()
+            "wrote {} with {done} of {total} pixels rendered{untouched}; the same command with --resume finishes it",
+            partial.display()
         ),
         status,
     }
@@ -335,6 +364,8 @@ fn output_path(args: &RenderArgs) -> Result<PathBuf, Failure> {
     };
     ImageFormat::from_path(&path).map_err(|e| Failure::Input(e.to_string()))?;
     crate::output::check_writable(&path)?;
+    // An interrupted render writes beside it: that must be possible too.
+    crate::output::check_writable(&partial_path(&path))?;
     Ok(path)
 }
 

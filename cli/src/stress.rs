@@ -41,9 +41,9 @@ pub(crate) fn stress(args: &StressArgs) -> Result<(), Failure> {
         grid: args.grid,
         joints: !args.no_joints,
     });
-    print!("{}", table(&rows));
+    crate::output::say(&table(&rows));
     let line = verdict(&rows)?;
-    println!("{line}");
+    crate::output::say(&format!("{line}\n"));
     Ok(())
 }
 

@@ -320,7 +320,7 @@ fn bad_input_is_refused_before_any_work() {
         ),
         (
             vec![&set1, good, "--report", good],
-            "--report: not a folder",
+            "--report: is a file, expected a folder",
         ),
         (
             vec!["--class", "nowhere"],

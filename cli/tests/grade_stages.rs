@@ -340,14 +340,12 @@ fn unreadable_answers_are_bad_input() {
 #[test]
 fn a_write_folder_that_cannot_be_made_is_refused_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a-file"), "").unwrap();
     let o = glint(
-        &["grade", "--stages", &SET1, "--write", "no/such/folder"],
+        &["grade", "--stages", &SET1, "--write", "a-file/folder"],
         dir.path(),
     );
-    assert_input_error(
-        &o,
-        "no/such/folder: --write: the folder it would be made in, no/such, does not exist",
-    );
+    assert_input_error(&o, "a-file/folder: --write: cannot be made: a-file is a file");
     let o = glint(
         &[
             "grade",

@@ -1,7 +1,7 @@
 //! Renders stopped by Ctrl-C (SIGINT) or SIGTERM: the pixels finished so far are
-//! written, with one line saying so and the signal's exit status, and
-//! `--resume` finishes an interrupted EXR into the uninterrupted image, bit for
-//! bit.
+//! written beside the output (`OUT.partial.exr`), which stays as it was, with
+//! one line saying so and the signal's exit status, and `--resume` finishes
+//! the partial render into the uninterrupted image, bit for bit.
 
 mod common;
 
@@ -87,11 +87,18 @@ fn ctrl_c_writes_the_finished_pixels_and_resume_completes_them_bit_for_bit() {
     let err = stderr(&out);
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(
-        err.starts_with("glint: interrupted: wrote out.exr with ") && err.contains("--resume"),
+        err.starts_with("glint: interrupted: wrote out.partial.exr with ")
+            && err.contains("out.exr is as it was")
+            && err.contains("--resume"),
         "{err}"
     );
+    assert_eq!(
+        std::fs::read(dir.path().join("out.exr")).unwrap(),
+        b"the previous image",
+        "the user's image is kept"
+    );
     no_hidden_files(dir.path());
-    let partial = glint_camera::PartialFilm::load(&dir.path().join("out.exr")).unwrap();
+    let partial = glint_camera::PartialFilm::load(&dir.path().join("out.partial.exr")).unwrap();
     let done = partial.finished_count();
     assert!(
         done < 64 * 64,
@@ -100,7 +107,7 @@ fn ctrl_c_writes_the_finished_pixels_and_resume_completes_them_bit_for_bit() {
     // Other settings (another seed; another mirror depth, though this scene
     // has no mirror), an edited scene or another size make another render:
     // refused, the partial file left as it was.
-    let before = std::fs::read(dir.path().join("out.exr")).unwrap();
+    let before = std::fs::read(dir.path().join("out.partial.exr")).unwrap();
     let edited = dir.path().join("edited.toml");
     let text = std::fs::read_to_string(scene("cornell-set1")).unwrap();
     std::fs::write(
@@ -131,7 +138,10 @@ fn ctrl_c_writes_the_finished_pixels_and_resume_completes_them_bit_for_bit() {
             dir.path(),
         );
         common::assert_input_error(&refused, expected);
-        assert_eq!(std::fs::read(dir.path().join("out.exr")).unwrap(), before);
+        assert_eq!(
+            std::fs::read(dir.path().join("out.partial.exr")).unwrap(),
+            before
+        );
     }
     std::fs::remove_file(&edited).unwrap();
     // The thread count and --stats change no pixel: not part of the render.
@@ -162,24 +172,49 @@ fn ctrl_c_writes_the_finished_pixels_and_resume_completes_them_bit_for_bit() {
         read("out.exr") == read("full.exr"),
         "the resumed image differs"
     );
+    assert!(
+        !dir.path().join("out.partial.exr").exists(),
+        "the finished partial render is removed"
+    );
     no_hidden_files(dir.path());
 }
 
 #[test]
-fn sigterm_writes_a_png_with_the_rest_black_and_exits_143() {
+fn sigterm_keeps_the_users_png_and_writes_the_partial_render_beside_it() {
     let dir = tempfile::tempdir().unwrap();
-    let (out, _, _) = interrupted("out.png", "TERM", dir.path());
+    std::fs::write(dir.path().join("out.png"), b"a good image").unwrap();
+    let (out, _, spp) = interrupted("out.png", "TERM", dir.path());
     assert_eq!(out.status.code(), Some(143), "{}", stderr(&out));
     let err = stderr(&out);
     assert!(
-        err.starts_with("glint: interrupted: wrote out.png with ") && err.contains("are black"),
+        err.starts_with("glint: interrupted: wrote out.partial.exr with ")
+            && err.contains("out.png is as it was"),
         "{err}"
     );
     assert_eq!(err.lines().count(), 1, "{err}");
+    assert_eq!(
+        std::fs::read(dir.path().join("out.png")).unwrap(),
+        b"a good image"
+    );
+    let partial = glint_camera::PartialFilm::load(&dir.path().join("out.partial.exr")).unwrap();
+    assert_eq!(partial.film.resolution(), glam::UVec2::new(64, 64));
+    // The last pixel of the last band is never reached first.
+    assert!(!partial.finished[64 * 64 - 1]);
+    // --resume finishes it into the PNG asked for.
+    let mut a = args(spp, "out.png");
+    a.extend([
+        "--resume".to_owned(),
+        "--threads".to_owned(),
+        "1".to_owned(),
+    ]);
+    let resumed = glint(
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert_eq!(resumed.status.code(), Some(0), "{}", stderr(&resumed));
     let film = glint_camera::Film::load(&dir.path().join("out.png")).unwrap();
     assert_eq!(film.resolution(), glam::UVec2::new(64, 64));
-    // The last pixel of the last band is never reached first: black.
-    assert_eq!(film.pixel(63, 63), glam::Vec3::ZERO);
+    assert!(!dir.path().join("out.partial.exr").exists());
     no_hidden_files(dir.path());
 }
 
@@ -196,11 +231,11 @@ fn resume_refuses_what_is_not_a_partial_render() {
     };
     common::assert_input_error(
         &run("gone.exr"),
-        "--resume: gone.exr: cannot read the image",
+        "--resume: there is no partial render gone.partial.exr to finish",
     );
     assert_eq!(
         glint(
-            &args(4, "done.exr")
+            &args(4, "done.partial.exr")
                 .iter()
                 .map(String::as_str)
                 .collect::<Vec<_>>(),
@@ -216,10 +251,11 @@ fn resume_refuses_what_is_not_a_partial_render() {
         finished: vec![false; 64 * 64],
         fingerprint: None,
     };
-    unnamed.save(&dir.path().join("unnamed.exr")).unwrap();
+    unnamed
+        .save(&dir.path().join("unnamed.partial.exr"))
+        .unwrap();
     common::assert_input_error(
         &run("unnamed.exr"),
         "does not record the scene and settings",
     );
-    common::assert_input_error(&run("out.png"), "a partial render is an OpenEXR file");
 }

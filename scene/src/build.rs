@@ -408,7 +408,7 @@ fn regions(file: &SceneFile) -> Result<Vec<(String, [u32; 4])>, Problem> {
     file.regions
         .iter()
         .map(|(name, spanned)| {
-            let [x0, y0, x1, y1] = *spanned.get_ref();
+            let [x0, y0, x1, y1] = spanned.get_ref().0;
             if x0 >= x1 || y0 >= y1 || x1 > size.x || y1 > size.y {
                 return Err(Problem::new(
                     spanned.span(),
@@ -602,6 +602,10 @@ fn textures<'a>(
     let mut images: HashMap<PathBuf, Arc<TextureImage>> = HashMap::new();
     let mut textures = BTreeMap::new();
     for (name, table) in tables {
+        // Every texture is checked; only those a material reads are loaded.
+        if let TextureTable::CheckerImage(c) = table {
+            checker_image_size(name, c)?;
+        }
         if !referenced.contains(name.as_str()) {
             // Kept by name only, for the list of known names in errors.
             textures.insert(name.as_str(), Texture::Constant(Vec3::ZERO));
@@ -614,22 +618,6 @@ fn textures<'a>(
             }),
             TextureTable::CheckerImage(c) => {
                 let (checks, per_check) = (c.checks.get_ref().0, c.pixels_per_check.get_ref().0);
-                let side = checks as u64 * per_check as u64;
-                if side * side > MAX_IMAGE_TEXELS {
-                    // Point at pixels_per_check if the file set it, else at checks.
-                    let (key, span) = if c.pixels_per_check.span().is_empty() {
-                        ("checks", c.checks.span())
-                    } else {
-                        ("pixels_per_check", c.pixels_per_check.span())
-                    };
-                    return Err(Problem::new(
-                        span,
-                        format!("textures.{name}.checker_image.{key}"),
-                        format!(
-                            "the image would be {side}x{side} texels (checks × pixels_per_check per side), more than the limit of {MAX_IMAGE_TEXELS} texels"
-                        ),
-                    ));
-                }
                 let checker = Checkerboard::new(c.colors[0].0, c.colors[1].0, checks);
                 let image = TextureImage::from_checkerboard(checker, per_check);
                 Texture::Image(ImageTexture::new(image, c.wrap.0, c.filter.0))
@@ -661,6 +649,30 @@ fn textures<'a>(
         textures.insert(name.as_str(), texture);
     }
     Ok(textures)
+}
+
+/// A checker image's side, `checks × pixels_per_check`, within
+/// [`MAX_IMAGE_TEXELS`] (in u64 and saturating: the product of two large
+/// counts must not wrap).
+fn checker_image_size(name: &str, c: &CheckerImageTable) -> Result<(), Problem> {
+    let (checks, per_check) = (c.checks.get_ref().0, c.pixels_per_check.get_ref().0);
+    let side = checks as u64 * per_check as u64;
+    if side.saturating_mul(side) <= MAX_IMAGE_TEXELS {
+        return Ok(());
+    }
+    // Point at pixels_per_check if the file set it, else at checks.
+    let (key, span) = if c.pixels_per_check.span().is_empty() {
+        ("checks", c.checks.span())
+    } else {
+        ("pixels_per_check", c.pixels_per_check.span())
+    };
+    Err(Problem::new(
+        span,
+        format!("textures.{name}.checker_image.{key}"),
+        format!(
+            "the image would be {side}x{side} texels (checks × pixels_per_check per side), more than the limit of {MAX_IMAGE_TEXELS} texels"
+        ),
+    ))
 }
 
 fn material(

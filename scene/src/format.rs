@@ -44,7 +44,7 @@ pub struct SceneFile {
     /// Named rectangles of the image, `[x0, y0, x1, y1]` in pixels of the render
     /// resolution (x1, y1 excluded), for `glint bench --region NAME`.
     #[serde(default)]
-    pub regions: BTreeMap<String, Spanned<[u32; 4]>>,
+    pub regions: BTreeMap<String, Spanned<Exactly<u32, 4>>>,
 }
 
 fn black() -> Color {
@@ -146,7 +146,7 @@ pub enum TextureTable {
 #[serde(deny_unknown_fields)]
 pub struct CheckerboardTable {
     /// The colors of even and odd checks.
-    pub colors: [Color; 2],
+    pub colors: Exactly<Color, 2>,
     /// Checks along each side of the uv square.
     pub checks: Count,
     #[serde(default = "point_filter")]
@@ -161,7 +161,7 @@ fn point_filter() -> CheckerFilter {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CheckerImageTable {
-    pub colors: [Color; 2],
+    pub colors: Exactly<Color, 2>,
     pub checks: Spanned<Count>,
     #[serde(default = "course_pixels_per_check")]
     pub pixels_per_check: Spanned<Count>,

@@ -22,6 +22,7 @@
 
 mod build;
 mod error;
+mod files;
 mod format;
 pub mod mitsuba;
 mod obj;
@@ -29,6 +30,7 @@ mod values;
 
 pub use build::{LoadTimings, SceneDescription};
 pub use error::SceneError;
+pub use files::{MAX_MESH_BYTES, MAX_SCENE_BYTES};
 pub use values::{parse_resolution_parts, MAX_RESOLUTION};
 
 use std::path::Path;
@@ -36,12 +38,25 @@ use std::path::Path;
 /// Reads and validates the scene file at `path`, and the assets it names
 /// (paths relative to the scene file's directory).
 pub fn load(path: &Path) -> Result<SceneDescription, SceneError> {
-    let source = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+    let read = |message: String| SceneError::Read {
+        path: path.to_path_buf(),
+        source: std::io::Error::other(message),
+    };
+    files::check_regular(path, MAX_SCENE_BYTES, "a scene file").map_err(read)?;
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
         path: path.to_path_buf(),
         source,
     })?;
+    let file = path.display().to_string();
+    let source = files::utf8(&bytes).map_err(|(line, column, message)| SceneError::Invalid {
+        file: file.clone(),
+        line,
+        column,
+        field: None,
+        message,
+    })?;
     let base_dir = path.parent().unwrap_or(Path::new(""));
-    parse_in(&source, &path.display().to_string(), base_dir)
+    parse_in(source, &file, base_dir)
 }
 
 /// Parses and validates scene text; `file` names it in error messages, and asset

@@ -40,6 +40,8 @@ pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
     let cannot_read =
         |e: &dyn std::fmt::Display| format!("{}: cannot read the OBJ file: {e}", path.display());
     // tobj reports a file it cannot open without the reason.
+    crate::files::check_regular(path, crate::MAX_MESH_BYTES, "an OBJ file")
+        .map_err(|e| cannot_read(&e))?;
     let file = std::fs::File::open(path).map_err(|e| cannot_read(&e))?;
     check_face_indices(path)?;
     let base = path.parent().unwrap_or(Path::new(""));
@@ -172,7 +174,8 @@ fn material_library_error(path: &Path, e: tobj::LoadError) -> String {
 
 /// Refuses a face index that tobj 4 would overflow on when it scales it to an
 /// array offset (a relative index before the first element, or one beyond
-/// 2⁴⁰), naming the line; tobj reports the other bad indices itself.
+/// 2⁴⁰), naming the line; tobj reports the other bad indices itself. Normals
+/// that are not directions are refused too ([`check_normal`]).
 fn check_face_indices(path: &Path) -> Result<(), String> {
     let Ok(bytes) = std::fs::read(path) else {
         return Ok(()); // tobj reports it
@@ -184,7 +187,11 @@ fn check_face_indices(path: &Path) -> Result<(), String> {
         match words.next() {
             Some("v") => counts[0] += 1,
             Some("vt") => counts[1] += 1,
-            Some("vn") => counts[2] += 1,
+            Some("vn") => {
+                counts[2] += 1;
+                check_normal(words, counts[2])
+                    .map_err(|why| format!("{}: line {}: {why}", path.display(), number + 1))?;
+            }
             Some("f") => {
                 for (kind, index) in words.flat_map(|w| w.split('/').enumerate()) {
                     let (Ok(index), Some(&count)) = (index.parse::<i64>(), counts.get(kind)) else {
@@ -205,10 +212,29 @@ fn check_face_indices(path: &Path) -> Result<(), String> {
     Ok(())
 }
 
+/// A `vn` line's three numbers must make a direction: finite and not all zero
+/// (a NaN normal would shade its triangles NaN, silently dropped).
+fn check_normal<'a>(words: impl Iterator<Item = &'a str>, index: i64) -> Result<(), String> {
+    let values: Vec<f32> = words.take(3).filter_map(|w| w.parse().ok()).collect();
+    match values[..] {
+        [x, y, z] if [x, y, z].iter().all(|v| v.is_finite()) && (x, y, z) != (0.0, 0.0, 0.0) => {
+            Ok(())
+        }
+        [_, _, _] => Err(format!(
+            "normal {index} is {values:?}; expected three finite numbers, not all 0"
+        )),
+        _ => Ok(()), // tobj reports a short line
+    }
+}
+
 /// Refuses a colour line (`Ka`, `Kd`, `Ks`, `Ke`) with fewer than three values
 /// in the material library at `library`, naming the file and line: tobj 4
 /// panics on one (it unwraps a three-element conversion).
 fn check_material_library(library: &Path) -> Result<(), String> {
+    if library.exists() {
+        crate::files::check_regular(library, crate::MAX_MESH_BYTES, "an MTL file")
+            .map_err(|e| format!("{}: {e}", library.display()))?;
+    }
     let Ok(bytes) = std::fs::read(library) else {
         return Ok(()); // tobj reports it
     };

@@ -15,9 +15,10 @@ pub const MAX_RESOLUTION: u32 = 16384;
 /// loses all precision (a ULP of 1e12 is 65536) and squares overflow to infinity.
 pub const MAX_MAGNITUDE: f32 = 1e12;
 
-/// Any TOML number (integer or float) as f32; anything else is refused with a
-/// message that says a number was expected.
-struct Number(f32);
+/// Any TOML number (integer or float), as written (f64: a value too large
+/// for f32 is reported as written, not as infinity); anything else is refused
+/// with a message that says a number was expected.
+struct Number(f64);
 
 impl<'de> Deserialize<'de> for Number {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
@@ -28,28 +29,30 @@ impl<'de> Deserialize<'de> for Number {
                 f.write_str("a number")
             }
             fn visit_i64<E: de::Error>(self, v: i64) -> Result<Number, E> {
-                Ok(Number(v as f32))
+                Ok(Number(v as f64))
             }
             fn visit_u64<E: de::Error>(self, v: u64) -> Result<Number, E> {
-                Ok(Number(v as f32))
+                Ok(Number(v as f64))
             }
             fn visit_f64<E: de::Error>(self, v: f64) -> Result<Number, E> {
-                Ok(Number(v as f32))
+                Ok(Number(v))
             }
         }
         d.deserialize_any(V)
     }
 }
 
-fn finite<E: de::Error>(v: f32) -> Result<f32, E> {
+/// A number as written, checked to be finite and of magnitude at most
+/// [`MAX_MAGNITUDE`] before it becomes an f32.
+fn finite<E: de::Error>(v: f64) -> Result<f32, E> {
     if !v.is_finite() {
         Err(E::custom(format!("expected a finite number, got {v}")))
-    } else if v.abs() > MAX_MAGNITUDE {
+    } else if v.abs() > MAX_MAGNITUDE as f64 {
         Err(E::custom(format!(
             "expected a number of magnitude at most {MAX_MAGNITUDE:e}, got {v:e}"
         )))
     } else {
-        Ok(v)
+        Ok(v as f32)
     }
 }
 
@@ -143,6 +146,28 @@ validated!(
     FieldOfView(f32) via number, |v| v > 0.0 && v < 180.0, "a field of view in degrees strictly between 0 and 180"
 );
 
+/// Exactly `N` values: a TOML array of another length is refused (serde's
+/// own arrays read the first `N` and ignore the rest).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Exactly<T, const N: usize>(pub [T; N]);
+
+impl<T, const N: usize> std::ops::Deref for Exactly<T, N> {
+    type Target = [T; N];
+    fn deref(&self) -> &[T; N] {
+        &self.0
+    }
+}
+
+impl<'de, T: Deserialize<'de>, const N: usize> Deserialize<'de> for Exactly<T, N> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let items = Vec::<T>::deserialize(d)?;
+        let count = items.len();
+        <[T; N]>::try_from(items)
+            .map(Exactly)
+            .map_err(|_| de::Error::custom(format!("expected {N} values, got {count}")))
+    }
+}
+
 /// A count of at least 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Count(pub u32);
@@ -164,7 +189,13 @@ pub struct Resolution(pub UVec2);
 
 impl<'de> Deserialize<'de> for Resolution {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let [w, h] = <[u32; 2]>::deserialize(d)?;
+        let sides = Vec::<u32>::deserialize(d)?;
+        let [w, h] = sides[..] else {
+            return Err(de::Error::custom(format!(
+                "expected a resolution [width, height], two whole numbers, got {} numbers",
+                sides.len()
+            )));
+        };
         parse_resolution_parts(w, h)
             .map(Resolution)
             .map_err(de::Error::custom)
@@ -296,13 +327,13 @@ impl<'de> Deserialize<'de> for Scale3 {
                 f.write_str("a scale: a number or [sx, sy, sz]")
             }
             fn visit_i64<E: de::Error>(self, v: i64) -> Result<Vec3, E> {
-                Ok(Vec3::splat(finite(v as f32)?))
+                Ok(Vec3::splat(finite(v as f64)?))
             }
             fn visit_u64<E: de::Error>(self, v: u64) -> Result<Vec3, E> {
-                Ok(Vec3::splat(finite(v as f32)?))
+                Ok(Vec3::splat(finite(v as f64)?))
             }
             fn visit_f64<E: de::Error>(self, v: f64) -> Result<Vec3, E> {
-                Ok(Vec3::splat(finite(v as f32)?))
+                Ok(Vec3::splat(finite(v)?))
             }
             fn visit_seq<A: de::SeqAccess<'de>>(self, seq: A) -> Result<Vec3, A::Error> {
                 vector(de::value::SeqAccessDeserializer::new(seq))

@@ -31,6 +31,11 @@ pub fn load_image(path: &Path) -> Result<Image, ImageLoadError> {
         path: path.to_path_buf(),
         message,
     };
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+        return Err(fail(
+            "not a regular file (a folder, FIFO or device); an image must be a file".into(),
+        ));
+    }
     let mut reader = image::ImageReader::open(path)
         .map_err(|e| fail(e.to_string()))?
         .with_guessed_format()
@@ -39,8 +44,20 @@ pub fn load_image(path: &Path) -> Result<Image, ImageLoadError> {
     limits.max_image_width = Some(MAX_IMAGE_SIDE);
     limits.max_image_height = Some(MAX_IMAGE_SIDE);
     reader.limits(limits);
-    let (w, h) = reader.into_dimensions().map_err(|e| fail(e.to_string()))?;
+    let header = reader.into_decoder().map_err(|e| fail(e.to_string()))?;
+    let (w, h) = image::ImageDecoder::dimensions(&header);
     check_size(w, h).map_err(fail)?;
+    let file_len = std::fs::metadata(path)
+        .map_err(|e| fail(e.to_string()))?
+        .len();
+    // No codec expands a file more than about 1032 times (deflate): a header
+    // claiming more texels than its file could hold is refused before decoding.
+    let decoded = image::ImageDecoder::total_bytes(&header);
+    if decoded > 2048 * file_len.max(1) {
+        return Err(fail(format!(
+            "the header says {w}x{h} texels ({decoded} bytes decoded), more than a file of {file_len} bytes can hold"
+        )));
+    }
     let decoded = image::ImageReader::open(path)
         .and_then(|r| r.with_guessed_format())
         .map_err(|e| fail(e.to_string()))?

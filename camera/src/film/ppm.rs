@@ -28,6 +28,7 @@ struct Header {
 /// The largest code of the file at `path`, from its header: what an 8-bit
 /// PPM's quantisation step is relative to.
 pub(super) fn maxval(path: &Path) -> Result<u32, String> {
+    super::read::regular_file(path)?;
     let mut head = Vec::with_capacity(HEADER_LIMIT);
     std::fs::File::open(path)
         .map_err(|e| e.to_string())?
@@ -103,6 +104,7 @@ fn skip_space_and_comments(bytes: &[u8], mut pos: usize) -> Option<usize> {
 }
 
 pub(super) fn read_ppm(path: &Path) -> Result<Film, String> {
+    super::read::regular_file(path)?;
     let mut file = std::fs::File::open(path).map_err(|e| e.to_string())?;
     let file_len = file.metadata().map_err(|e| e.to_string())?.len();
     let mut head = Vec::with_capacity(HEADER_LIMIT);

@@ -143,6 +143,28 @@ pub fn srgb_to_linear(encoded: f32) -> f32 {
     }
 }
 
+/// The most an image's pixels may take over its file's size. Deflate (PNG,
+/// OpenEXR's ZIP) expands data at most about 1032 times, and the other
+/// codecs less: a header that claims more pixels than its file could hold is
+/// refused before any pixel memory is taken.
+pub const MAX_EXPANSION: u64 = 2048;
+
+/// Refuses a `width × height` image whose `decoded` bytes are more than
+/// [`MAX_EXPANSION`] times the file's `file_len`.
+pub(super) fn check_expansion(
+    width: u32,
+    height: u32,
+    decoded: u64,
+    file_len: u64,
+) -> Result<(), String> {
+    if decoded > MAX_EXPANSION.saturating_mul(file_len.max(1)) {
+        return Err(format!(
+            "the header says {width}x{height} pixels ({decoded} bytes decoded), more than a file of {file_len} bytes can hold"
+        ));
+    }
+    Ok(())
+}
+
 pub(super) fn check_size(width: u64, height: u64) -> Result<(), String> {
     if width == 0 || height == 0 {
         return Err(format!("the image is {width}x{height}: it has no pixels"));
@@ -157,9 +179,21 @@ pub(super) fn check_size(width: u64, height: u64) -> Result<(), String> {
 }
 
 fn open(path: &Path) -> Result<BufReader<std::fs::File>, String> {
+    regular_file(path)?;
     std::fs::File::open(path)
         .map(BufReader::new)
         .map_err(|e| e.to_string())
+}
+
+/// Refuses what is not a regular file: a FIFO or a device would never end.
+pub(super) fn regular_file(path: &Path) -> Result<(), String> {
+    match std::fs::metadata(path) {
+        Ok(meta) if !meta.is_file() => {
+            Err("not a regular file (a folder, FIFO or device); an image must be a file".into())
+        }
+        Ok(_) => Ok(()),
+        Err(e) => Err(e.to_string()),
+    }
 }
 
 /// PNG, JPEG and OpenEXR through the `image` crate: the header first (size
@@ -174,10 +208,14 @@ pub(super) fn decode(
     path: &Path,
     format: image::ImageFormat,
 ) -> Result<image::DynamicImage, String> {
-    let (w, h) = image::ImageReader::with_format(open(path)?, format)
-        .into_dimensions()
+    use image::ImageDecoder;
+    let header = image::ImageReader::with_format(open(path)?, format)
+        .into_decoder()
         .map_err(|e| e.to_string())?;
+    let (w, h) = header.dimensions();
     check_size(w as u64, h as u64)?;
+    let file_len = std::fs::metadata(path).map_err(|e| e.to_string())?.len();
+    check_expansion(w, h, header.total_bytes(), file_len)?;
     let mut reader = image::ImageReader::with_format(open(path)?, format);
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(MAX_LOAD_SIDE);
@@ -292,6 +330,7 @@ fn parse_pfm_header(bytes: &[u8]) -> Result<PfmHeader, String> {
 }
 
 fn read_pfm(path: &Path) -> Result<Film, String> {
+    regular_file(path)?;
     let mut file = std::fs::File::open(path).map_err(|e| e.to_string())?;
     let file_len = file.metadata().map_err(|e| e.to_string())?.len();
     let mut head = Vec::with_capacity(PFM_HEADER_LIMIT);

@@ -249,6 +249,30 @@ mod tests {
     }
 
     #[test]
+    fn parallel_edges_are_judged_by_their_angle_whatever_their_length() {
+        for scale in [1e-6f32, 1.0, 1e10] {
+            let (e1, e2) = (Vec3::new(scale, 0.0, 0.0), Vec3::new(0.0, 0.0, scale));
+            let p = Parallelogram::new(Vec3::ZERO, e1, e2, false).expect("a square");
+            assert_eq!(p.normal(), -Vec3::Y, "scale {scale}");
+            assert!(
+                (p.area() / (scale * scale) - 1.0).abs() < 1e-6,
+                "scale {scale}"
+            );
+            // Hit from above at its centre, at the right distance.
+            let ray = Ray::new(Vec3::new(0.5 * scale, -2.0 * scale, 0.5 * scale), Vec3::Y);
+            let two = Parallelogram::new(Vec3::ZERO, e1, e2, true).unwrap();
+            let t = two.hit_distance(&ray, f32::INFINITY).expect("hit");
+            assert!(
+                (t / (2.0 * scale) - 1.0).abs() < 1e-5,
+                "scale {scale}: t {t}"
+            );
+            // Edges 1e-7 radians apart are parallel at any scale.
+            let nearly = Vec3::new(scale, scale * 1e-7, 0.0);
+            assert!(Parallelogram::new(Vec3::ZERO, e1, nearly, false).is_none());
+        }
+    }
+
+    #[test]
     fn uv_derivatives_match_finite_differences() {
         // Move along dpdu by a small step in u, re-intersect from the camera, and
         // check the uv advanced by that step.

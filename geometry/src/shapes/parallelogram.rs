@@ -38,14 +38,28 @@ pub struct Parallelogram {
     pub(super) coordinate_scale: Vec2,
 }
 
+/// `|v|` without squaring `v`'s components (which overflow f32 beyond about
+/// 1e19): the vector is scaled by its largest component first.
+fn unsquared_length(v: Vec3) -> f32 {
+    let squared = v.length_squared();
+    if squared.is_finite() {
+        return squared.sqrt(); // as glam's length, bit for bit
+    }
+    let largest = v.abs().max_element();
+    largest * (v / largest).length()
+}
+
 impl Parallelogram {
     /// A parallelogram whose front side is `normalize(edge1 × edge2)`.
-    /// Returns `None` if the edges are parallel or zero (no area).
+    /// Returns `None` if the edges are parallel or zero (no area): the sine of
+    /// the angle between them at most 1e-6, whatever their length (lengths and
+    /// the area are taken without squaring, so that edges of 1e10 neither
+    /// overflow nor read as parallel).
     pub fn new(origin: Vec3, edge1: Vec3, edge2: Vec3, two_sided: bool) -> Option<Self> {
         let n = edge1.cross(edge2);
-        let area2 = n.length_squared();
-        let scale = edge1.length_squared() * edge2.length_squared();
-        if area2.is_nan() || area2 <= 1e-12 * scale || !area2.is_finite() {
+        let area = unsquared_length(n);
+        let sine = area / (unsquared_length(edge1) * unsquared_length(edge2));
+        if !(sine > 1e-6) || !area.is_finite() {
             return None;
         }
         let error = gamma(7) * (origin.abs() + edge1.abs() + edge2.abs());
@@ -53,14 +67,24 @@ impl Parallelogram {
         let pull = Vec2::new(reach / edge1.length(), reach / edge2.length()).min(Vec2::splat(0.5));
         let extent =
             origin.abs().max_element() + edge1.abs().max_element() + edge2.abs().max_element();
-        let coordinate_scale = Vec2::new(edge2.length(), edge1.length()) / area2.sqrt();
+        let coordinate_scale = Vec2::new(unsquared_length(edge2), unsquared_length(edge1)) / area;
+        let area2 = n.length_squared();
+        // Where |n|² does not overflow, the plain formulas (the bits every
+        // render so far was made with); beyond, the same from the unit normal.
+        let (normal, w) = match area2.is_finite() {
+            true => (n.normalize(), n / area2),
+            false => {
+                let normal = (n / n.abs().max_element()).normalize();
+                (normal, normal / area)
+            }
+        };
         Some(Self {
             origin,
             edge1,
             edge2,
-            normal: n.normalize(),
+            normal,
             two_sided,
-            w: n / area2,
+            w,
             error,
             pull,
             extent,
@@ -88,7 +112,7 @@ impl Parallelogram {
         self.normal
     }
     pub fn area(&self) -> f32 {
-        self.edge1.cross(self.edge2).length()
+        unsquared_length(self.edge1.cross(self.edge2))
     }
     pub fn center(&self) -> Vec3 {
         self.origin + 0.5 * (self.edge1 + self.edge2)

@@ -3,40 +3,16 @@
 use crate::GradeError;
 use std::path::Path;
 
-/// Checks that `dir` (given as `flag`) can take files: a folder, or a name
-/// whose parent folder exists, where files can be made (probed with a
-/// temporary file that is removed at once).
+/// Checks that `dir` (given as `flag`) can take files: a folder, or one
+/// that can be made ([`glint_camera::check_output_folder`]).
 pub fn check_dir(dir: &Path, flag: &str) -> Result<(), GradeError> {
-    let input = |m: String| GradeError::Input(format!("{}: {flag}: {m}", dir.display()));
-    if dir.exists() && !dir.is_dir() {
-        return Err(input("not a folder".into()));
-    }
-    let probe_in = if dir.is_dir() {
-        dir.to_owned()
-    } else {
-        let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
-        let parent = parent.unwrap_or(Path::new("."));
-        if !parent.is_dir() {
-            return Err(input(format!(
-                "the folder it would be made in, {}, does not exist",
-                parent.display()
-            )));
-        }
-        parent.to_owned()
-    };
-    tempfile::Builder::new()
-        .prefix(".glint-probe-")
-        .tempfile_in(&probe_in)
-        .map_err(|e| input(format!("cannot write there: {e}")))?;
-    Ok(())
+    glint_camera::check_output_folder(dir)
+        .map_err(|e| GradeError::Input(format!("{}: {flag}: {e}", dir.display())))
 }
 
-/// Makes `dir` if it does not exist yet.
+/// Makes `dir`, and the folders it is in, if they do not exist yet.
 pub fn make_dir(dir: &Path) -> Result<(), GradeError> {
-    if dir.is_dir() {
-        return Ok(());
-    }
-    std::fs::create_dir(dir).map_err(|e| {
+    std::fs::create_dir_all(dir).map_err(|e| {
         GradeError::Internal(format!("{}: cannot make the folder: {e}", dir.display()))
     })
 }

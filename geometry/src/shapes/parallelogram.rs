@@ -59,7 +59,7 @@ impl Parallelogram {
         let n = edge1.cross(edge2);
         let area = unsquared_length(n);
         let sine = area / (unsquared_length(edge1) * unsquared_length(edge2));
-        if !(sine > 1e-6) || !area.is_finite() {
+        if sine.is_nan() || sine <= 1e-6 || !area.is_finite() {
             return None;
         }
         let error = gamma(7) * (origin.abs() + edge1.abs() + edge2.abs());

@@ -112,7 +112,7 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
 /// Prints `text` on stdout; a reader that stops early (`| head`) is not an
 /// error.
 fn print(text: &str) {
-    crate::output::say(&text);
+    crate::output::say(text);
 }
 
 /// `--against`: the student's document at `path` against Glint's; the

@@ -94,7 +94,7 @@ fn check(args: &StageArgs, dir: &Path, cases: u32) -> Result<(), Failure> {
 /// Prints `text` on stdout; a reader that stops early (`| head`) is not an
 /// error.
 fn print(text: &str) {
-    crate::output::say(&text);
+    crate::output::say(text);
 }
 
 fn failure(e: GradeError) -> Failure {

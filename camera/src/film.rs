@@ -8,7 +8,7 @@ mod ppm;
 mod read;
 
 pub use partial::PartialFilm;
-pub use read::{srgb_to_linear, SampleEncoding, MAX_LOAD_SIDE};
+pub use read::{srgb_to_linear, SampleEncoding, MAX_EXPANSION, MAX_LOAD_SIDE};
 
 use glam::{UVec2, Vec3};
 use std::io::{Seek, Write};

@@ -30,6 +30,10 @@
 //!   as stored, NaN and negative values included), refusing sides over
 //!   [`MAX_LOAD_SIDE`]; [`Film::load_with_encoding`] also says how the file
 //!   stored its samples ([`SampleEncoding`]: the quantisation a grader allows for).
+//! - Every image reader refuses what is not a regular file, and a header that
+//!   claims more pixels than [`MAX_EXPANSION`] times its file could hold, before
+//!   taking any pixel memory; [`check_output_file`] and [`check_output_folder`]
+//!   check where a command will write, before it works.
 //! - Errors: [`CameraError`] and [`FilmError`].
 
 mod atomic_file;
@@ -43,7 +47,7 @@ pub use camera::{
 };
 pub use film::{
     linear_to_srgb8, srgb_to_linear, Film, FilmError, ImageFormat, PartialFilm, SampleEncoding,
-    MAX_LOAD_SIDE,
+    MAX_EXPANSION, MAX_LOAD_SIDE,
 };
 pub use output_paths::{check_output_file, check_output_folder, MAX_NAME_BYTES};
 

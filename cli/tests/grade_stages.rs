@@ -345,7 +345,10 @@ fn a_write_folder_that_cannot_be_made_is_refused_before_any_work() {
         &["grade", "--stages", &SET1, "--write", "a-file/folder"],
         dir.path(),
     );
-    assert_input_error(&o, "a-file/folder: --write: cannot be made: a-file is a file");
+    assert_input_error(
+        &o,
+        "a-file/folder: --write: cannot be made: a-file is a file",
+    );
     let o = glint(
         &[
             "grade",

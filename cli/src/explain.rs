@@ -119,7 +119,7 @@ fn print(text: &str) {
 /// report on stdout, exit status 1 where they part.
 fn compare(explanation: &Explanation, path: &Path, args: &ExplainArgs) -> Result<(), Failure> {
     let name = path.display();
-    let text = std::fs::read_to_string(path)
+    let text = glint_scene::read_text(path, glint_scene::MAX_DOCUMENT_BYTES, "a document")
         .map_err(|e| Failure::Input(format!("{name}: cannot read the document: {e}")))?;
     let student = Node::parse(&text).map_err(|e| {
         // serde_json's message ends in " at line L column C": moved to the front.

@@ -145,6 +145,7 @@ pub(crate) fn readable(message: &str) -> String {
         out.push(c);
         i = end + 1;
     }
+    let out = shorten_long_words(&out);
     let length = out.chars().count();
     if length > LINE_LIMIT {
         let kept: String = out.chars().take(LINE_LIMIT).collect();
@@ -153,9 +154,45 @@ pub(crate) fn readable(message: &str) -> String {
     out
 }
 
+/// Each run of more than twice [`ECHO_LIMIT`] characters without a space (a
+/// path, a field path, a value not in quotes) cut to its first 40 and last 20
+/// characters around "…": the start says what it was, the end (a file's name,
+/// its extension, the colon after it) where.
+fn shorten_long_words(text: &str) -> String {
+    let mut out = String::with_capacity(text.len().min(LINE_LIMIT + 80));
+    for (i, word) in text.split(' ').enumerate() {
+        if i > 0 {
+            out.push(' ');
+        }
+        let chars: Vec<char> = word.chars().collect();
+        if chars.len() > 2 * ECHO_LIMIT {
+            out.extend(&chars[..40]);
+            out.push('…');
+            out.extend(&chars[chars.len() - 20..]);
+        } else {
+            out.push_str(word);
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_words_keep_their_start_and_end() {
+        let path = format!("/tmp/{}.png:", "a".repeat(100_000));
+        let line = readable(&format!("{path} cannot read the image: File name too long"));
+        assert_eq!(
+            line,
+            format!(
+                "/tmp/{}…{}.png: cannot read the image: File name too long",
+                "a".repeat(35),
+                "a".repeat(15)
+            )
+        );
+    }
 
     #[test]
     fn echoed_values_and_lines_are_cut_to_a_readable_length() {

@@ -13,6 +13,10 @@ pub const MAX_SCENE_BYTES: u64 = 1 << 20;
 /// The largest OBJ or MTL file read, in bytes (about 10 million triangles).
 pub const MAX_MESH_BYTES: u64 = 1 << 30;
 
+/// The largest other text document a command reads, in bytes: a class's
+/// manifest, a student's answers or explained pixel, a course index.
+pub const MAX_DOCUMENT_BYTES: u64 = 16 << 20;
+
 /// Checks that `path` is a regular file of at most `limit` bytes (`what` names
 /// it in the message: "the scene file").
 pub fn check_regular(path: &Path, limit: u64, what: &str) -> Result<(), String> {
@@ -45,6 +49,17 @@ pub fn utf8(bytes: &[u8]) -> Result<&str, (usize, usize, String)> {
             format!("the byte 0x{byte:02x} is not UTF-8 text"),
         )
     })
+}
+
+/// The text of the regular file `path` of at most `limit` bytes (`what`
+/// names it in messages: "a manifest"), UTF-8, or why not, in one line.
+pub fn read_text(path: &Path, limit: u64, what: &str) -> Result<String, String> {
+    check_regular(path, limit, what)?;
+    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
+    match utf8(&bytes) {
+        Ok(_) => Ok(String::from_utf8(bytes).expect("checked")),
+        Err((line, column, message)) => Err(format!("line {line}, column {column}: {message}")),
+    }
 }
 
 #[cfg(test)]

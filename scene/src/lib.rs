@@ -30,7 +30,7 @@ mod values;
 
 pub use build::{LoadTimings, SceneDescription};
 pub use error::SceneError;
-pub use files::{MAX_MESH_BYTES, MAX_SCENE_BYTES};
+pub use files::{read_text, MAX_DOCUMENT_BYTES, MAX_MESH_BYTES, MAX_SCENE_BYTES};
 pub use values::{parse_resolution_parts, MAX_RESOLUTION};
 
 use std::path::Path;

@@ -43,13 +43,30 @@ pub fn stderr(o: &Output) -> String {
 /// Bad input: exit status 2, one line on stderr, `glint: error: …` containing
 /// `expected`, no panic, nothing on stdout.
 pub fn assert_input_error(o: &Output, expected: &str) {
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(o));
+    if let Some(problem) = input_error_problem(o, expected) {
+        panic!("{problem}");
+    }
+}
+
+/// What makes `o` not the answer to bad input [`assert_input_error`] expects,
+/// if anything.
+pub fn input_error_problem(o: &Output, expected: &str) -> Option<String> {
     let err = stderr(o);
-    assert_eq!(err.lines().count(), 1, "not one line: {err}");
-    assert!(err.starts_with("glint: error: "), "{err}");
-    assert!(err.contains(expected), "expected {expected:?} in {err}");
-    assert!(!err.contains("panicked") && !err.contains("backtrace"));
-    assert!(o.stdout.is_empty(), "stdout: {}", stdout(o));
+    if o.status.code() != Some(2) {
+        Some(format!("status {:?}, not 2: {err}", o.status.code()))
+    } else if err.lines().count() != 1 {
+        Some(format!("not one line: {err}"))
+    } else if !err.starts_with("glint: error: ") {
+        Some(format!("not `glint: error: …`: {err}"))
+    } else if !err.contains(expected) {
+        Some(format!("expected {expected:?} in {err}"))
+    } else if err.contains("panicked") || err.contains("backtrace") {
+        Some(format!("a panic: {err}"))
+    } else if !o.stdout.is_empty() {
+        Some(format!("stdout: {}", stdout(o)))
+    } else {
+        None
+    }
 }
 
 /// The repository's root.

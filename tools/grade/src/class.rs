@@ -106,10 +106,11 @@ pub fn entries_from_manifest(
     stated: &StatedSettings,
 ) -> Result<Vec<Entry>, GradeError> {
     let input = |message: String| GradeError::Input(format!("{}: {message}", path.display()));
-    let text = std::fs::read(path).map_err(|e| input(format!("cannot read the manifest: {e}")))?;
+    let text = glint_scene::read_text(path, glint_scene::MAX_DOCUMENT_BYTES, "a manifest")
+        .map_err(|e| input(format!("cannot read the manifest: {e}")))?;
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
-        .from_reader(text.as_slice());
+        .from_reader(text.as_bytes());
     let header = reader
         .headers()
         .map_err(|e| input(csv_problem(&e)))?

@@ -85,7 +85,7 @@ impl Course {
     /// Reads a course index.
     pub fn load(path: &Path) -> Result<Course, GradeError> {
         let input = |m: String| GradeError::Input(format!("{}: {m}", path.display()));
-        let text = std::fs::read_to_string(path)
+        let text = glint_scene::read_text(path, glint_scene::MAX_DOCUMENT_BYTES, "a course index")
             .map_err(|e| input(format!("cannot read the course index: {e}")))?;
         let file: CourseFile = toml::from_str(&text).map_err(|e| {
             let at = e.span().map_or(String::new(), |s| {

@@ -81,9 +81,10 @@ pub fn read(
     layout: &Layout,
     ids: &BTreeSet<String>,
 ) -> Result<Answers, GradeError> {
-    let text = std::fs::read_to_string(file).map_err(|e| {
-        GradeError::Input(format!("{}: cannot read the answers: {e}", file.display()))
-    })?;
+    let text = glint_scene::read_text(file, glint_scene::MAX_DOCUMENT_BYTES, "an answer file")
+        .map_err(|e| {
+            GradeError::Input(format!("{}: cannot read the answers: {e}", file.display()))
+        })?;
     let is_json = file.extension().is_some_and(|e| e == "json");
     let rows = match is_json {
         true => read_json(&text, stage, layout, ids),

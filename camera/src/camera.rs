@@ -1,14 +1,7 @@
 //! The pinhole camera of the course report (sections 2.1 and 2.2).
 
 use glam::{UVec2, Vec2, Vec3};
-
-/// The f32 lanes of [`Camera::generate_rays_lanes`]: the type, and so the
-/// number of lanes, of `glint_geometry::lanes::F32Lanes` (the integrator,
-/// which passes one to the other, would not compile otherwise).
-pub type F32Lanes = wide::f32x16;
-
-/// The number of lanes of [`F32Lanes`].
-pub const LANES: usize = 16;
+pub use glint_lanes::{F32Lanes, LANES};
 
 /// A ray leaving the camera: origin at the pinhole, unit-length direction.
 #[derive(Clone, Copy, Debug, PartialEq)]

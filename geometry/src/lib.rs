@@ -58,7 +58,7 @@ mod counters;
 mod differentials;
 pub mod error_bounds;
 mod hit;
-pub mod lanes;
+pub use glint_lanes as lanes;
 mod offset;
 mod prefetch;
 mod ray;

@@ -11,8 +11,6 @@ use glint_lighting::AreaSampling;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-// The camera's ray lanes are the geometry's lanes: one camera ray per lane.
-const _: () = assert!(glint_camera::LANES == LANES);
 use std::time::{Duration, Instant};
 
 /// Height in rows of the tiles (full-width bands) the image is split into for

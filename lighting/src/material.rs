@@ -1,5 +1,5 @@
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes};
+use glint_geometry::lanes::{F32Lanes, Float, Mask, Vec3Lanes, Vector3};
 use glint_texture::{TexCoord, Texture};
 
 /// A per-material change of texture coordinates: `uv' = uv · scale + offset`
@@ -164,43 +164,37 @@ impl PhongMaterial {
     /// `kd · n·l + ks · lobe`, or zero if the light is behind the surface.
     #[inline]
     pub fn reflect(&self, kd: Vec3, ks: Vec3, n: Vec3, l: Vec3, v: Vec3) -> Vec3 {
-        let n_dot_l = n.dot(l);
-        if n_dot_l <= 0.0 {
-            return Vec3::ZERO;
-        }
-        kd * n_dot_l + ks * self.specular_lobe(n, l, v, n_dot_l)
+        let lobe = |n_dot_l| self.specular_lobe(n, l, v, n_dot_l);
+        phong_reflection(&kd.into(), &ks.into(), true, &n.into(), &l.into(), lobe).into()
     }
 
     /// [`Self::reflect`] for `ks = 0`, without the specular lobe: the same value
     /// (`kd · n·l`; the lobe's `0 · lobe` adds nothing).
     #[inline]
     pub fn reflect_diffuse(&self, kd: Vec3, n: Vec3, l: Vec3) -> Vec3 {
-        let n_dot_l = n.dot(l);
-        if n_dot_l <= 0.0 {
-            return Vec3::ZERO;
-        }
-        kd * n_dot_l
+        let (kd, n, l) = (kd.into(), n.into(), l.into());
+        phong_reflection(&kd, &kd, false, &n, &l, |_| 0.0).into()
     }
 
     /// The scalar specular lobe for unit `n`, `l`, `v`.
     #[inline]
     pub fn specular_lobe(&self, n: Vec3, l: Vec3, v: Vec3, n_dot_l: f32) -> f32 {
         let cosine = match self.lobe {
-            SpecularLobe::Phong => (2.0 * n_dot_l * n - l).dot(v),
+            SpecularLobe::Phong => phong_cosine(&n.into(), &l.into(), &v.into(), n_dot_l),
             SpecularLobe::BlinnPhong => match (l + v).try_normalize() {
                 Some(h) => n.dot(h),
                 None => 0.0,
             },
         };
-        if cosine <= 0.0 {
-            0.0
-        } else if self.integral_exponent() {
-            // Integral exponents (the usual case) by repeated squaring: several
-            // times faster than powf, and as accurate to a few ULPs.
-            powi(cosine, self.shininess as i32, 1.0)
-        } else {
-            cosine.powf(self.shininess)
-        }
+        lobe_of_cosine(cosine, |cosine| {
+            if self.integral_exponent() {
+                // Integral exponents (the usual case) by repeated squaring: several
+                // times faster than powf, and as accurate to a few ULPs.
+                powi(cosine, self.shininess as i32, 1.0)
+            } else {
+                cosine.powf(self.shininess)
+            }
+        })
     }
 
     /// Whether the exponent is taken by [`powi`] (integral, up to 1024) rather
@@ -223,16 +217,18 @@ impl PhongMaterial {
         v: Vec3,
         specular: bool,
     ) -> Vec3Lanes {
-        let n_dot_l = l.dot_splat(n);
-        let diffuse = Vec3Lanes::scaled_splat(kd, n_dot_l);
-        let reflected = if specular {
-            diffuse + Vec3Lanes::scaled_splat(ks, self.specular_lobe_lanes(n, l, v, n_dot_l))
+        let specular = if specular {
+            F32Lanes::TRUE
         } else {
-            diffuse
+            F32Lanes::FALSE
         };
-        // `n·l ≤ 0` gives zero (a NaN goes on, as in the scalar test).
-        let behind = lanes::le(n_dot_l, F32Lanes::ZERO);
-        Vec3Lanes::select(behind, &Vec3Lanes::default(), &reflected)
+        let lobe = |n_dot_l| self.specular_lobe_lanes(n, l, v, n_dot_l);
+        let (kd, ks, n) = (
+            Vec3Lanes::splat(kd),
+            Vec3Lanes::splat(ks),
+            Vec3Lanes::splat(n),
+        );
+        phong_reflection(&kd, &ks, specular, &n, l, lobe)
     }
 
     /// [`Self::specular_lobe`] for [`LANES`](glint_geometry::lanes::LANES) directions at once.
@@ -244,12 +240,55 @@ impl PhongMaterial {
                 self.specular_lobe(n, l.lane(k), v, n_dot_l[k])
             }));
         }
-        // (2·(n·l))·n − l, then its dot product with v.
-        let mirror = Vec3Lanes::scaled_splat(n, F32Lanes::splat(2.0) * n_dot_l) - *l;
-        let cosine = mirror.dot_splat(v);
-        let lobe = powi(cosine, self.shininess as i32, F32Lanes::ONE);
-        lanes::le(cosine, F32Lanes::ZERO).select(F32Lanes::ZERO, lobe)
+        let cosine = phong_cosine(&Vec3Lanes::splat(n), l, &Vec3Lanes::splat(v), n_dot_l);
+        lobe_of_cosine(cosine, |c| powi(c, self.shininess as i32, F32Lanes::ONE))
     }
+}
+
+/// Phong's reflection of a unit light from `l`, over any [`Float`]:
+/// `kd·(n·l) + ks·lobe(n·l)` in the lanes of `specular`, `kd·(n·l)` in the
+/// others, and zero where `n·l ≤ 0` (a NaN goes on). Phong, "Illumination for
+/// computer generated pictures", CACM 18(6), 1975; the course report's eq. 3.
+#[inline(always)]
+pub fn phong_reflection<F: Float>(
+    kd: &Vector3<F>,
+    ks: &Vector3<F>,
+    specular: F::Mask,
+    n: &Vector3<F>,
+    l: &Vector3<F>,
+    lobe: impl FnOnce(F) -> F,
+) -> Vector3<F> {
+    let zero = Vector3::splat(Vec3::ZERO);
+    let n_dot_l = n.dot(l);
+    let behind = n_dot_l.le(F::ZERO);
+    if behind.all() {
+        return zero;
+    }
+    let diffuse = kd.scale(n_dot_l);
+    let reflected = if specular.any() {
+        let glossy = diffuse + ks.scale(lobe(n_dot_l));
+        Vector3::select(specular, &glossy, &diffuse)
+    } else {
+        diffuse
+    };
+    Vector3::select(behind, &zero, &reflected)
+}
+
+/// The cosine of Phong's lobe: `r·v` with `r = (2(n·l))n − l`, the mirror
+/// direction of `l` about `n`.
+#[inline(always)]
+pub fn phong_cosine<F: Float>(n: &Vector3<F>, l: &Vector3<F>, v: &Vector3<F>, n_dot_l: F) -> F {
+    (n.scale(F::splat(2.0) * n_dot_l) - *l).dot(v)
+}
+
+/// A lobe's value from its cosine: `power(cosine)`, zero where `cosine ≤ 0`.
+#[inline(always)]
+pub fn lobe_of_cosine<F: Float>(cosine: F, power: impl FnOnce(F) -> F) -> F {
+    let below = cosine.le(F::ZERO);
+    if below.all() {
+        return F::ZERO;
+    }
+    F::select(below, F::ZERO, power(cosine))
 }
 
 /// `base^exponent` by binary exponentiation, inlined: the multiplications of

@@ -10,6 +10,7 @@
 //! [`f32::powi`] with each lane's own exponent; lanes whose lobe is Blinn–Phong
 //! or whose exponent is not an integer are computed one by one.
 
+use crate::material::{lobe_of_cosine, phong_cosine, phong_reflection};
 use crate::{PhongMaterial, SpecularLobe};
 use glam::Vec3;
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
@@ -116,28 +117,16 @@ impl<'a> PhongLanes<'a> {
     /// towards the lane's viewer: `kd · n·l + ks · lobe`, zero where `n·l ≤ 0`.
     #[inline]
     pub fn reflect(&self, l: &Vec3Lanes) -> Vec3Lanes {
-        let n = self.n;
-        let n_dot_l = n.dot(l);
-        let diffuse = self.kd.scale(n_dot_l);
-        let reflected = if self.specular == 0 {
-            diffuse
-        } else {
-            let lobe = self.specular_lobe(&n, l, n_dot_l);
-            let specular = diffuse + self.ks.scale(lobe);
-            Vec3Lanes::select(lanes::from_bits(self.specular), &specular, &diffuse)
-        };
-        // `n·l ≤ 0` gives zero (a NaN goes on, as in the scalar test).
-        let behind = lanes::le(n_dot_l, F32Lanes::ZERO);
-        Vec3Lanes::select(behind, &Vec3Lanes::default(), &reflected)
+        let specular = lanes::from_bits(self.specular);
+        let lobe = |n_dot_l| self.specular_lobe(&self.n, l, n_dot_l);
+        phong_reflection(&self.kd, &self.ks, specular, &self.n, l, lobe)
     }
 
     /// [`PhongMaterial::specular_lobe`] per lane.
     #[inline]
     fn specular_lobe(&self, n: &Vec3Lanes, l: &Vec3Lanes, n_dot_l: F32Lanes) -> F32Lanes {
-        // (2·(n·l))·n − l, then its dot product with v.
-        let mirror = n.scale(F32Lanes::splat(2.0) * n_dot_l) - *l;
-        let cosine = mirror.dot(&self.v);
-        let lobe = lanes::le(cosine, F32Lanes::ZERO).select(F32Lanes::ZERO, self.powers(cosine));
+        let cosine = phong_cosine(n, l, &self.v, n_dot_l);
+        let lobe = lobe_of_cosine(cosine, |cosine| self.powers(cosine));
         let one_by_one = self.specular & !self.lane_lobes;
         if one_by_one == 0 {
             return lobe;

@@ -4,6 +4,7 @@
 use crate::error_bounds::gamma;
 use crate::{Hit, Ray};
 use glam::{Vec2, Vec3};
+use glint_lanes::{Float, Mask, Vector3};
 
 /// The parallelogram `origin + α·edge1 + β·edge2`, `α, β ∈ [0, 1]`.
 ///
@@ -47,6 +48,71 @@ fn unsquared_length(v: Vec3) -> f32 {
     }
     let largest = v.abs().max_element();
     largest * (v / largest).length()
+}
+
+/// What [`Parallelogram::hit_distance`] reads of a parallelogram, over any
+/// [`Float`]: one parallelogram (`f32`), one in every lane, or one per lane.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ParallelogramConstants<F: Float> {
+    pub(crate) origin: Vector3<F>,
+    pub(crate) edge1: Vector3<F>,
+    pub(crate) edge2: Vector3<F>,
+    pub(crate) normal: Vector3<F>,
+    pub(crate) w: Vector3<F>,
+    pub(crate) extent: F,
+    pub(crate) coordinate_scale: [F; 2],
+    /// The lanes seen from their front side only.
+    pub(crate) one_sided: F::Mask,
+}
+
+impl<F: Float> ParallelogramConstants<F> {
+    /// The edge coordinates of the plane's point `p`:
+    /// `α = w·((p − p₀) × e₂)`, `β = w·(e₁ × (p − p₀))`.
+    #[inline(always)]
+    pub(crate) fn coordinates(&self, p: &Vector3<F>) -> (F, F) {
+        let local = *p - self.origin;
+        (
+            self.w.dot(&local.cross(&self.edge2)),
+            self.w.dot(&self.edge1.cross(&local)),
+        )
+    }
+
+    /// [`Parallelogram::hit_distance`] per lane: the mask of the lanes hit, and
+    /// the plane's distance `t = n·(p₀ − o) / n·d`. A point is inside when its
+    /// edge coordinates lie in [0, 1], or within [`Parallelogram::edge_margin`]
+    /// of it (tested only where some lane needs it: inside [0, 1] is inside the
+    /// margin too).
+    #[inline(always)]
+    pub(crate) fn hits(
+        &self,
+        origin: &Vector3<F>,
+        direction: &Vector3<F>,
+        t_max: F,
+    ) -> (F::Mask, F) {
+        let denom = self.normal.dot(direction);
+        let facing_away = denom.eq(F::ZERO) | (self.one_sided & denom.gt(F::ZERO));
+        if facing_away.all() {
+            return (F::Mask::FALSE, F::ZERO);
+        }
+        let t = self.normal.dot(&(self.origin - *origin)) / denom;
+        let candidates = t.in_ray_range(t_max) & !facing_away;
+        if !candidates.any() {
+            return (F::Mask::FALSE, t);
+        }
+        let (alpha, beta) = self.coordinates(&(*origin + direction.scale(t)));
+        let unit = |x: F| x.ge(F::ZERO) & x.le(F::ONE);
+        let mut inside = unit(alpha) & unit(beta);
+        if (candidates & !inside).any() {
+            let length = F::splat(gamma(16)) * (origin.abs().max_element() + self.extent);
+            let within = |x: F, scale: F| {
+                let margin = length * scale;
+                x.ge(-margin) & x.le(F::ONE + margin)
+            };
+            inside =
+                within(alpha, self.coordinate_scale[0]) & within(beta, self.coordinate_scale[1]);
+        }
+        (candidates & inside, t)
+    }
 }
 
 impl Parallelogram {
@@ -133,28 +199,37 @@ impl Parallelogram {
     }
 
     fn coordinates(&self, p: Vec3) -> Vec2 {
-        let local = p - self.origin;
-        Vec2::new(
-            self.w.dot(local.cross(self.edge2)),
-            self.w.dot(self.edge1.cross(local)),
-        )
+        let (alpha, beta) = self.constants::<f32>().coordinates(&p.into());
+        Vec2::new(alpha, beta)
     }
 
     pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
-        let denom = self.normal.dot(ray.direction);
-        if denom == 0.0 || (!self.two_sided && denom > 0.0) {
-            return None;
+        let (hit, t) =
+            self.constants::<f32>()
+                .hits(&ray.origin.into(), &ray.direction.into(), t_max);
+        hit.then_some(t)
+    }
+
+    /// The constants of the ray test, the same in every lane.
+    #[inline(always)]
+    pub(crate) fn constants<F: Float>(&self) -> ParallelogramConstants<F> {
+        ParallelogramConstants {
+            origin: Vector3::splat(self.origin),
+            edge1: Vector3::splat(self.edge1),
+            edge2: Vector3::splat(self.edge2),
+            normal: Vector3::splat(self.normal),
+            w: Vector3::splat(self.w),
+            extent: F::splat(self.extent),
+            coordinate_scale: [
+                F::splat(self.coordinate_scale.x),
+                F::splat(self.coordinate_scale.y),
+            ],
+            one_sided: if self.two_sided {
+                F::Mask::FALSE
+            } else {
+                F::Mask::TRUE
+            },
         }
-        let t = self.normal.dot(self.origin - ray.origin) / denom;
-        if !(t > 0.0 && t < t_max) {
-            return None;
-        }
-        let ab = self.coordinates(ray.at(t));
-        let inside = ab.cmpge(Vec2::ZERO).all() && ab.cmple(Vec2::ONE).all() || {
-            let margin = self.edge_margin(ray.origin);
-            ab.cmpge(-margin).all() && ab.cmple(Vec2::ONE + margin).all()
-        };
-        inside.then_some(t)
     }
 
     /// How far outside [0, 1] the edge coordinates (α, β) of a hit of a ray

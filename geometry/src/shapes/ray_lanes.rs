@@ -9,7 +9,7 @@
 
 use super::{Parallelogram, Sphere};
 use crate::error_bounds::gamma;
-use crate::lanes::{self, F32Lanes, Vec3Lanes, LANES};
+use crate::lanes::{F32Lanes, Mask, Vec3Lanes, LANES};
 use crate::Ray;
 use glam::{Vec2, Vec3};
 
@@ -41,12 +41,6 @@ impl RayLanes {
     }
 }
 
-/// Whether `t` lies in (0, t_max), per lane.
-#[inline(always)]
-fn in_range(t: F32Lanes, t_max: F32Lanes) -> F32Lanes {
-    lanes::gt(t, F32Lanes::ZERO) & lanes::lt(t, t_max)
-}
-
 impl Sphere {
     /// The lanes (bit k for lane k) whose ray [`Self::hit_distance`] finds a hit
     /// in (0, `t_max`): the same verdict, bit for bit, as the scalar test's.
@@ -59,42 +53,18 @@ impl Sphere {
     /// (0, `t_max`), and in those lanes its distance, bit for bit the scalar one.
     #[inline]
     pub fn hit_distance_lanes(&self, rays: &RayLanes, t_max: f32) -> (u32, F32Lanes) {
-        let zero = F32Lanes::ZERO;
-        let d = &rays.direction;
-        let f = rays.origin.sub_splat(self.center);
-        let b = f.dot(d);
-        let r2 = F32Lanes::splat(self.radius * self.radius);
-        let c = f.dot(&f) - r2;
-        let receding = lanes::gt(c, zero) & lanes::gt(b, zero);
-        let a = d.dot(d);
-        let perpendicular = f - d.scale(b / a);
-        let disc = a * (r2 - perpendicular.dot(&perpendicular));
-        let missed = receding | lanes::lt(disc, zero);
-        let q = -(b + b.signum() * disc.sqrt());
-        // q = 0: the roots ±√(−c/a).
-        let h = (-c / a).max(zero).sqrt();
-        let (x, y) = (c / q, q / a);
-        let q_zero = q.simd_eq(zero);
-        let t0 = q_zero.select(-h, x.min(y));
-        let t1 = q_zero.select(h, x.max(y));
-        let t_max = F32Lanes::splat(t_max);
-        let near = in_range(t0, t_max);
-        let hit = (near | in_range(t1, t_max)) & !missed;
-        (lanes::bits(hit), near.select(t0, t1))
+        let (hit, t) = super::sphere::sphere_hits(
+            &Vec3Lanes::splat(self.center),
+            F32Lanes::splat(self.radius * self.radius),
+            &rays.origin,
+            &rays.direction,
+            F32Lanes::splat(t_max),
+        );
+        (hit.bits(), t)
     }
 }
 
 impl Parallelogram {
-    /// The edge coordinates (α, β) of each lane's point `p`, as `coordinates`
-    /// rounds them.
-    #[inline]
-    fn coordinates_lanes(&self, p: &Vec3Lanes) -> (F32Lanes, F32Lanes) {
-        let local = p.sub_splat(self.origin);
-        let alpha = local.cross_splat(self.edge2).dot_splat(self.w);
-        let beta = Vec3Lanes::splat_cross(self.edge1, &local).dot_splat(self.w);
-        (alpha, beta)
-    }
-
     /// The lanes whose ray [`Self::hit_distance`] finds a hit in (0, `t_max`),
     /// as [`Sphere::hits_lanes`] for spheres.
     #[inline]
@@ -106,35 +76,12 @@ impl Parallelogram {
     /// [`Sphere::hit_distance_lanes`] for spheres.
     #[inline]
     pub fn hit_distance_lanes(&self, rays: &RayLanes, t_max: f32) -> (u32, F32Lanes) {
-        let zero = F32Lanes::ZERO;
-        let one = F32Lanes::ONE;
-        let denom = rays.direction.dot_splat(self.normal);
-        let mut facing_away = denom.simd_eq(zero);
-        if !self.two_sided {
-            facing_away |= lanes::gt(denom, zero);
-        }
-        let t = Vec3Lanes::splat_sub(self.origin, &rays.origin).dot_splat(self.normal) / denom;
-        let (alpha, beta) = self.coordinates_lanes(&rays.at(t));
-        let candidates = in_range(t, F32Lanes::splat(t_max)) & !facing_away;
-        let unit = |x: F32Lanes| x.simd_ge(zero) & x.simd_le(one);
-        let inside = unit(alpha) & unit(beta);
-        // Within [0, 1] is within the margin too: the margin, which takes a few
-        // operations per lane, only decides lanes outside [0, 1].
-        let hit = if lanes::bits(candidates & !inside) == 0 {
-            candidates & inside
-        } else {
-            // `edge_margin` of each lane's origin.
-            let o = rays.origin.abs();
-            let length =
-                F32Lanes::splat(gamma(16)) * (o.x.max(o.y.max(o.z)) + F32Lanes::splat(self.extent));
-            let within = |x: F32Lanes, scale: f32| {
-                let margin = length * F32Lanes::splat(scale);
-                x.simd_ge(-margin) & x.simd_le(one + margin)
-            };
-            let (sa, sb) = (self.coordinate_scale.x, self.coordinate_scale.y);
-            candidates & within(alpha, sa) & within(beta, sb)
-        };
-        (lanes::bits(hit), t)
+        let (hit, t) = self.constants::<F32Lanes>().hits(
+            &rays.origin,
+            &rays.direction,
+            F32Lanes::splat(t_max),
+        );
+        (hit.bits(), t)
     }
 }
 
@@ -195,7 +142,7 @@ impl Parallelogram {
     /// derivatives (the edges, the same in every lane).
     #[inline]
     pub fn surface_points_lanes(&self, rays: &RayLanes, t: F32Lanes) -> SurfaceLanes {
-        let (alpha, beta) = self.coordinates_lanes(&rays.at(t));
+        let (alpha, beta) = self.constants::<F32Lanes>().coordinates(&rays.at(t));
         // Vec2::clamp: max with the lower bound, then min with the upper.
         let (zero, one) = (F32Lanes::ZERO, F32Lanes::ONE);
         let (u, v) = (alpha.max(zero).min(one), beta.max(zero).min(one));

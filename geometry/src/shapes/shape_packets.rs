@@ -3,66 +3,39 @@
 //! no BVH) test every shape for every ray, and a packet tests four for about the
 //! price of one.
 //!
-//! As for [`TrianglePacket`](super::TrianglePacket), every lane performs exactly
-//! the IEEE operations of the scalar test ([`Sphere::hit_distance`],
-//! [`Parallelogram::hit_distance`]) in the same order, with products and sums
-//! grouped as glam's `Vec3::dot` and `Vec3::cross` group them. Rust never
-//! contracts `a * b + c` into a fused multiply-add, so each lane's verdict and
-//! distance are bit for bit the scalar test's, and a caller may mix the two.
+//! The tests are the scalar tests' kernels ([`Sphere::hit_distance`],
+//! [`Parallelogram::hit_distance`]) run over four lanes of shapes with the ray
+//! in every lane, so each lane's verdict and distance are bit for bit the
+//! scalar test's, and a caller may mix the two.
 
+use super::parallelogram::ParallelogramConstants;
+use super::sphere::sphere_hits;
 use super::{Parallelogram, Sphere};
 use crate::counters::count;
-use crate::error_bounds::gamma;
 use crate::Ray;
-use glam::{BVec4A, Vec3, Vec4};
+use glam::{Vec3, Vec4};
+use glint_lanes::{Mask, Vector3};
+use wide::f32x4;
 
-/// Lane-wise `a · b` for vectors given as `[x, y, z]` lanes, summed as
-/// `Vec3::dot` sums: `(x·x′ + y·y′) + z·z′`.
-#[inline(always)]
-fn dot(a: [Vec4; 3], b: [Vec4; 3]) -> Vec4 {
-    (a[0] * b[0]) + (a[1] * b[1]) + (a[2] * b[2])
+/// Sets lane `lane` of `lanes` to `v`.
+fn set(lanes: &mut Vector3<f32x4>, lane: usize, v: Vec3) {
+    lanes.x.as_mut_array()[lane] = v.x;
+    lanes.y.as_mut_array()[lane] = v.y;
+    lanes.z.as_mut_array()[lane] = v.z;
 }
 
-/// Lane-wise `a × b`, as `Vec3::cross` computes it.
+/// The ray `ray` in all four lanes.
 #[inline(always)]
-fn cross(a: [Vec4; 3], b: [Vec4; 3]) -> [Vec4; 3] {
-    [
-        a[1] * b[2] - b[1] * a[2],
-        a[2] * b[0] - b[2] * a[0],
-        a[0] * b[1] - b[0] * a[1],
-    ]
-}
-
-/// `v` in every lane, one `Vec4` per axis.
-#[inline(always)]
-fn splat(v: Vec3) -> [Vec4; 3] {
-    [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)]
-}
-
-/// Lane-wise square root (correctly rounded, as `f32::sqrt`; compiles to one `sqrtps`).
-#[inline(always)]
-fn sqrt(v: Vec4) -> Vec4 {
-    Vec4::from_array(v.to_array().map(f32::sqrt))
-}
-
-#[inline(always)]
-fn sub(a: [Vec4; 3], b: [Vec4; 3]) -> [Vec4; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-/// Sets lane `lane` of the per-axis lanes `lanes` to `v`.
-fn set(lanes: &mut [Vec4; 3], lane: usize, v: Vec3) {
-    for (axis, value) in lanes.iter_mut().zip(v.to_array()) {
-        axis[lane] = value;
-    }
+fn splat(ray: &Ray) -> (Vector3<f32x4>, Vector3<f32x4>) {
+    (Vector3::splat(ray.origin), Vector3::splat(ray.direction))
 }
 
 /// Up to four spheres, structure of arrays; unused lanes hold NaN and are never hit.
 #[derive(Clone, Copy, Debug)]
 pub struct SpherePacket {
-    center: [Vec4; 3],
+    center: Vector3<f32x4>,
     /// `radius²`, rounded as the scalar test rounds it.
-    radius2: Vec4,
+    radius2: f32x4,
     /// Lanes in use.
     used: u32,
 }
@@ -70,56 +43,38 @@ pub struct SpherePacket {
 impl SpherePacket {
     /// A packet with every lane unused.
     pub const EMPTY: SpherePacket = SpherePacket {
-        center: [Vec4::NAN; 3],
-        radius2: Vec4::NAN,
+        center: Vector3 {
+            x: f32x4::new([f32::NAN; 4]),
+            y: f32x4::new([f32::NAN; 4]),
+            z: f32x4::new([f32::NAN; 4]),
+        },
+        radius2: f32x4::new([f32::NAN; 4]),
         used: 0,
     };
 
     /// Puts `sphere` in `lane` (0..4).
     pub fn set_lane(&mut self, lane: usize, sphere: &Sphere) {
         set(&mut self.center, lane, sphere.center);
-        self.radius2[lane] = sphere.radius * sphere.radius;
+        self.radius2.as_mut_array()[lane] = sphere.radius * sphere.radius;
         self.used = self.used.max(lane as u32 + 1);
     }
 
     /// The scalar test of each lane: bit k of the mask is set iff
     /// `sphere_k.hit_distance(ray, t_max)` is `Some(t)`, and lane k of the `Vec4` is
-    /// then that `t`, bit for bit. Lanes not hit hold unspecified values.
-    ///
-    /// The math is [`Sphere::hit_distance`]'s (Haines et al. 2019): `f = o − c`,
-    /// `b = f·d`, `c = |f|² − r²`, `disc = a·(r² − |f − (b/a)·d|²)`, the roots `c/q`
-    /// and `q/a` with `q = −(b + sign(b)·√disc)`, the nearer one in (0, t_max) first.
+    /// then that `t`, bit for bit (the same kernel). Lanes not hit hold
+    /// unspecified values.
     #[inline]
     pub fn hit4(&self, ray: &Ray, t_max: f32) -> (u32, Vec4) {
         count(|c| c.sphere_tests += u64::from(self.used));
-        let d = splat(ray.direction);
-        let f = sub(splat(ray.origin), self.center);
-        let b = dot(f, d);
-        let c = dot(f, f) - self.radius2;
-        let zero = Vec4::ZERO;
-        let receding = c.cmpgt(zero) & b.cmpgt(zero);
-        let a = Vec4::splat(ray.direction.length_squared());
-        let along = b / a;
-        let perpendicular = [
-            f[0] - along * d[0],
-            f[1] - along * d[1],
-            f[2] - along * d[2],
-        ];
-        let disc = a * (self.radius2 - dot(perpendicular, perpendicular));
-        let missed = receding | disc.cmplt(zero);
-        let q = -(b + b.signum() * sqrt(disc));
-        // q = 0: the roots ±√(−c/a).
-        let h = sqrt((-c / a).max(zero));
-        let (x, y) = (c / q, q / a);
-        let q_zero = q.cmpeq(zero);
-        let t0 = Vec4::select(q_zero, -h, x.min(y));
-        let t1 = Vec4::select(q_zero, h, x.max(y));
-        let t_max = Vec4::splat(t_max);
-        let in_range = |t: Vec4| t.cmpgt(zero) & t.cmplt(t_max);
-        let near = in_range(t0);
-        let far = in_range(t1) & !near;
-        let hits = (near | far) & !missed;
-        (hits.bitmask(), Vec4::select(near, t0, t1))
+        let (origin, direction) = splat(ray);
+        let (hits, t) = sphere_hits(
+            &self.center,
+            self.radius2,
+            &origin,
+            &direction,
+            f32x4::splat(t_max),
+        );
+        (hits.bits(), Vec4::from_array(t.to_array()))
     }
 }
 
@@ -127,84 +82,61 @@ impl SpherePacket {
 /// never hit.
 #[derive(Clone, Copy, Debug)]
 pub struct ParallelogramPacket {
-    origin: [Vec4; 3],
-    edge1: [Vec4; 3],
-    edge2: [Vec4; 3],
-    normal: [Vec4; 3],
-    w: [Vec4; 3],
-    /// Each lane's `extent` and `coordinate_scale`, for its `edge_margin`.
-    extent: Vec4,
-    coordinate_scale: [Vec4; 2],
-    /// Lanes seen from their front side only.
-    one_sided: BVec4A,
+    shapes: ParallelogramConstants<f32x4>,
     /// Lanes in use.
     used: u32,
 }
 
 impl ParallelogramPacket {
     /// A packet with every lane unused.
-    pub const EMPTY: ParallelogramPacket = ParallelogramPacket {
-        origin: [Vec4::NAN; 3],
-        edge1: [Vec4::NAN; 3],
-        edge2: [Vec4::NAN; 3],
-        normal: [Vec4::NAN; 3],
-        w: [Vec4::NAN; 3],
-        extent: Vec4::NAN,
-        coordinate_scale: [Vec4::NAN; 2],
-        one_sided: BVec4A::FALSE,
-        used: 0,
+    pub const EMPTY: ParallelogramPacket = {
+        let nan = f32x4::new([f32::NAN; 4]);
+        let nan3 = Vector3 {
+            x: nan,
+            y: nan,
+            z: nan,
+        };
+        ParallelogramPacket {
+            shapes: ParallelogramConstants {
+                origin: nan3,
+                edge1: nan3,
+                edge2: nan3,
+                normal: nan3,
+                w: nan3,
+                extent: nan,
+                coordinate_scale: [nan; 2],
+                one_sided: f32x4::ZERO,
+            },
+            used: 0,
+        }
     };
 
     /// Puts `p` in `lane` (0..4).
     pub fn set_lane(&mut self, lane: usize, p: &Parallelogram) {
-        set(&mut self.origin, lane, p.origin);
-        set(&mut self.edge1, lane, p.edge1);
-        set(&mut self.edge2, lane, p.edge2);
-        set(&mut self.normal, lane, p.normal);
-        set(&mut self.w, lane, p.w);
-        self.extent[lane] = p.extent;
-        self.coordinate_scale[0][lane] = p.coordinate_scale.x;
-        self.coordinate_scale[1][lane] = p.coordinate_scale.y;
-        self.one_sided.set(lane, !p.two_sided);
+        let shapes = &mut self.shapes;
+        set(&mut shapes.origin, lane, p.origin);
+        set(&mut shapes.edge1, lane, p.edge1);
+        set(&mut shapes.edge2, lane, p.edge2);
+        set(&mut shapes.normal, lane, p.normal);
+        set(&mut shapes.w, lane, p.w);
+        shapes.extent.as_mut_array()[lane] = p.extent;
+        shapes.coordinate_scale[0].as_mut_array()[lane] = p.coordinate_scale.x;
+        shapes.coordinate_scale[1].as_mut_array()[lane] = p.coordinate_scale.y;
+        shapes.one_sided.as_mut_array()[lane] = if p.two_sided {
+            0.0
+        } else {
+            f32::from_bits(u32::MAX)
+        };
         self.used = self.used.max(lane as u32 + 1);
     }
 
-    /// The scalar test of each lane, as [`SpherePacket::hit4`] for spheres: the
-    /// plane's distance `t = n·(p₀ − o) / n·d`, then the hit point's edge
-    /// coordinates `α = w·((p − p₀) × e₂)`, `β = w·(e₁ × (p − p₀))` in [0, 1].
+    /// The scalar test of each lane, as [`SpherePacket::hit4`] for spheres.
     #[inline]
     pub fn hit4(&self, ray: &Ray, t_max: f32) -> (u32, Vec4) {
         count(|c| c.parallelogram_tests += u64::from(self.used));
-        let zero = Vec4::ZERO;
-        let one = Vec4::ONE;
-        let d = splat(ray.direction);
-        let o = splat(ray.origin);
-        let denom = dot(self.normal, d);
-        let facing_away = denom.cmpeq(zero) | (self.one_sided & denom.cmpgt(zero));
-        let t = dot(self.normal, sub(self.origin, o)) / denom;
-        let in_range = t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
-        // ray.at(t) = o + t·d
-        let point = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
-        let local = sub(point, self.origin);
-        let alpha = dot(self.w, cross(local, self.edge2));
-        let beta = dot(self.w, cross(self.edge1, local));
-        let unit = |x: Vec4| x.cmpge(zero) & x.cmple(one);
-        let mut inside = unit(alpha) & unit(beta);
-        // Within [0, 1] is within the margin too: the margin only decides lanes
-        // outside [0, 1] (as in `Parallelogram::hit_distance_lanes`).
-        if (in_range & !facing_away & !inside).any() {
-            // Each lane's `edge_margin` for this ray.
-            let length = Vec4::splat(gamma(16))
-                * (Vec4::splat(ray.origin.abs().max_element()) + self.extent);
-            let within = |x: Vec4, scale: Vec4| {
-                let margin = length * scale;
-                x.cmpge(-margin) & x.cmple(one + margin)
-            };
-            inside =
-                within(alpha, self.coordinate_scale[0]) & within(beta, self.coordinate_scale[1]);
-        }
-        let hits = in_range & inside & !facing_away;
-        (hits.bitmask(), t)
+        let (origin, direction) = splat(ray);
+        let (hits, t) = self.shapes.hits(&origin, &direction, f32x4::splat(t_max));
+        (hits.bits(), Vec4::from_array(t.to_array()))
     }
 }
 

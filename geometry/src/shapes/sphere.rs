@@ -4,7 +4,56 @@
 use crate::error_bounds::gamma;
 use crate::{Hit, Ray};
 use glam::{Vec2, Vec3};
+use glint_lanes::{Float, Mask, Vector3};
 use std::f32::consts::{PI, TAU};
+
+/// [`Sphere::hit_distance`] over any [`Float`]: for one ray and one sphere
+/// (`f32`), many rays and one sphere, or one ray and many spheres (lanes, the
+/// other operands splat). The mask of the lanes whose ray hits in `(0, t_max)`,
+/// and there the nearer such root.
+///
+/// Haines et al., "Precision Improvements for Ray/Sphere Intersection", Ray
+/// Tracing Gems (2019), ch. 7: `f = o − c`, `b = f·d`, `a = d·d`,
+/// `disc = a·(r² − |f − (b/a)·d|²)`, and the roots `c/q` and `q/a` with
+/// `q = −(b + sign(b)·√disc)` (`±√(−c/a)` where `q = 0`).
+#[inline(always)]
+pub(crate) fn sphere_hits<F: Float>(
+    center: &Vector3<F>,
+    radius2: F,
+    origin: &Vector3<F>,
+    direction: &Vector3<F>,
+    t_max: F,
+) -> (F::Mask, F) {
+    let f = *origin - *center;
+    let d = direction;
+    let b = f.dot(d);
+    let c = f.dot(&f) - radius2;
+    // Outside the sphere (c > 0) and moving away (b > 0): both roots are
+    // negative. Most rays against most spheres end here, before any division.
+    let receding = c.gt(F::ZERO) & b.gt(F::ZERO);
+    if receding.all() {
+        return (F::Mask::FALSE, F::ZERO);
+    }
+    let a = d.dot(d);
+    let perpendicular = f - d.scale(b / a);
+    let disc = a * (radius2 - perpendicular.dot(&perpendicular));
+    let missed = receding | disc.lt(F::ZERO);
+    if missed.all() {
+        return (F::Mask::FALSE, F::ZERO);
+    }
+    let q = -(b + b.signum() * disc.sqrt());
+    let (x, y) = (c / q, q / a);
+    let (mut t0, mut t1) = (x.min(y), x.max(y));
+    let q_zero = q.eq(F::ZERO);
+    if q_zero.any() {
+        let h = (-c / a).max(F::ZERO).sqrt();
+        t0 = F::select(q_zero, -h, t0);
+        t1 = F::select(q_zero, h, t1);
+    }
+    let near = t0.in_ray_range(t_max);
+    let hit = (near | t1.in_ray_range(t_max)) & !missed;
+    (hit, F::select(near, t0, t1))
+}
 
 /// A sphere given by centre and radius.
 ///
@@ -39,31 +88,14 @@ impl Sphere {
     /// is computed directly rather than as a difference of large squares — and the
     /// roots come from the stable pair `q = −(b + sign(b)·√disc)`, `t = c/q`, `t = q/a`.
     pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
-        let f = ray.origin - self.center;
-        let d = ray.direction;
-        let b = f.dot(d);
-        let r2 = self.radius * self.radius;
-        let c = f.length_squared() - r2;
-        // Outside the sphere (c > 0) and moving away (b > 0): both roots are
-        // negative. Most rays against most spheres end here, before any division.
-        if c > 0.0 && b > 0.0 {
-            return None;
-        }
-        let a = d.length_squared();
-        let perpendicular = f - (b / a) * d;
-        let disc = a * (r2 - perpendicular.length_squared());
-        if disc < 0.0 {
-            return None;
-        }
-        let q = -(b + b.signum() * disc.sqrt());
-        let (t0, t1) = if q == 0.0 {
-            let h = (-c / a).max(0.0).sqrt();
-            (-h, h)
-        } else {
-            let (x, y) = (c / q, q / a);
-            (x.min(y), x.max(y))
-        };
-        [t0, t1].into_iter().find(|&t| t > 0.0 && t < t_max)
+        let (hit, t) = sphere_hits(
+            &self.center.into(),
+            self.radius * self.radius,
+            &ray.origin.into(),
+            &ray.direction.into(),
+            t_max,
+        );
+        hit.then_some(t)
     }
 
     /// The surface record at ray parameter `t`, found by [`Self::hit_distance`].

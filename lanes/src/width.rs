@@ -1,50 +1,45 @@
-//! [`LANES`] 3-vectors at once, in structure-of-arrays form ([`Vec3Lanes`]),
-//! for work that repeats the same arithmetic on many rays or samples (a
-//! pixel's camera samples, a shading point's light samples, their shadow rays).
+//! The lane width the renderer's wavefronts use, [`LANES`], its types, and
+//! helpers for masks held as lanes of all-ones or all-zeros bits.
 //!
-//! Each lane performs exactly the IEEE operations of glam's scalar [`Vec3`]
-//! methods, in the same order: `a.dot(b)` is `(a.x·b.x + a.y·b.y) + a.z·b.z`,
-//! `a + s·b` rounds the product then the sum, and nothing is fused into a
-//! multiply-add. So a lane's result is bit for bit the scalar result, whatever
-//! instructions the CPU has and however many lanes there are.
-//!
-//! There are sixteen lanes: one AVX-512 register of f32 (`wide` uses two AVX
-//! halves, or four SSE quarters, where the build lacks it). Sixteen rendered
-//! the course's Cornell box at 64 × 1 samples about 20% faster than eight on
-//! an AVX-512 machine (docs/speed.md). The code depends on the width only
-//! through [`LANES`] and these aliases.
+//! Sixteen lanes by default: one AVX-512 register of f32 (`wide` uses two AVX
+//! halves, or four SSE quarters, where the build lacks it); eight with the
+//! `lanes8` feature. The code depends on the width only through [`LANES`] and
+//! these aliases, and every lane is bit for bit the scalar result, so the
+//! image is the same at either width (docs/speed.md measures which is faster).
 
+use crate::vector::Vector3;
 use glam::Vec3;
 
 /// [`LANES`] f32 lanes.
+#[cfg(not(feature = "lanes8"))]
 pub type F32Lanes = wide::f32x16;
 /// [`LANES`] i32 lanes.
+#[cfg(not(feature = "lanes8"))]
 pub type I32Lanes = wide::i32x16;
 /// [`LANES`] u32 lanes.
+#[cfg(not(feature = "lanes8"))]
 pub type U32Lanes = wide::u32x16;
-
 /// The number of lanes (at most 32: sets of lanes are `u32` bits).
+#[cfg(not(feature = "lanes8"))]
 pub const LANES: usize = 16;
 
+/// [`LANES`] f32 lanes.
+#[cfg(feature = "lanes8")]
+pub type F32Lanes = wide::f32x8;
+/// [`LANES`] i32 lanes.
+#[cfg(feature = "lanes8")]
+pub type I32Lanes = wide::i32x8;
+/// [`LANES`] u32 lanes.
+#[cfg(feature = "lanes8")]
+pub type U32Lanes = wide::u32x8;
+/// The number of lanes (at most 32: sets of lanes are `u32` bits).
+#[cfg(feature = "lanes8")]
+pub const LANES: usize = 8;
+
 /// [`LANES`] 3-vectors, one per lane.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Vec3Lanes {
-    pub x: F32Lanes,
-    pub y: F32Lanes,
-    pub z: F32Lanes,
-}
+pub type Vec3Lanes = Vector3<F32Lanes>;
 
-impl Vec3Lanes {
-    /// `v` in every lane.
-    #[inline]
-    pub fn splat(v: Vec3) -> Self {
-        Self {
-            x: F32Lanes::splat(v.x),
-            y: F32Lanes::splat(v.y),
-            z: F32Lanes::splat(v.z),
-        }
-    }
-
+impl Vector3<F32Lanes> {
     /// The vectors `v`, lane k holding `v[k]`.
     #[inline]
     pub fn from_lanes(v: [Vec3; LANES]) -> Self {
@@ -65,206 +60,12 @@ impl Vec3Lanes {
         )
     }
 
-    /// `self · other`, as [`Vec3::dot`] rounds it.
-    #[inline]
-    pub fn dot(&self, other: &Self) -> F32Lanes {
-        self.x * other.x + self.y * other.y + self.z * other.z
-    }
-
-    /// `self · v` for the same `v` in every lane.
-    #[inline]
-    pub fn dot_splat(&self, v: Vec3) -> F32Lanes {
-        self.x * F32Lanes::splat(v.x)
-            + self.y * F32Lanes::splat(v.y)
-            + self.z * F32Lanes::splat(v.z)
-    }
-
-    /// Each lane times its own scalar, as `Vec3 * f32`.
-    #[inline]
-    pub fn scale(&self, s: F32Lanes) -> Self {
-        Self {
-            x: self.x * s,
-            y: self.y * s,
-            z: self.z * s,
-        }
-    }
-
-    /// `self / s` for the same `s` in every lane, as `Vec3 / f32`.
-    #[inline]
-    pub fn div_splat(&self, s: f32) -> Self {
-        let s = F32Lanes::splat(s);
-        Self {
-            x: self.x / s,
-            y: self.y / s,
-            z: self.z / s,
-        }
-    }
-
-    /// `s · v` per lane, as `f32 * Vec3`.
-    #[inline]
-    pub fn scaled_splat(v: Vec3, s: F32Lanes) -> Self {
-        Self {
-            x: F32Lanes::splat(v.x) * s,
-            y: F32Lanes::splat(v.y) * s,
-            z: F32Lanes::splat(v.z) * s,
-        }
-    }
-
-    /// `v * other` per component for the same `v` in every lane, as `Vec3 * Vec3`.
-    #[inline]
-    pub fn scaled_splat_lanes(v: Vec3, other: &Self) -> Self {
-        Self {
-            x: F32Lanes::splat(v.x) * other.x,
-            y: F32Lanes::splat(v.y) * other.y,
-            z: F32Lanes::splat(v.z) * other.z,
-        }
-    }
-
-    /// `self − v` for the same `v` in every lane.
-    #[inline]
-    pub fn sub_splat(&self, v: Vec3) -> Self {
-        Self {
-            x: self.x - F32Lanes::splat(v.x),
-            y: self.y - F32Lanes::splat(v.y),
-            z: self.z - F32Lanes::splat(v.z),
-        }
-    }
-
-    /// `v − self` for the same `v` in every lane.
-    #[inline]
-    pub fn splat_sub(v: Vec3, other: &Self) -> Self {
-        Self {
-            x: F32Lanes::splat(v.x) - other.x,
-            y: F32Lanes::splat(v.y) - other.y,
-            z: F32Lanes::splat(v.z) - other.z,
-        }
-    }
-
-    /// `self × v` for the same `v` in every lane, as [`Vec3::cross`] rounds it.
-    #[inline]
-    pub fn cross_splat(&self, v: Vec3) -> Self {
-        let (x, y, z) = (
-            F32Lanes::splat(v.x),
-            F32Lanes::splat(v.y),
-            F32Lanes::splat(v.z),
-        );
-        Self {
-            x: self.y * z - y * self.z,
-            y: self.z * x - z * self.x,
-            z: self.x * y - x * self.y,
-        }
-    }
-
-    /// `v × self` for the same `v` in every lane, as [`Vec3::cross`] rounds it.
-    #[inline]
-    pub fn splat_cross(v: Vec3, other: &Self) -> Self {
-        let (x, y, z) = (
-            F32Lanes::splat(v.x),
-            F32Lanes::splat(v.y),
-            F32Lanes::splat(v.z),
-        );
-        Self {
-            x: y * other.z - other.y * z,
-            y: z * other.x - other.z * x,
-            z: x * other.y - other.x * y,
-        }
-    }
-
-    /// Per lane, `if_true` where `mask` is set, else `if_false`.
-    #[inline]
-    pub fn select(mask: F32Lanes, if_true: &Self, if_false: &Self) -> Self {
-        Self {
-            x: mask.select(if_true.x, if_false.x),
-            y: mask.select(if_true.y, if_false.y),
-            z: mask.select(if_true.z, if_false.z),
-        }
-    }
-
-    /// [`Vec3::try_normalize`] per lane: the unit vectors, and the mask of the
-    /// lanes where it succeeds (`1/length` finite and positive).
-    #[inline]
-    pub fn try_normalize(&self) -> (Self, F32Lanes) {
-        let rcp = F32Lanes::ONE / self.dot(self).sqrt();
-        let ok = rcp.is_finite() & rcp.simd_gt(F32Lanes::ZERO);
-        (self.scale(rcp), ok)
-    }
-
-    /// [`Vec3::normalize`] per lane: `self · (1/length)`, rounded as glam rounds it.
-    #[inline]
-    pub fn normalize(&self) -> Self {
-        self.scale(F32Lanes::ONE / self.dot(self).sqrt())
-    }
-
     /// Sets lane `lane` to `v`.
     #[inline]
     pub fn set_lane(&mut self, lane: usize, v: Vec3) {
         self.x.as_mut_array()[lane] = v.x;
         self.y.as_mut_array()[lane] = v.y;
         self.z.as_mut_array()[lane] = v.z;
-    }
-
-    /// `v + self` for the same `v` in every lane.
-    #[inline]
-    pub fn splat_add(v: Vec3, other: &Self) -> Self {
-        Self {
-            x: F32Lanes::splat(v.x) + other.x,
-            y: F32Lanes::splat(v.y) + other.y,
-            z: F32Lanes::splat(v.z) + other.z,
-        }
-    }
-
-    /// Each component's magnitude, as [`Vec3::abs`].
-    #[inline]
-    pub fn abs(&self) -> Self {
-        Self {
-            x: self.x.abs(),
-            y: self.y.abs(),
-            z: self.z.abs(),
-        }
-    }
-
-    /// The lanes equal to zero in every component (as `Vec3 == Vec3::ZERO`).
-    #[inline]
-    pub fn is_zero(&self) -> F32Lanes {
-        self.x.simd_eq(F32Lanes::ZERO)
-            & self.y.simd_eq(F32Lanes::ZERO)
-            & self.z.simd_eq(F32Lanes::ZERO)
-    }
-}
-
-impl std::ops::Sub for Vec3Lanes {
-    type Output = Self;
-    #[inline]
-    fn sub(self, o: Self) -> Self {
-        Self {
-            x: self.x - o.x,
-            y: self.y - o.y,
-            z: self.z - o.z,
-        }
-    }
-}
-
-impl std::ops::Neg for Vec3Lanes {
-    type Output = Self;
-    #[inline]
-    fn neg(self) -> Self {
-        Self {
-            x: -self.x,
-            y: -self.y,
-            z: -self.z,
-        }
-    }
-}
-
-impl std::ops::Add for Vec3Lanes {
-    type Output = Self;
-    #[inline]
-    fn add(self, o: Self) -> Self {
-        Self {
-            x: self.x + o.x,
-            y: self.y + o.y,
-            z: self.z + o.z,
-        }
     }
 }
 

@@ -1,0 +1,234 @@
+//! [`Float`]: the numbers a kernel is written over, one `f32` or lanes of
+//! them, and [`Mask`]: the per-lane truth values its comparisons give.
+//!
+//! A kernel written once over `F: Float` runs for one ray as `F = f32` (its
+//! masks plain `bool`s, its early exits real branches) and for many as
+//! `F = f32x4 | f32x8 | f32x16` (masks of lanes, an exit taken only when it
+//! holds in every lane), as Mitsuba 3 writes its code once over its `Float`.
+//! Each lane performs the IEEE operation the scalar type performs, so a lane's
+//! result is bit for bit the scalar one; `min` and `max` keep each type's own
+//! NaN rule ([`f32::min`] returns the other operand, a SIMD `min` the second),
+//! which matters only where an input is already NaN.
+
+use std::fmt::Debug;
+use std::ops::{Add, BitAnd, BitOr, BitOrAssign, Div, Mul, Neg, Not, Sub};
+
+/// The truth values of one comparison: a `bool`, or one per lane.
+pub trait Mask:
+    Copy + Debug + BitAnd<Output = Self> + BitOr<Output = Self> + BitOrAssign + Not<Output = Self>
+{
+    /// True in every lane.
+    const TRUE: Self;
+    /// False in every lane.
+    const FALSE: Self;
+    /// Whether any lane is true.
+    fn any(self) -> bool;
+    /// Whether every lane is true.
+    fn all(self) -> bool;
+    /// The lanes as bits, lane k as bit k.
+    fn bits(self) -> u32;
+}
+
+/// One `f32`, or lanes of them, with the operations kernels need.
+pub trait Float:
+    Copy
+    + Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    type Mask: Mask;
+    /// Lanes in one value.
+    const WIDTH: usize;
+    const ZERO: Self;
+    const ONE: Self;
+    /// `v` in every lane.
+    fn splat(v: f32) -> Self;
+    fn sqrt(self) -> Self;
+    fn abs(self) -> Self;
+    fn min(self, other: Self) -> Self;
+    fn max(self, other: Self) -> Self;
+    /// `1` for `+0` and positive numbers, `−1` for `−0` and negative ones.
+    fn signum(self) -> Self;
+    fn is_finite(self) -> Self::Mask;
+    fn lt(self, other: Self) -> Self::Mask;
+    fn le(self, other: Self) -> Self::Mask;
+    fn gt(self, other: Self) -> Self::Mask;
+    fn ge(self, other: Self) -> Self::Mask;
+    fn eq(self, other: Self) -> Self::Mask;
+    /// Per lane, `if_true` where `mask` holds, else `if_false`.
+    fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
+    /// `self` in `(0, t_max)`, the open range of a ray's valid distances.
+    #[inline(always)]
+    fn in_ray_range(self, t_max: Self) -> Self::Mask {
+        self.gt(Self::ZERO) & self.lt(t_max)
+    }
+}
+
+impl Mask for bool {
+    const TRUE: Self = true;
+    const FALSE: Self = false;
+    #[inline(always)]
+    fn any(self) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn all(self) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        self as u32
+    }
+}
+
+impl Float for f32 {
+    type Mask = bool;
+    const WIDTH: usize = 1;
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::abs(self)
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        f32::min(self, other)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        f32::max(self, other)
+    }
+    #[inline(always)]
+    fn signum(self) -> Self {
+        f32::signum(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> bool {
+        self < other
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> bool {
+        self <= other
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> bool {
+        self > other
+    }
+    #[inline(always)]
+    fn ge(self, other: Self) -> bool {
+        self >= other
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> bool {
+        self == other
+    }
+    #[inline(always)]
+    fn select(mask: bool, if_true: Self, if_false: Self) -> Self {
+        if mask {
+            if_true
+        } else {
+            if_false
+        }
+    }
+}
+
+/// [`Float`] and [`Mask`] for a `wide` vector of f32: its masks are the same
+/// register type, each lane all ones (true) or all zeros (false).
+macro_rules! lanes_of_f32 {
+    ($t:ty, $width:expr) => {
+        impl Mask for $t {
+            const TRUE: Self = <$t>::new([f32::from_bits(u32::MAX); $width]);
+            const FALSE: Self = <$t>::ZERO;
+            #[inline(always)]
+            fn any(self) -> bool {
+                <$t>::any(self)
+            }
+            #[inline(always)]
+            fn all(self) -> bool {
+                <$t>::all(self)
+            }
+            #[inline(always)]
+            fn bits(self) -> u32 {
+                self.to_bitmask() as u32
+            }
+        }
+
+        impl Float for $t {
+            type Mask = $t;
+            const WIDTH: usize = $width;
+            const ZERO: Self = <$t>::ZERO;
+            const ONE: Self = <$t>::ONE;
+            #[inline(always)]
+            fn splat(v: f32) -> Self {
+                <$t>::splat(v)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                <$t>::sqrt(self)
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                <$t>::abs(self)
+            }
+            #[inline(always)]
+            fn min(self, other: Self) -> Self {
+                <$t>::min(self, other)
+            }
+            #[inline(always)]
+            fn max(self, other: Self) -> Self {
+                <$t>::max(self, other)
+            }
+            #[inline(always)]
+            fn signum(self) -> Self {
+                <$t>::signum(self)
+            }
+            #[inline(always)]
+            fn is_finite(self) -> Self {
+                <$t>::is_finite(self)
+            }
+            #[inline(always)]
+            fn lt(self, other: Self) -> Self {
+                self.simd_lt(other)
+            }
+            #[inline(always)]
+            fn le(self, other: Self) -> Self {
+                self.simd_le(other)
+            }
+            #[inline(always)]
+            fn gt(self, other: Self) -> Self {
+                self.simd_gt(other)
+            }
+            #[inline(always)]
+            fn ge(self, other: Self) -> Self {
+                self.simd_ge(other)
+            }
+            #[inline(always)]
+            fn eq(self, other: Self) -> Self {
+                self.simd_eq(other)
+            }
+            #[inline(always)]
+            fn select(mask: Self, if_true: Self, if_false: Self) -> Self {
+                mask.select(if_true, if_false)
+            }
+        }
+    };
+}
+
+lanes_of_f32!(wide::f32x4, 4);
+lanes_of_f32!(wide::f32x8, 8);
+lanes_of_f32!(wide::f32x16, 16);

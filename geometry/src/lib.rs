@@ -69,15 +69,15 @@ pub use counters::{take_counters, CountingGuard, QueryCounters};
 pub use differentials::{reflect, reflect_differential, RayDifferential, SurfaceDifferentials};
 pub use hit::Hit;
 pub use offset::{offset_ray_origin, offset_ray_origins, spawn_ray, spawn_ray_to, RayTarget};
-pub use ray::Ray;
+pub use ray::{Ray, RayLanes};
 pub use shape_list::{
     BvhRef, BvhVisit, ChildVisit, ClosestExplained, ClosestLanes, LeafPrimitive, ObjectRef,
     ObjectTest, Occluders, PrimitiveHit, ShapeList,
 };
 pub use shapes::{triangle, triangle_packet};
 pub use shapes::{
-    AaBox, MeshError, Parallelogram, ParallelogramPacket, Plane, RayLanes, Shape, Sphere,
-    SpherePacket, SurfaceLanes, TriangleMesh, TrianglePacket,
+    AaBox, MeshError, Parallelogram, ParallelogramPacket, Plane, Shape, Sphere, SpherePacket,
+    SurfaceLanes, TriangleMesh, TrianglePacket,
 };
 
 #[cfg(doctest)]

@@ -1,8 +1,8 @@
 //! Arbitrary output variables: per-pixel buffers other than radiance, for
 //! studying a stage (texture coordinates, MIP level, normals, depth, albedo).
 
-use crate::direct::texture_footprint;
 use crate::report_level::report_level;
+use crate::texture_lookup::texture_footprint;
 use crate::{Scene, SurfaceKind};
 use glam::Vec3;
 use glint_camera::Film;

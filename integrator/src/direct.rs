@@ -1,6 +1,8 @@
 use crate::counters::{ShadingCounters, TextureCounters};
 use crate::sampling::Pcg32;
 use crate::sampling::{DimensionPair, PixelSample, SamplePattern, MAX_JOINT};
+use crate::settings::RenderSettings;
+use crate::texture_lookup::texture_footprint;
 use crate::trace::{Event, Shadow, Skip, Tracer};
 use crate::{Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
@@ -94,7 +96,7 @@ impl<T: Tracer> SampleContext<T> {
 impl DirectIntegrator {
     /// The integrator `settings` describe (their sample counts, patterns and
     /// depth; the rest is the render loop's).
-    pub fn new(settings: &crate::RenderSettings) -> Self {
+    pub fn new(settings: &RenderSettings) -> Self {
         Self {
             light_samples: settings.light_samples,
             light_pattern: settings.light_pattern,
@@ -433,24 +435,6 @@ impl DirectIntegrator {
         }
         ctx.environment_points = samples;
         sum / self.environment_samples as f32
-    }
-}
-
-/// The texture lookup at `hit`: with the pixel's footprint from the ray
-/// differentials if the material filters over one, else just the point.
-pub(crate) fn texture_footprint(
-    material: &PhongMaterial,
-    hit: &Hit,
-    diff: &RayDifferential,
-) -> TexCoord {
-    if !material.uses_footprint() {
-        return TexCoord::point(hit.uv);
-    }
-    let d = hit.differentials(diff);
-    TexCoord {
-        uv: hit.uv,
-        duvdx: d.duvdx,
-        duvdy: d.duvdy,
     }
 }
 

@@ -44,6 +44,8 @@ mod render;
 mod report_level;
 pub mod sampling;
 mod scene;
+mod settings;
+mod texture_lookup;
 pub mod trace;
 
 pub use aov::Aov;
@@ -52,12 +54,12 @@ pub use direct::{DirectIntegrator, SampleContext};
 pub use explain::{explain_pixel, ExplainError, PixelExplanation};
 pub use glint_lighting::{AreaSampling, ShadingModel};
 pub use render::{
-    camera_ray, render, render_with, Crop, RenderControl, RenderOutput, RenderSettings,
-    RenderStats, SampleCount, SettingsError, MAX_SAMPLES, MAX_THREADS, TILE_SIZE,
+    camera_ray, render, render_with, RenderControl, RenderOutput, RenderStats, TILE_SIZE,
 };
 pub use report_level::{pixel_height_on_surface, report_level, uv_unit_length, ReportLevel};
 pub use sampling::SamplePattern;
 pub use scene::{Scene, SceneBuilder, SceneError, Surface, SurfaceKind};
+pub use settings::{Crop, RenderSettings, SampleCount, SettingsError, MAX_SAMPLES, MAX_THREADS};
 
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]

@@ -5,14 +5,13 @@
 //! `sah`), or by object medians where the depth limit or the geometry leaves no
 //! choice.
 
+use super::binary_node::BvhNode;
 use super::bounds::Bounds3;
-use super::sah::{best_binned_split, sweep_split, SWEEP_MAX_PRIMITIVES};
-use super::wide::{WideBvh, LEAF_WIDTH};
+use super::extents::{Aabb, BuildPrimitive, Extents};
+use super::sah::{best_binned_split, sweep_split, MAX_LEAF_PRIMITIVES, SWEEP_MAX_PRIMITIVES};
+use super::wide::WideBvh;
 use super::{index_u32, Bvh};
-use glam::{Vec3, Vec3A};
 
-/// The most primitives a leaf may hold: one four-wide packet.
-pub(super) const MAX_LEAF_PRIMITIVES: usize = LEAF_WIDTH;
 /// The deepest a leaf of the binary tree may sit below the root, in edges; it
 /// bounds the wide tree's depth, and so the traversal stack.
 pub(super) const MAX_DEPTH: usize = 64;
@@ -65,48 +64,6 @@ impl Bvh {
     }
 }
 
-/// One node of the binary tree as the build produces it, 32 bytes. A subtree built
-/// on one thread is an array of these in depth-first order, with links relative to
-/// its start; [`Subtree::flatten_into`] joins the subtrees into one array, which
-/// [`WideBvh::collapse`] turns into the wide tree.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C)]
-pub(super) struct BvhNode {
-    pub(super) min: Vec3,
-    /// Leaf: position of its first primitive in the build's primitive order.
-    /// Interior: index of its second child (the first child is the next node).
-    pub(super) offset: u32,
-    pub(super) max: Vec3,
-    /// Number of primitives of a leaf (≥ 1); 0 marks an interior node.
-    pub(super) count: u32,
-}
-
-const _: () = assert!(std::mem::size_of::<BvhNode>() == 32);
-
-impl BvhNode {
-    pub(super) fn leaf(bounds: &Bounds3, first: usize, count: usize) -> Self {
-        Self {
-            min: bounds.min,
-            offset: index_u32(first),
-            max: bounds.max,
-            count: index_u32(count),
-        }
-    }
-
-    pub(super) fn interior(bounds: &Bounds3, second_child: usize) -> Self {
-        Self {
-            min: bounds.min,
-            offset: index_u32(second_child),
-            max: bounds.max,
-            count: 0,
-        }
-    }
-
-    pub(super) fn is_leaf(&self) -> bool {
-        self.count > 0
-    }
-}
-
 /// Build parameters; tests vary them to reach the depth limit and serial builds.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BuildOptions {
@@ -119,63 +76,6 @@ impl BuildOptions {
         max_depth: MAX_DEPTH,
         parallel_threshold: PARALLEL_THRESHOLD,
     };
-}
-
-/// A box during the build, in glam's SIMD `Vec3A`: a union is two instructions.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Aabb {
-    pub(super) min: Vec3A,
-    pub(super) max: Vec3A,
-}
-
-impl Aabb {
-    pub(super) const EMPTY: Aabb = Aabb {
-        min: Vec3A::INFINITY,
-        max: Vec3A::NEG_INFINITY,
-    };
-
-    pub(super) fn union(self, other: Aabb) -> Aabb {
-        Aabb {
-            min: self.min.min(other.min),
-            max: self.max.max(other.max),
-        }
-    }
-
-    pub(super) fn include(self, p: Vec3A) -> Aabb {
-        Aabb {
-            min: self.min.min(p),
-            max: self.max.max(p),
-        }
-    }
-
-    pub(super) fn bounds3(&self) -> Bounds3 {
-        Bounds3 {
-            min: self.min.into(),
-            max: self.max.into(),
-        }
-    }
-
-    pub(super) fn surface_area(&self) -> f32 {
-        self.bounds3().surface_area()
-    }
-}
-
-/// A primitive during the build: its bounds, its input index, and its centroid's
-/// bins on the three axes in the current node's binning (set by `sah::fill_bins`,
-/// read by the partition that follows; they fit in what would be padding).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct BuildPrimitive {
-    pub(super) bounds: Aabb,
-    pub(super) index: u32,
-    pub(super) bins: [u8; 3],
-}
-
-impl BuildPrimitive {
-    /// `min/2 + max/2`, as [`Bounds3::centroid`].
-    #[inline]
-    pub(super) fn centroid(&self) -> Vec3A {
-        0.5 * self.bounds.min + 0.5 * self.bounds.max
-    }
 }
 
 /// The primitives with finite, non-empty bounds, in input order.
@@ -193,46 +93,6 @@ pub(super) fn buildable_primitives(bounds: &[Bounds3]) -> Vec<BuildPrimitive> {
             bins: [0; 3],
         })
         .collect()
-}
-
-/// A set of primitives as the build sees it: joint bounds, bounds of the
-/// centroids, and count. Nodes and SAH bins both have one.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Extents {
-    pub(super) bounds: Aabb,
-    pub(super) centroids: Aabb,
-    pub(super) count: u32,
-}
-
-impl Extents {
-    pub(super) const EMPTY: Extents = Extents {
-        bounds: Aabb::EMPTY,
-        centroids: Aabb::EMPTY,
-        count: 0,
-    };
-
-    pub(super) fn of(prims: &[BuildPrimitive]) -> Extents {
-        let mut extents = Extents::EMPTY;
-        for prim in prims {
-            extents.add(prim, prim.centroid());
-        }
-        extents
-    }
-
-    #[inline]
-    pub(super) fn add(&mut self, prim: &BuildPrimitive, centroid: Vec3A) {
-        self.bounds = self.bounds.union(prim.bounds);
-        self.centroids = self.centroids.include(centroid);
-        self.count += 1;
-    }
-
-    pub(super) fn merge(self, other: Extents) -> Extents {
-        Extents {
-            bounds: self.bounds.union(other.bounds),
-            centroids: self.centroids.union(other.centroids),
-            count: self.count + other.count,
-        }
-    }
 }
 
 /// A subtree under construction: built sequentially into one node array (child

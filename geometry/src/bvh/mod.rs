@@ -29,21 +29,29 @@
 //!
 //! # Files, one concept each
 //! - `bounds`: [`Bounds3`] and the ray–box slab test.
+//! - `binary_node`: the binary tree's 32-byte node, which the build produces and
+//!   the collapse reads.
+//! - `extents`: the boxes, primitives and sets of primitives the build and the
+//!   SAH work on.
 //! - `build`: the binary tree, built in parallel, flattened, then collapsed.
-//! - `sah`: where a node is split (binned SAH, and an exact sweep for small nodes).
+//! - `sah`: where a node is split (binned SAH, and an exact sweep for small nodes),
+//!   and how many primitives a leaf may hold.
 //! - `wide`: the 4-wide node layout (two cache lines per node) and the collapse.
 //! - `prepared_ray`: the ray–node test, four child boxes at once.
 //! - `traversal_stack`: the children still to visit, front to back.
 //! - `traversal`: the single-ray queries.
+//! - `traversal_lanes`: one any-hit query for several rays at once, one ray per
+//!   SIMD lane ([`Bvh::any_hit_lanes`]).
 //! - `stream`: traversal of a batch of rays, interleaved.
 //! - `trail`: the steps of one query, recorded for `glint explain`.
 //! - `stats`: [`BvhStats`].
 //! - `tests` and `test_support`: tests of the tree as built (the queries' tests
-//!   sit beside them, in `traversal` and `stream`).
+//!   sit beside them, in `traversal`, `traversal_lanes` and `stream`).
 
+mod binary_node;
 mod bounds;
 mod build;
-mod packet;
+mod extents;
 mod prepared_ray;
 mod sah;
 mod stats;
@@ -54,6 +62,7 @@ pub(crate) mod test_support;
 mod tests;
 mod trail;
 mod traversal;
+mod traversal_lanes;
 mod traversal_stack;
 mod wide;
 

@@ -6,8 +6,12 @@
 //! per four primitives. Large nodes bin their centroids and score the planes
 //! between bins (Wald 2007); small ones sweep every split between neighbours.
 
-use super::build::{Aabb, BuildPrimitive, Extents, MAX_LEAF_PRIMITIVES};
+use super::extents::{Aabb, BuildPrimitive, Extents};
+use super::wide::LEAF_WIDTH;
 use glam::Vec3A;
+
+/// The most primitives a leaf may hold: one four-wide packet.
+pub(super) const MAX_LEAF_PRIMITIVES: usize = LEAF_WIDTH;
 
 /// `C_trav`: the SAH cost of visiting an interior node, relative to [`INTERSECTION_COST`].
 pub(super) const TRAVERSAL_COST: f32 = 1.0;

@@ -2,7 +2,7 @@
 //! reference slab test, and a walk that checks a built tree's invariants.
 
 use super::build::MAX_DEPTH;
-use super::build::MAX_LEAF_PRIMITIVES;
+use super::sah::MAX_LEAF_PRIMITIVES;
 use super::wide::{self, Link};
 use super::{Bounds3, Bvh, LEAF_WIDTH};
 use crate::Ray;

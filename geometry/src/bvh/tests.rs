@@ -1,7 +1,8 @@
 //! Tests of the tree as built: its structure and statistics, degenerate inputs,
 //! the depth limit, determinism across thread counts, and build time.
 
-use super::build::{build_binary, buildable_primitives, halvings_to_leaf, BuildOptions, BvhNode};
+use super::binary_node::BvhNode;
+use super::build::{build_binary, buildable_primitives, halvings_to_leaf, BuildOptions};
 use super::test_support::{box_hit, check_invariants, jittered_grid, random_boxes, XorShift};
 use super::*;
 use crate::Ray;

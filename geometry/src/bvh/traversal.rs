@@ -232,7 +232,7 @@ impl Iterator for LeafPrimitives<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::build::MAX_LEAF_PRIMITIVES;
+    use crate::bvh::sah::MAX_LEAF_PRIMITIVES;
     use crate::bvh::test_support::{box_hit, check_invariants, random_boxes, XorShift};
     use crate::bvh::{Bounds3, LEAF_WIDTH};
     use crate::{AaBox, Shape, Sphere};

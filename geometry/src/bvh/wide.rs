@@ -16,8 +16,9 @@
 //! starts at a multiple of [`LEAF_WIDTH`] (the runs are padded), so that a caller
 //! can store a leaf's primitives as one four-lane packet and test them together.
 
-use super::build::BvhNode;
-use super::{index_u32, Bounds3};
+use super::binary_node::BvhNode;
+use super::bounds::Bounds3;
+use super::index_u32;
 use glam::{Vec3, Vec4};
 
 /// Children per node, and the lanes of the box test.

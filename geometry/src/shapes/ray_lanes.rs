@@ -10,36 +10,8 @@
 use super::{Parallelogram, Sphere};
 use crate::error_bounds::gamma;
 use crate::lanes::{F32Lanes, Mask, Vec3Lanes, LANES};
-use crate::Ray;
+use crate::RayLanes;
 use glam::{Vec2, Vec3};
-
-/// [`LANES`] rays, `origin + t·direction` in each lane.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RayLanes {
-    pub origin: Vec3Lanes,
-    pub direction: Vec3Lanes,
-}
-
-impl RayLanes {
-    /// The rays `rays`, lane k holding `rays[k]`.
-    pub fn new(rays: [Ray; LANES]) -> Self {
-        let lanes = |of: fn(&Ray) -> Vec3| Vec3Lanes {
-            x: F32Lanes::new(rays.each_ref().map(|r| of(r).x)),
-            y: F32Lanes::new(rays.each_ref().map(|r| of(r).y)),
-            z: F32Lanes::new(rays.each_ref().map(|r| of(r).z)),
-        };
-        Self {
-            origin: lanes(|r| r.origin),
-            direction: lanes(|r| r.direction),
-        }
-    }
-
-    /// Lane `lane` as a scalar ray.
-    #[inline]
-    pub fn lane(&self, lane: usize) -> Ray {
-        Ray::new(self.origin.lane(lane), self.direction.lane(lane))
-    }
-}
 
 impl Sphere {
     /// The lanes (bit k for lane k) whose ray [`Self::hit_distance`] finds a hit
@@ -97,14 +69,6 @@ pub struct SurfaceLanes {
     pub normal: Vec3Lanes,
     pub u: F32Lanes,
     pub v: F32Lanes,
-}
-
-impl RayLanes {
-    /// Each lane's point at its own parameter `t`, as [`Ray::at`] rounds it.
-    #[inline]
-    pub fn at(&self, t: F32Lanes) -> Vec3Lanes {
-        self.origin + self.direction.scale(t)
-    }
 }
 
 impl Sphere {
@@ -167,7 +131,7 @@ impl Parallelogram {
 mod tests {
     use super::*;
     use crate::bvh::test_support::XorShift;
-    use crate::Hit;
+    use crate::{Hit, Ray};
 
     fn rays_from(origin: Vec3, targets: [Vec3; LANES]) -> RayLanes {
         RayLanes::new(targets.map(|t| Ray::new(origin, t - origin)))

@@ -72,9 +72,11 @@
 //!   ([`Pcg32Lanes`]).
 //! - `streams`: [`pixel_rng`], [`uniform`] and [`PixelSample`], which names a
 //!   camera sample's stream and its Sobol points.
+//! - `mix`: [`mix64`], the hash that `streams`, `pcg` and `sobol` seed with.
 //! - `sobol_tests`: the published points, elementary intervals, convergence and
 //!   correlation of the Sobol sequences.
 
+mod mix;
 mod pattern;
 mod pcg;
 mod sobol;
@@ -82,7 +84,8 @@ mod sobol;
 mod sobol_tests;
 mod streams;
 
+pub use mix::mix64;
 pub use pattern::SamplePattern;
 pub use pcg::{Pcg32, Pcg32Lanes, STREAM};
 pub use sobol::{DimensionPair, SobolPoints, SobolSequence, MAX_JOINT};
-pub use streams::{mix64, pixel_key, pixel_rng, stream_seed, uniform, PixelSample, PIXEL_STREAM};
+pub use streams::{pixel_key, pixel_rng, stream_seed, uniform, PixelSample, PIXEL_STREAM};

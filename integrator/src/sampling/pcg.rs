@@ -11,7 +11,7 @@
 //! Arbitrary Strides", 1994), which is how the lanes take consecutive draws
 //! of one stream.
 
-use super::streams::mix64;
+use super::mix::mix64;
 use glint_geometry::lanes::{F32Lanes, LANES};
 
 /// The LCG's multiplier (Knuth's MMIX constant, PCG's default).
@@ -251,20 +251,6 @@ mod tests {
                 for (k, rng) in scalars.iter_mut().enumerate() {
                     assert_eq!(u.to_array()[k].to_bits(), rng.uniform().to_bits());
                 }
-            }
-        }
-    }
-
-    #[test]
-    fn lanes_for_streams_are_the_samples_streams() {
-        use crate::sampling::{pixel_key, stream_seed};
-        for (seed, pixel, first) in [(0, 0, 0), (7, 512 * 300 + 11, 24), (u64::MAX, 3, 56)] {
-            let mut lanes = Pcg32Lanes::for_streams(pixel_key(seed, pixel), first);
-            let (x, y) = lanes.uniform2();
-            for k in 0..LANES {
-                let mut rng = Pcg32::new(stream_seed(seed, pixel, first + k as u64));
-                assert_eq!(x.to_array()[k].to_bits(), rng.uniform().to_bits());
-                assert_eq!(y.to_array()[k].to_bits(), rng.uniform().to_bits());
             }
         }
     }

@@ -23,7 +23,7 @@
 //! `sobol_burley::sample(index, 0 or 1, seed)`, which the tests check for every
 //! index of several sequences; a point costs about a quarter of the two calls.
 
-use super::streams::mix64;
+use super::mix::mix64;
 use glam::Vec2;
 use glint_geometry::lanes::U32Lanes;
 use glint_geometry::lanes::{F32Lanes, LANES};

@@ -1,16 +1,9 @@
 //! The per-pixel random streams: every number a pixel uses is a function of
 //! `(seed, pixel index, sample index)`, never of a shared generator.
 
+use super::mix::mix64;
 use super::pcg::Pcg32;
 use super::sobol::{DimensionPair, SobolPoints};
-
-/// SplitMix64's finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix.
-#[inline]
-pub fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
 
 /// The sample index that names a pixel's own stream (its pixel-sample pattern),
 /// distinct from the streams of its individual samples `0..spp`.
@@ -80,6 +73,8 @@ impl PixelSample {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::Pcg32Lanes;
+    use glint_geometry::lanes::LANES;
 
     #[test]
     fn uniform_has_the_right_mean() {
@@ -87,5 +82,18 @@ mod tests {
         let n = 100_000;
         let mean: f64 = (0..n).map(|_| uniform(&mut rng) as f64).sum::<f64>() / n as f64;
         assert!((mean - 0.5).abs() < 0.005, "mean {mean}");
+    }
+
+    #[test]
+    fn lanes_for_streams_are_the_samples_streams() {
+        for (seed, pixel, first) in [(0, 0, 0), (7, 512 * 300 + 11, 24), (u64::MAX, 3, 56)] {
+            let mut lanes = Pcg32Lanes::for_streams(pixel_key(seed, pixel), first);
+            let (x, y) = lanes.uniform2();
+            for k in 0..LANES {
+                let mut rng = Pcg32::new(stream_seed(seed, pixel, first + k as u64));
+                assert_eq!(x.to_array()[k].to_bits(), rng.uniform().to_bits());
+                assert_eq!(y.to_array()[k].to_bits(), rng.uniform().to_bits());
+            }
+        }
     }
 }

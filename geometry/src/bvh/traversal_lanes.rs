@@ -41,7 +41,7 @@ impl Bvh {
         if active == 0 || self.is_empty() {
             return 0;
         }
-        let lanes = PreparedLanes::new(rays, t_max);
+        let lanes = PreparedRayLanes::new(rays, t_max);
         STACK.with(|cell| {
             let mut own = Vec::new();
             let mut borrowed = cell.try_borrow_mut();
@@ -94,7 +94,7 @@ fn nan_lanes(rays: &RayLanes) -> u32 {
 
 /// [`LANES`] rays set up for box tests, as [`PreparedRay`](super::prepared_ray) sets
 /// up one.
-struct PreparedLanes {
+struct PreparedRayLanes {
     origin: [F32Lanes; 3],
     inv_dir: [F32Lanes; 3],
     /// Per axis, the lanes whose `1/d ≥ 0` meet the minimum plane first.
@@ -102,7 +102,7 @@ struct PreparedLanes {
     t_max: F32Lanes,
 }
 
-impl PreparedLanes {
+impl PreparedRayLanes {
     fn new(rays: &RayLanes, t_max: f32) -> Self {
         let (o, d) = (&rays.origin, &rays.direction);
         let inv_dir = [
@@ -163,7 +163,7 @@ mod tests {
             let node = node_of(&boxes);
             let rays: [Ray; LANES] = std::array::from_fn(|_| awkward_ray(&mut rng, &boxes, true));
             let t_max = some_t_max(&mut rng);
-            let lanes = PreparedLanes::new(&RayLanes::new(rays), t_max);
+            let lanes = PreparedRayLanes::new(&RayLanes::new(rays), t_max);
             for child in 0..WIDTH {
                 let in_lanes = lanes.enter_child(&node.planes, child);
                 for (k, ray) in rays.iter().enumerate() {

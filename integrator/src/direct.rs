@@ -141,78 +141,20 @@ impl DirectIntegrator {
             hit: hit.map(Box::new),
         });
         let Some(hit) = hit else {
-            return match &scene.environment {
-                Some(env) => {
-                    ctx.counters.environment_lookups += 1;
-                    // Physical shading reads the map unfiltered: the mean of a
-                    // pixel's samples is then an unbiased estimate of the
-                    // radiance over its footprint, where a map prefiltered over
-                    // each ray's footprint is blurred twice (measured against
-                    // Mitsuba 3: a chrome sphere's rim came out 16% too bright
-                    // under the studio map's small, bright lamps).
-                    let width = match scene.shading {
-                        ShadingModel::Phong => diff.angular_width(ray.direction),
-                        ShadingModel::Physical => 0.0,
-                    };
-                    let radiance = env.radiance(ray.direction.normalize(), width);
-                    ctx.tracer.record(|| Event::Environment {
-                        direction: ray.direction.normalize(),
-                        width,
-                        radiance,
-                    });
-                    radiance
-                }
-                None => Vec3::ZERO,
-            };
+            return self.environment_seen(scene, ray, diff, ctx);
         };
         let material = match scene.surface_of(&hit) {
-            SurfaceKind::Emitter(light) => {
-                let radiance = match light {
-                    Light::Area(area) => area.color,
-                    Light::Sphere(sphere) => sphere.color,
-                    _ => Vec3::ZERO,
-                };
-                ctx.tracer.record(|| Event::Emitter { radiance });
-                return radiance;
-            }
+            SurfaceKind::Emitter(light) => return emitted(light, ctx),
             SurfaceKind::Material(m) => m,
         };
         let r = material.reflectivity;
         let local = if material.has_local_shading() {
-            if material.uses_footprint() {
-                ctx.counters.footprints += 1;
-            }
-            let tc = texture_footprint(material, &hit, diff);
-            if ctx.detailed {
-                ctx.textures.record(material, &tc);
-            }
-            let point = ShadingPoint::new(&hit, material, ray, &tc);
-            ctx.tracer.record(|| Event::Surface {
-                tc,
-                kd: point.kd,
-                ks: point.ks,
-                n: point.n,
-                ng: point.ng,
-                v: point.v,
-            });
-            match scene.shading {
-                ShadingModel::Phong => self.shade(scene, &point, depth, ctx),
-                ShadingModel::Physical => self.shade_physical(scene, &point, depth, ctx),
-            }
+            self.local_shading(scene, &hit, material, ray, diff, depth, ctx)
         } else {
             Vec3::ZERO
         };
         let mirror = if r > 0.0 && depth < self.max_depth {
-            let surface = hit.differentials(diff);
-            let (wi, reflected_diff) = reflect_differential(&hit, ray.direction, diff, &surface);
-            let reflected = spawn_ray(&hit, wi);
-            ctx.counters.reflection_rays += 1;
-            ctx.tracer.record(|| Event::Mirror {
-                reflectivity: r,
-                tint: material.mirror_tint,
-                direction: wi,
-            });
-            material.mirror_tint * self.li(scene, &reflected, &reflected_diff, depth + 1, ctx)
+            self.mirror_reflection(scene, &hit, material, ray, diff, depth, ctx)
         } else {
             Vec3::ZERO
         };
@@ -224,6 +166,97 @@ impl DirectIntegrator {
             value,
         });
         value
+    }
+
+    /// The environment's radiance along a ray that hits nothing (black without one).
+    fn environment_seen<T: Tracer>(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        diff: &RayDifferential,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
+        let Some(env) = &scene.environment else {
+            return Vec3::ZERO;
+        };
+        ctx.counters.environment_lookups += 1;
+        // Physical shading reads the map unfiltered: the mean of a
+        // pixel's samples is then an unbiased estimate of the
+        // radiance over its footprint, where a map prefiltered over
+        // each ray's footprint is blurred twice (measured against
+        // Mitsuba 3: a chrome sphere's rim came out 16% too bright
+        // under the studio map's small, bright lamps).
+        let width = match scene.shading {
+            ShadingModel::Phong => diff.angular_width(ray.direction),
+            ShadingModel::Physical => 0.0,
+        };
+        let radiance = env.radiance(ray.direction.normalize(), width);
+        ctx.tracer.record(|| Event::Environment {
+            direction: ray.direction.normalize(),
+            width,
+            radiance,
+        });
+        radiance
+    }
+
+    /// The light reflected at `hit` by its material (ambient, lights and
+    /// environment), its textures read over the ray's footprint.
+    #[allow(clippy::too_many_arguments)]
+    fn local_shading<T: Tracer>(
+        &self,
+        scene: &Scene,
+        hit: &Hit,
+        material: &PhongMaterial,
+        ray: &Ray,
+        diff: &RayDifferential,
+        depth: u32,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
+        if material.uses_footprint() {
+            ctx.counters.footprints += 1;
+        }
+        let tc = texture_footprint(material, hit, diff);
+        if ctx.detailed {
+            ctx.textures.record(material, &tc);
+        }
+        let point = ShadingPoint::new(hit, material, ray, &tc);
+        ctx.tracer.record(|| Event::Surface {
+            tc,
+            kd: point.kd,
+            ks: point.ks,
+            n: point.n,
+            ng: point.ng,
+            v: point.v,
+        });
+        match scene.shading {
+            ShadingModel::Phong => self.shade(scene, &point, depth, ctx),
+            ShadingModel::Physical => self.shade_physical(scene, &point, depth, ctx),
+        }
+    }
+
+    /// The radiance a mirror at `hit` reflects towards the ray, tinted: the
+    /// reflected ray followed one level deeper, with its differentials.
+    #[allow(clippy::too_many_arguments)]
+    fn mirror_reflection<T: Tracer>(
+        &self,
+        scene: &Scene,
+        hit: &Hit,
+        material: &PhongMaterial,
+        ray: &Ray,
+        diff: &RayDifferential,
+        depth: u32,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
+        let surface = hit.differentials(diff);
+        let (wi, reflected_diff) = reflect_differential(hit, ray.direction, diff, &surface);
+        let reflected = spawn_ray(hit, wi);
+        ctx.counters.reflection_rays += 1;
+        ctx.tracer.record(|| Event::Mirror {
+            reflectivity: material.reflectivity,
+            tint: material.mirror_tint,
+            direction: wi,
+        });
+        material.mirror_tint * self.li(scene, &reflected, &reflected_diff, depth + 1, ctx)
     }
 
     /// The local shading of `point`, `depth` reflections deep: ambient, the
@@ -626,6 +659,17 @@ impl PairAllocation {
             own
         }
     }
+}
+
+/// The radiance of a light's surface seen directly: its color.
+fn emitted<T: Tracer>(light: &Light, ctx: &mut SampleContext<T>) -> Vec3 {
+    let radiance = match light {
+        Light::Area(area) => area.color,
+        Light::Sphere(sphere) => sphere.color,
+        _ => Vec3::ZERO,
+    };
+    ctx.tracer.record(|| Event::Emitter { radiance });
+    radiance
 }
 
 /// The nearest object blocking `shadow` before `t_max`, as a tracer reports

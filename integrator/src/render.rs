@@ -7,7 +7,9 @@ use crate::{DirectIntegrator, Scene};
 use glam::{UVec2, Vec2, Vec3};
 use glint_camera::{Camera, Film, PartialFilm};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
-use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential, RayLanes};
+use glint_geometry::{
+    take_counters, CountingGuard, Hit, QueryCounters, Ray, RayDifferential, RayLanes,
+};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -307,7 +309,7 @@ impl<'a> PixelRenderer<'a> {
         pixel_samples: &mut [Vec2],
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let (scene, settings, integrator) = (self.scene, self.settings, self.integrator);
+        let (scene, settings) = (self.scene, self.settings);
         let width = scene.camera.resolution().x;
         let pixel = y as u64 * width as u64 + x as u64;
         let mut rng = pixel_rng(settings.seed, pixel, PIXEL_STREAM);
@@ -322,83 +324,130 @@ impl<'a> PixelRenderer<'a> {
             u64::MAX
         };
         for (chunk, jitters) in pixel_samples.chunks(LANES).enumerate() {
-            let used = jitters.len();
             let first = PixelSample {
                 seed: settings.seed,
                 pixel,
                 sample: (chunk * LANES) as u64,
             };
-            if all_in_lanes && used > 1 {
-                // Camera rays, closest hits and shading, LANES samples at a time.
-                let jitter = |axis: usize| {
-                    F32Lanes::new(std::array::from_fn(|k| jitters[k.min(used - 1)][axis]))
-                };
-                let c = scene.camera.generate_rays_lanes(
-                    F32Lanes::splat(x as f32) + jitter(0),
-                    F32Lanes::splat(y as f32) + jitter(1),
-                );
-                let [dx, dy, dz] = c.direction;
-                let rays = RayLanes {
-                    origin: Vec3Lanes::splat(c.origin),
-                    direction: Vec3Lanes {
-                        x: dx,
-                        y: dy,
-                        z: dz,
-                    },
-                };
-                let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
-                let closest = closest.expect("has_closest_lanes");
-                let values = integrator.li_first_hits(scene, &rays, &closest, used, first, ctx);
-                accumulate(&mut sum, &values, used, ctx);
-                continue;
-            }
-            let rays: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
-                let raster = Vec2::new(x as f32, y as f32) + jitters[k.min(jitters.len() - 1)];
-                if self.differentials {
-                    camera_ray(&scene.camera, raster, self.footprint_scale)
-                } else {
-                    let c = scene.camera.generate_ray(raster.x, raster.y);
-                    let ray = Ray::new(c.origin, c.direction);
-                    (ray, RayDifferential::none(&ray))
-                }
-            });
-            // Several camera rays at once: their closest hits one shape against
-            // all of them, where the scene's layout allows it (the same hits).
-            let ray_lanes = RayLanes::new(rays.map(|(ray, _)| ray));
-            let closest = (settings.aov.is_none() && used > 1 && !T::ON)
-                .then(|| scene.shapes.closest_lanes(&ray_lanes, used))
-                .flatten();
-            let values = match &closest {
-                // One sample per light: the chunk's samples shaded together.
-                Some(closest) if first_hits_in_lanes => {
-                    integrator.li_first_hits(scene, &ray_lanes, closest, used, first, ctx)
-                }
-                _ => Vec3Lanes::from_lanes(std::array::from_fn(|k| {
-                    let Some((ray, diff)) = rays.get(k).filter(|_| k < used) else {
-                        return Vec3::ZERO;
-                    };
-                    let sample = (chunk * LANES + k) as u64;
-                    ctx.begin_sample(settings.seed, pixel, sample);
-                    ctx.tracer.start_sample(sample);
-                    ctx.tracer
-                        .record(|| self.camera_event(jitters[k], x, y, ray, diff));
-                    let value = match (settings.aov, &closest) {
-                        (None, Some(closest)) => {
-                            let hit = closest
-                                .hit(k)
-                                .and_then(|found| scene.shapes.surface_record(ray, found));
-                            integrator.li_at(scene, ray, diff, hit, 0, ctx)
-                        }
-                        (None, None) => integrator.li(scene, ray, diff, 0, ctx),
-                        (Some(aov), _) => aov.evaluate(scene, ray, diff, settings.max_depth),
-                    };
-                    ctx.tracer.record(|| Event::SampleRadiance { value });
-                    value
-                })),
+            let values = if all_in_lanes && jitters.len() > 1 {
+                self.samples_in_lanes(x, y, jitters, candidates, first, ctx)
+            } else {
+                self.samples_by_rays(x, y, jitters, first_hits_in_lanes, first, ctx)
             };
-            accumulate(&mut sum, &values, used, ctx);
+            accumulate(&mut sum, &values, jitters.len(), ctx);
         }
         sum / settings.spp as f32
+    }
+
+    /// The radiance of up to [`LANES`] camera samples of pixel (x, y), at
+    /// `jitters` in it: camera rays, closest hits among the objects
+    /// `candidates` names, and shading, all in lanes.
+    fn samples_in_lanes<T: Tracer>(
+        &self,
+        x: u32,
+        y: u32,
+        jitters: &[Vec2],
+        candidates: u64,
+        first: PixelSample,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let (scene, used) = (self.scene, jitters.len());
+        let jitter =
+            |axis: usize| F32Lanes::new(std::array::from_fn(|k| jitters[k.min(used - 1)][axis]));
+        let c = scene.camera.generate_rays_lanes(
+            F32Lanes::splat(x as f32) + jitter(0),
+            F32Lanes::splat(y as f32) + jitter(1),
+        );
+        let [dx, dy, dz] = c.direction;
+        let rays = RayLanes {
+            origin: Vec3Lanes::splat(c.origin),
+            direction: Vec3Lanes {
+                x: dx,
+                y: dy,
+                z: dz,
+            },
+        };
+        let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
+        let closest = closest.expect("has_closest_lanes");
+        self.integrator
+            .li_first_hits(scene, &rays, &closest, used, first, ctx)
+    }
+
+    /// The radiance (or AOV) of up to [`LANES`] camera samples of pixel (x, y),
+    /// each camera ray made with its differentials: their closest hits found
+    /// together where the scene's layout allows it (the same hits), then shaded
+    /// together if `first_hits_in_lanes`, else one by one.
+    fn samples_by_rays<T: Tracer>(
+        &self,
+        x: u32,
+        y: u32,
+        jitters: &[Vec2],
+        first_hits_in_lanes: bool,
+        first: PixelSample,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let (scene, settings, used) = (self.scene, self.settings, jitters.len());
+        let rays: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
+            let raster = Vec2::new(x as f32, y as f32) + jitters[k.min(used - 1)];
+            if self.differentials {
+                camera_ray(&scene.camera, raster, self.footprint_scale)
+            } else {
+                let c = scene.camera.generate_ray(raster.x, raster.y);
+                let ray = Ray::new(c.origin, c.direction);
+                (ray, RayDifferential::none(&ray))
+            }
+        });
+        let ray_lanes = RayLanes::new(rays.map(|(ray, _)| ray));
+        let closest = (settings.aov.is_none() && used > 1 && !T::ON)
+            .then(|| scene.shapes.closest_lanes(&ray_lanes, used))
+            .flatten();
+        match &closest {
+            // One sample per light: the chunk's samples shaded together.
+            Some(closest) if first_hits_in_lanes => self
+                .integrator
+                .li_first_hits(scene, &ray_lanes, closest, used, first, ctx),
+            _ => Vec3Lanes::from_lanes(std::array::from_fn(|k| {
+                let Some((ray, diff)) = rays.get(k).filter(|_| k < used) else {
+                    return Vec3::ZERO;
+                };
+                let hit = closest.as_ref().map(|closest| {
+                    closest
+                        .hit(k)
+                        .and_then(|found| scene.shapes.surface_record(ray, found))
+                });
+                let sample = first.sample + k as u64;
+                self.sample(x, y, jitters[k], sample, ray, diff, hit, ctx)
+            })),
+        }
+    }
+
+    /// The radiance (or AOV) of camera sample `sample` of pixel (x, y), at
+    /// `jitter` in it, along `ray`; `hit` is its first hit where already found.
+    #[allow(clippy::too_many_arguments)]
+    fn sample<T: Tracer>(
+        &self,
+        x: u32,
+        y: u32,
+        jitter: Vec2,
+        sample: u64,
+        ray: &Ray,
+        diff: &RayDifferential,
+        hit: Option<Option<Hit>>,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
+        let (scene, settings, integrator) = (self.scene, self.settings, self.integrator);
+        let pixel = y as u64 * scene.camera.resolution().x as u64 + x as u64;
+        ctx.begin_sample(settings.seed, pixel, sample);
+        ctx.tracer.start_sample(sample);
+        ctx.tracer
+            .record(|| self.camera_event(jitter, x, y, ray, diff));
+        let value = match (settings.aov, hit) {
+            (None, Some(hit)) => integrator.li_at(scene, ray, diff, hit, 0, ctx),
+            (None, None) => integrator.li(scene, ray, diff, 0, ctx),
+            (Some(aov), _) => aov.evaluate(scene, ray, diff, settings.max_depth),
+        };
+        ctx.tracer.record(|| Event::SampleRadiance { value });
+        value
     }
 
     /// The camera stage of a sample at `jitter` in pixel `(x, y)`.

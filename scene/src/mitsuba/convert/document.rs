@@ -11,9 +11,11 @@ impl Converter<'_> {
     /// samples for both, except with point lights, which Mitsuba 3's `direct`
     /// counts once per emitter sample without dividing by their number
     /// (mitsuba3 issue #1861): then one emitter sample, which is exact for
-    /// them.
+    /// them. [`Options::bsdf_samples`](super::Options) replaces the BSDF
+    /// samples.
     pub(super) fn integrator_samples(&mut self) -> (u32, u32) {
         let n = self.description.settings.light_samples;
+        let bsdf = self.options.bsdf_samples.unwrap_or(n);
         let points = self
             .scene
             .lights
@@ -24,12 +26,12 @@ impl Converter<'_> {
                 "Mitsuba 3's `direct` integrator counts a point light once per emitter sample \
                  without dividing by their number (mitsuba3 issue #1861; so in 3.9.1), so this \
                  scene with point lights is written with emitter_samples = 1 and bsdf_samples = \
-                 {n}, not {n} and {n}: exact for point lights, noisier for area lights and the \
+                 {bsdf}, not {n} and {bsdf}: exact for point lights, noisier for area lights and the \
                  environment"
             ));
-            (1, n)
+            (1, bsdf)
         } else {
-            (n, n)
+            (n, bsdf)
         }
     }
 
@@ -49,10 +51,22 @@ impl Converter<'_> {
                 "Shading model: the course's Phong model, written as if it were physical (the values differ)."
             }
         });
-        xml.comment(
-            "Glint's light samples per camera sample become emitter and BSDF samples, \
-             which Mitsuba combines by multiple importance sampling.",
-        );
+        xml.comment(match self.options.bsdf_samples {
+            None => {
+                "Glint's light samples per camera sample become emitter and BSDF samples, \
+                 which Mitsuba combines by multiple importance sampling."
+            }
+            Some(0) => {
+                "Glint's light samples per camera sample become emitter samples, and no BSDF \
+                 samples are taken (glint export --bsdf-samples 0): one shadow ray per light \
+                 sample, as in Glint."
+            }
+            Some(_) => {
+                "Glint's light samples per camera sample become emitter samples; the BSDF \
+                 samples are as asked (glint export --bsdf-samples), combined with them by \
+                 multiple importance sampling."
+            }
+        });
         xml.open("integrator", &[("type", "direct")]);
         xml.integer("emitter_samples", emitter_samples as u64);
         xml.integer("bsdf_samples", bsdf_samples as u64);

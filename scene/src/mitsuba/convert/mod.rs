@@ -50,11 +50,26 @@ pub enum SideContents {
     Exr(Film),
 }
 
+/// What the Mitsuba scene may be asked to do otherwise than Glint's scene
+/// says; the default follows the scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    /// The `direct` integrator's `bsdf_samples` instead of Glint's light
+    /// samples. 0 takes emitter samples only, one shadow ray each: the work
+    /// Glint's light sampling does, for comparing speed.
+    pub bsdf_samples: Option<u32>,
+}
+
 /// Converts `description` for Mitsuba 3. Files are referred to as
 /// `ASSETS/NAME`, `assets` being the assets folder's path relative to the XML
 /// file (its name, as [`super::export`] places it beside the XML).
 pub fn convert(description: &SceneDescription, assets: &str) -> Conversion {
-    Converter::new(description, assets).run()
+    convert_with(description, assets, Options::default())
+}
+
+/// [`convert`] with `options`.
+pub fn convert_with(description: &SceneDescription, assets: &str, options: Options) -> Conversion {
+    Converter::new(description, assets, options).run()
 }
 
 /// A BSDF as written once and referred to by id: the material, the map from
@@ -65,6 +80,7 @@ type BsdfKey = (u32, Option<[u32; 6]>, bool);
 struct Converter<'a> {
     scene: &'a Scene,
     description: &'a SceneDescription,
+    options: Options,
     assets: String,
     bsdfs: Xml,
     shapes: Xml,
@@ -90,7 +106,7 @@ struct Converter<'a> {
 }
 
 impl<'a> Converter<'a> {
-    fn new(description: &'a SceneDescription, assets: &str) -> Self {
+    fn new(description: &'a SceneDescription, assets: &str, options: Options) -> Self {
         let scene = &description.scene;
         let extent = scene_points(scene)
             .map(|p| p.distance(scene.camera.position()))
@@ -98,6 +114,7 @@ impl<'a> Converter<'a> {
         Self {
             scene,
             description,
+            options,
             assets: assets.trim_end_matches('/').to_owned(),
             bsdfs: Xml::with_depth(1),
             shapes: Xml::with_depth(1),

@@ -32,6 +32,12 @@ pub(crate) struct ExportArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     light_samples: Option<u32>,
 
+    /// The direct integrator's BSDF samples (default: the light samples). 0
+    /// samples the emitters only, one shadow ray per light sample, the work
+    /// Glint's light sampling does
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(0..=1_048_576))]
+    bsdf_samples: Option<u32>,
+
     /// The sampler's seed (overrides render.seed)
     #[arg(long, value_name = "N")]
     seed: Option<u64>,
@@ -82,7 +88,10 @@ pub(crate) fn export(args: &ExportArgs) -> Result<(), Failure> {
             .with_resolution(resolution)
             .map_err(|e| Failure::Input(format!("--resolution: {e}")))?;
     }
-    let exported = mitsuba::export(&description, &output).map_err(failure)?;
+    let options = mitsuba::Options {
+        bsdf_samples: args.bsdf_samples,
+    };
+    let exported = mitsuba::export_with(&description, &output, options).map_err(failure)?;
     for warning in &exported.warnings {
         crate::output::tell(&format!("glint: warning: {warning}"));
     }

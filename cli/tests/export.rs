@@ -299,6 +299,41 @@ fn a_failed_export_leaves_the_users_files_untouched() {
 }
 
 #[test]
+fn bsdf_samples_replace_the_light_samples_as_the_integrators_bsdf_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let integrator = |name: &str| {
+        let xml = std::fs::read_to_string(dir.path().join(format!("{name}.xml"))).unwrap();
+        let emitter = xml.contains("<integer name=\"emitter_samples\" value=\"4\"/>");
+        let start = xml.find("name=\"bsdf_samples\" value=\"").unwrap() + 27;
+        let bsdf = xml[start..].split('"').next().unwrap().to_owned();
+        (emitter, bsdf)
+    };
+    let o = export(
+        "cornell-set1",
+        dir.path(),
+        &["--light-samples", "4", "--bsdf-samples", "0"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("direct integrator with 4 emitter and 0 BSDF samples"));
+    assert_eq!(integrator("cornell-set1"), (true, "0".to_owned()));
+    let o = export(
+        "cornell-set1",
+        dir.path(),
+        &["--light-samples", "4", "--bsdf-samples", "2"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(integrator("cornell-set1"), (true, "2".to_owned()));
+    // Point lights keep their one emitter sample.
+    let o = export(
+        "point-light",
+        dir.path(),
+        &["--light-samples", "4", "--bsdf-samples", "0"],
+    );
+    assert!(stdout(&o).contains("direct integrator with 1 emitter and 0 BSDF samples"));
+    assert!(stderr(&o).contains("emitter_samples = 1 and bsdf_samples = 0, not 4 and 0"));
+}
+
+#[test]
 fn help_documents_the_subcommand() {
     let o = glint(&["export", "--help"], Path::new("."));
     assert!(o.status.success());

@@ -6,7 +6,8 @@ For each case, Glint (a subprocess, ``target/release/glint render``) and Mitsuba
 of camera and light samples, taking turns, and the script prints a Markdown table
 of pixel samples per second and of the ratio Glint/Mitsuba. With ``--baseline``,
 an earlier Glint build takes turns with them too, and a second table gives the
-speed-up of Glint over it. See tools/mitsuba/README.md.
+speed-up of Glint over it. The Mitsuba scene is the one ``glint export --mitsuba``
+writes, with the case's sample counts. See tools/mitsuba/README.md.
 
 Python 3.11 and the standard library, plus the ``mitsuba`` package (which brings
 ``drjit``; numpy is not needed).
@@ -131,268 +132,97 @@ def read_scene(case: Case) -> SceneInfo:
 
 
 # ----------------------------------------------------------------------------------
-# Small vector helpers (no numpy)
+# The Glint scene as a Mitsuba scene: `glint export --mitsuba`
+
+# The summary line of `glint export` (docs/command-line.md), on stdout:
+# wrote OUT.xml[ and N files in DIR] (Mitsuba 3): WxH, N spp, direct integrator with N emitter and N BSDF samples, ...
+EXPORT_SUMMARY = re.compile(
+    r"\(Mitsuba 3\): (?P<w>\d+)x(?P<h>\d+), (?P<spp>\d+) spp, direct integrator with "
+    r"(?P<emitter>\d+) emitter and (?P<bsdf>\d+) BSDF samples"
+)
+EXPORT_WARNING = "glint: warning: "
 
 
-def add(a, b):
-    return [a[i] + b[i] for i in range(3)]
+@dataclass
+class Exported:
+    xml: Path
+    emitter_samples: int
+    bsdf_samples: int
 
 
-def scale(a, s):
-    return [x * s for x in a]
-
-
-def dot(a, b):
-    return sum(a[i] * b[i] for i in range(3))
-
-
-def cross(a, b):
-    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-
-
-def normalize(a):
-    n = math.sqrt(dot(a, a))
-    return [x / n for x in a]
-
-
-def matmul(a, b):
-    n, m, p = len(a), len(b), len(b[0])
-    return [[sum(a[i][k] * b[k][j] for k in range(m)) for j in range(p)] for i in range(n)]
-
-
-def affine(columns, translation):
-    """The 4x4 matrix with these three columns and this translation."""
-    x, y, z = columns
-    t = translation
-    return [
-        [x[0], y[0], z[0], t[0]],
-        [x[1], y[1], z[1], t[1]],
-        [x[2], y[2], z[2], t[2]],
-        [0.0, 0.0, 0.0, 1.0],
+def export_scene(glint: Path, case: Case, info: SceneInfo, out_dir: Path) -> Exported:
+    """Writes the case's scene as a Mitsuba scene, OUT_DIR/CASE.xml (and its
+    meshes beside it in CASE-assets/), with the case's sample counts and
+    `bsdf_samples = 0`: Glint takes one shadow ray per light sample and no BSDF
+    samples, so Mitsuba's `direct` does the same work. What the export cannot
+    reproduce like for like (its warnings) goes to the notes."""
+    xml = out_dir / f"{case.name}.xml"
+    cmd = [
+        str(glint), "export", "--mitsuba", str(info.path), "-o", str(xml),
+        "--spp", str(info.spp), "--light-samples", str(info.light_samples), "--bsdf-samples", "0",
     ]
-
-
-# ----------------------------------------------------------------------------------
-# The Glint scene as a Mitsuba scene dictionary
-
-
-def rgb(value):
-    return {"type": "rgb", "value": [float(x) for x in value]}
-
-
-def rectangle_to_world(center, edge1, edge2, normal):
-    """A Mitsuba `rectangle` spans [-1, 1]^2 in its local xy plane, facing +z: map it
-    onto center ± edge1/2 ± edge2/2, with +z going to `normal` (the front side).
-
-    Mitsuba's normal is the inverse transpose of the matrix applied to +z, so it is
-    perpendicular to both edges and on `normal`'s side. The rectangle is two
-    triangles whose winding also gives a normal; keeping the matrix's determinant
-    positive (swapping the edges, which spans the same parallelogram) keeps the two
-    normals in agreement."""
-    a, b = scale(edge1, 0.5), scale(edge2, 0.5)
-    n = normalize(normal)
-    if dot(cross(a, b), n) < 0:
-        a, b = b, a
-    return affine((a, b, n), center)
-
-
-def rotation_xyz(degrees):
-    """Glint's mesh `rotate`: about x, then y, then z, i.e. Rz · Ry · Rx."""
-    rx, ry, rz = (math.radians(d) for d in degrees)
-    cx, sx, cy, sy, cz, sz = math.cos(rx), math.sin(rx), math.cos(ry), math.sin(ry), math.cos(rz), math.sin(rz)
-    Rx = [[1, 0, 0], [0, cx, -sx], [0, sx, cx]]
-    Ry = [[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]]
-    Rz = [[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]]
-    return matmul(Rz, matmul(Ry, Rx))
-
-
-class Converter:
-    """Builds the `mi.load_dict` dictionary of a Glint scene: the same geometry, the
-    camera and the area lights, with each material's diffuse colour as a Mitsuba
-    `diffuse` BSDF. Whatever is not converted like-for-like is noted in `notes`."""
-
-    def __init__(self, mi, info: SceneInfo, emitter_samples: int):
-        self.mi = mi
-        self.info = info
-        self.doc = info.toml
-        self.emitter_samples = emitter_samples
-        self.notes = info.notes
-        self._noted: set[str] = set()
-
-    def note(self, text: str):
-        if text not in self._noted:
-            self._noted.add(text)
-            self.notes.append(text)
-
-    def fail(self, text: str):
-        raise Failure(f"{self.info.path.relative_to(REPO)}: cannot convert for Mitsuba: {text}", 2)
-
-    # -- materials -------------------------------------------------------------
-
-    def texture(self, name: str, for_sphere: bool):
-        tex = self.doc.get("textures", {}).get(name)
-        if tex is None:
-            self.fail(f"unknown texture {name!r}")
-        if "checkerboard" not in tex:
-            self.fail(f"texture {name!r}: only procedural checkerboards are converted")
-        c = tex["checkerboard"]
-        n = float(c["checks"])
-        if c.get("filter", "point") != "point":
-            self.note("checkerboards: Glint's `analytic` filter is not reproduced (Mitsuba looks the pattern up at the hit point)")
-        # Mitsuba's checkerboard has 2 x 2 checks over the unit uv square after its
-        # `to_uv` transform, color0 where (frac(u) > 1/2) == (frac(v) > 1/2), which is
-        # Glint's "first colour where the check's indices sum to an even number" once
-        # uv is scaled by N/2. On a sphere Mitsuba's v runs from the top pole down
-        # (Glint's from the bottom up), so v is mirrored too.
-        h = n / 2
-        to_uv = [[h, 0, 0], [0, -h, h], [0, 0, 1]] if for_sphere else [[h, 0, 0], [0, h, 0], [0, 0, 1]]
-        return {
-            "type": "checkerboard",
-            "color0": rgb(c["colors"][0]),
-            "color1": rgb(c["colors"][1]),
-            "to_uv": self.mi.ScalarTransform3f(to_uv),
-        }
-
-    def bsdf(self, name: str, shape_kind: str, two_sided: bool):
-        mat = self.doc.get("materials", {}).get(name)
-        if mat is None:
-            self.fail(f"unknown material {name!r}")
-        if "mirror" in mat or mat.get("reflectivity", 0) > 0:
-            self.fail(f"material {name!r}: mirrors are not converted")
-        if mat.get("uv_scale", [1, 1]) != [1, 1] or mat.get("uv_offset", [0, 0]) != [0, 0]:
-            self.fail(f"material {name!r}: uv_scale/uv_offset are not converted")
-        kd = mat["diffuse"]
-        if isinstance(kd, str):
-            reflectance = self.texture(kd, for_sphere=shape_kind == "sphere")
-        else:
-            reflectance = rgb(kd)
-        self.note(
-            "materials: Glint shades Phong (diffuse + a specular lobe, `specular` defaulting to the "
-            "diffuse colour); Mitsuba gets a Lambertian `diffuse` BSDF with the diffuse colour only"
+    try:
+        r = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO)
+    except OSError as e:
+        raise Failure(f"{case.name}: cannot run glint export ({glint}): {e}")
+    if r.returncode != 0:
+        err = (r.stderr.strip() or r.stdout.strip() or "(no output)").splitlines()
+        raise Failure(
+            f"{case.name}: glint export failed with exit status {r.returncode}: " + " | ".join(err[-5:])
+            + f"\n  command: {' '.join(cmd)}",
+            2 if r.returncode == 2 else 1,
         )
-        bsdf = {"type": "diffuse", "reflectance": reflectance}
-        if two_sided:
-            bsdf = {"type": "twosided", "material": bsdf}
-        return bsdf
-
-    # -- the scene -------------------------------------------------------------
-
-    def scene_dict(self, spp: int):
-        doc = self.doc
-        for key in ("environment", "plane", "box", "point_light"):
-            if key in doc:
-                self.fail(f"`{key}` is not converted")
-        if any(v != 0 for v in doc.get("ambient", [0, 0, 0])):
-            self.note(
-                "ambient: Glint adds `ambient · kd` at every shaded point; Mitsuba has no ambient term "
-                "(a constant environment would add an emitter to sample, so none is added)"
-            )
-        cam = doc["camera"]
-        info = self.info
-        d: dict = {
-            "type": "scene",
-            "integrator": {
-                "type": "direct",
-                "emitter_samples": self.emitter_samples,
-                "bsdf_samples": 0,
-            },
-            "sensor": {
-                "type": "perspective",
-                "fov": float(cam["fov"]),
-                "fov_axis": "y",
-                "to_world": self.mi.ScalarTransform4f().look_at(
-                    origin=[float(x) for x in cam["position"]],
-                    target=[float(x) for x in cam["look_at"]],
-                    up=[float(x) for x in cam.get("up", [0, 1, 0])],
-                ),
-                "film": {
-                    "type": "hdrfilm",
-                    "width": info.width,
-                    "height": info.height,
-                    "pixel_format": "rgb",
-                    "rfilter": {"type": "box"},
-                },
-                "sampler": {"type": "independent", "sample_count": spp},
-            },
-        }
-        for i, p in enumerate(doc.get("parallelogram", [])):
-            e1, e2 = p["edge1"], p["edge2"]
-            n = p.get("normal") or cross(e1, e2)
-            center = add(p["origin"], scale(add(e1, e2), 0.5))
-            two_sided = bool(p.get("two_sided", False))
-            d[f"parallelogram-{i}"] = {
-                "type": "rectangle",
-                "to_world": self.mi.ScalarTransform4f(rectangle_to_world(center, e1, e2, n)),
-                "bsdf": self.bsdf(p["material"], "parallelogram", two_sided),
-            }
-        for i, s in enumerate(doc.get("sphere", [])):
-            # Glint's sphere uv: u = atan2(-z, x)/2π around +y, v from the bottom
-            # pole. Mitsuba's: u = atan2(y, x)/2π around its local +z, v from the top
-            # pole. Local x, y, z -> world x, -z, y makes the u's agree (v is mirrored
-            # in the checkerboard's to_uv); the radius is the matrix's scale.
-            r = float(s["radius"])
-            rot = affine(([r, 0, 0], [0, 0, -r], [0, r, 0]), [float(x) for x in s["center"]])
-            d[f"sphere-{i}"] = {
-                "type": "sphere",
-                "to_world": self.mi.ScalarTransform4f(rot),
-                "bsdf": self.bsdf(s["material"], "sphere", False),
-            }
-        for i, m in enumerate(doc.get("mesh", [])):
-            if "material" not in m:
-                self.fail(f"mesh[{i}]: meshes with MTL materials are not converted")
-            file = (info.path.parent / m["file"]).resolve()
-            if not file.is_file():
-                raise Failure(f"{info.path.relative_to(REPO)}: mesh[{i}]: {file} is missing", 2)
-            sc = m.get("scale", 1)
-            sc = [float(sc)] * 3 if isinstance(sc, (int, float)) else [float(x) for x in sc]
-            if sc[0] * sc[1] * sc[2] < 0:
-                self.fail(f"mesh[{i}]: mirroring scales are not converted")
-            R = rotation_xyz(m.get("rotate", [0, 0, 0]))
-            cols = [[R[r][c] * sc[c] for r in range(3)] for c in range(3)]
-            d[f"mesh-{i}"] = {
-                "type": "obj",
-                "filename": str(file),
-                "to_world": self.mi.ScalarTransform4f(affine(cols, [float(x) for x in m.get("translate", [0, 0, 0])])),
-                # Glint shades a triangle on whichever side the viewer is (an open
-                # mesh shows its inside lit); Mitsuba's BSDFs are one-sided unless
-                # wrapped in `twosided`.
-                "bsdf": self.bsdf(m["material"], "mesh", True),
-            }
-            self.note(
-                "meshes: the OBJ has no normals and both compute angle-weighted vertex normals; Glint "
-                "intersects them with its own BVH, Mitsuba with Embree; both shade either side of a triangle"
-            )
-        lights = doc.get("area_light", [])
-        if not lights:
-            self.fail("no area light")
-        for i, a in enumerate(lights):
-            e1, e2 = a["edge1"], a["edge2"]
-            n = a.get("normal") or cross(e1, e2)
-            d[f"area-light-{i}"] = {
-                "type": "rectangle",
-                "to_world": self.mi.ScalarTransform4f(rectangle_to_world(a["center"], e1, e2, n)),
-                # Glint returns the light's colour when a camera ray hits it, without
-                # shading it; a black diffuse BSDF makes Mitsuba's shading of it zero
-                # (Mitsuba still samples the light there).
-                "bsdf": {"type": "diffuse", "reflectance": rgb([0, 0, 0])},
-                "emitter": {"type": "area", "radiance": rgb(a.get("color", [1, 1, 1]))},
-            }
-        self.note(
-            "the light seen directly: Glint returns its colour; Mitsuba adds its emission and then also "
-            "shades it (a black `diffuse`, still sampling the light: a little extra work on ~1% of the pixels)"
+    m = EXPORT_SUMMARY.search(r.stdout)
+    if not m:
+        raise Failure(f"{case.name}: glint export: no summary line in its output:\n{r.stdout}{r.stderr}")
+    got = (int(m["w"]), int(m["h"]), int(m["spp"]))
+    if got != (info.width, info.height, info.spp):
+        raise Failure(
+            f"{case.name}: glint export wrote {got[0]}x{got[1]} at {got[2]} spp, expected "
+            f"{info.width}x{info.height} at {info.spp} spp (the scene's defaults changed?)"
         )
-        self.note(
+    for line in r.stderr.splitlines():
+        if line.startswith(EXPORT_WARNING):
+            note = f"export: {line[len(EXPORT_WARNING):]}"
+            if note not in info.notes:
+                info.notes.append(note)
+    return Exported(xml, int(m["emitter"]), int(m["bsdf"]))
+
+
+def timing_notes(info: SceneInfo, exported: Exported):
+    """What differs in the work the two renderers do, beyond the export's warnings."""
+    doc = info.toml
+    info.notes.append(
+        "the light seen directly: Glint returns its colour; Mitsuba adds its emission and then also "
+        "shades it (a black `diffuse`, still sampling the light: a little extra work on ~1% of the pixels)"
+    )
+    if doc.get("shading", "phong") == "phong":
+        info.notes.append(
             "light transport: Glint's area light sample is a point light without distance falloff "
             "(`L · kd · max(0, n·l)`, the course's model); Mitsuba's `direct` integrator is physically "
             "based (`kd/π`, cosines at both ends, 1/r²), so its image is much darker. Both trace one "
             "shadow ray per light sample"
         )
-        if len(lights) > 1:
-            self.note(
-                "several area lights: Glint takes `light_samples` samples of each light per camera "
-                "sample, Mitsuba `emitter_samples` samples in all, each of one light picked at random"
-            )
-        return d
+    if len(doc.get("area_light", [])) > 1:
+        info.notes.append(
+            "several area lights: Glint takes `light_samples` samples of each light per camera "
+            "sample, Mitsuba `emitter_samples` samples in all, each of one light picked at random"
+        )
+    if doc.get("mesh"):
+        info.notes.append(
+            "meshes: Mitsuba reads the PLY files the export writes, with Glint's vertex normals; Glint "
+            "intersects them with its own BVH, Mitsuba with Embree; both shade either side of a triangle"
+        )
+    checkers = [t["checkerboard"] for t in doc.get("textures", {}).values() if "checkerboard" in t]
+    if any(c.get("filter", "point") != "point" for c in checkers):
+        info.notes.append(
+            "checkerboards: Glint's `analytic` filter is not reproduced (Mitsuba looks the pattern up at the hit point)"
+        )
+    if exported.emitter_samples != info.light_samples:
+        info.notes.append(
+            f"emitter samples: the export wrote {exported.emitter_samples} (point lights), Glint takes "
+            f"{info.light_samples} light samples"
+        )
 
 
 # ----------------------------------------------------------------------------------
@@ -546,11 +376,11 @@ class Mitsuba:
         except Exception:  # noqa: BLE001
             self.threads = os.cpu_count() or 0
 
-    def load(self, scene_dict: dict):
+    def load(self, xml: Path):
         try:
-            return self.mi.load_dict(scene_dict)
+            return self.mi.load_file(str(xml))
         except Exception as e:  # noqa: BLE001
-            raise Failure(f"Mitsuba could not load the converted scene: {e}")
+            raise Failure(f"Mitsuba could not load the exported scene {xml}: {e}")
 
     def render(self, scene, spp: int, seed: int):
         """Renders and waits for the result; returns (seconds, image)."""
@@ -662,7 +492,8 @@ def main(argv=None) -> int:
         samples = pixels * spp  # pixel (camera) samples of one render
         log(f"\n== {case.name}: {info.path.relative_to(REPO)}, {info.width}x{info.height}, {spp} spp x {light} light samples")
 
-        conv = Converter(ms.mi, info, emitter_samples=light)
+        exported = export_scene(glint, case, info, out_dir)
+        timing_notes(info, exported)
         patterns = glint_patterns(case, info)
         if patterns != ("random", "random"):
             info.notes.append(
@@ -670,7 +501,7 @@ def main(argv=None) -> int:
                 "(Owen-scrambled Sobol hashes per sample), Mitsuba's `independent` sampler draws uniform "
                 "random numbers; the sample counts are the same"
             )
-        scene = ms.load(conv.scene_dict(spp))
+        scene = ms.load(exported.xml)
         png = lambda label: out_dir / f"{label}-{case.name}.png"  # noqa: E731
 
         # Warm-ups, not timed: Mitsuba's compiles its kernels (LLVM JIT, cached on disk
@@ -719,7 +550,12 @@ def main(argv=None) -> int:
             "glint_args": list(case.glint_args),
             "mitsuba": {
                 "sampler": "independent",
-                "integrator": {"type": "direct", "emitter_samples": light, "bsdf_samples": 0},
+                "scene": str(exported.xml),
+                "integrator": {
+                    "type": "direct",
+                    "emitter_samples": exported.emitter_samples,
+                    "bsdf_samples": exported.bsdf_samples,
+                },
                 "warmup_s": warm_s,
                 "image": str(exr),
                 "channel_means": means,

@@ -17,6 +17,12 @@ evaluated at ``θ = j·π/(H − 1)``), which gives both renderers one radiance
 function. Mitsuba's ``u = 0`` looks down −z where Glint's ``u = ½`` does: the
 envmap is turned 180° about y to match.
 
+Both renderers read one scene file: Mitsuba renders what ``glint export --mitsuba``
+writes for it (4 times Glint's samples per pixel), with the envmap's file
+replaced by the map as it is, or resampled onto Mitsuba's rows as above. (The
+export's own map, a ``W × (2H + 1)`` image whose bilinear interpolation is
+exactly Glint's radiance, is not used here: the point is the two row layouts.)
+
     path/to/venv/bin/python tools/mitsuba/envmap.py MAP.hdr [MAP.hdr ...] [--spp N]
 
 Needs the ``mitsuba`` package (numpy is not needed) and a release build of
@@ -29,6 +35,7 @@ import math
 import subprocess
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
@@ -106,46 +113,41 @@ def pole_rows(mi, source, target):
     mi.Bitmap(mi.TensorXf(out, shape=(h, w, 3))).write(str(target))
 
 
-def render_mitsuba(envmap, spp, seed, out):
-    """Renders in a process of its own: after a render in this one, Mitsuba's
+def render_mitsuba(xml, envmap, seed, out):
+    """Renders the exported scene `xml` with its envmap's file replaced by
+    `envmap`, in a process of its own: after a render in this one, Mitsuba's
     threads leave this process's Python loops crawling."""
-    command = [sys.executable, __file__, "--mitsuba-render", str(envmap), str(spp), str(seed), str(out)]
+    command = [sys.executable, __file__, "--mitsuba-render", str(xml), str(envmap), str(seed), str(out)]
     subprocess.run(command, check=True)
 
 
-def mitsuba_render_here(mi, envmap, spp, seed, out):
-    T = mi.ScalarTransform4f
-    scene = mi.load_dict(
-        {
-            "type": "scene",
-            "integrator": {"type": "direct", "emitter_samples": 4, "bsdf_samples": 4},
-            "sensor": {
-                "type": "perspective",
-                "fov": 40,
-                "fov_axis": "y",
-                "to_world": T().look_at(origin=[0, 0, 4], target=[0, 0, 0], up=[0, 1, 0]),
-                "sampler": {"type": "independent", "sample_count": spp},
-                "film": {
-                    "type": "hdrfilm",
-                    "width": RESOLUTION,
-                    "height": RESOLUTION,
-                    "rfilter": {"type": "box"},
-                },
-            },
-            "env": {"type": "envmap", "filename": str(envmap), "to_world": T().rotate([0, 1, 0], 180)},
-            "sphere": {
-                "type": "sphere",
-                "radius": 1.0,
-                "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.5, 0.5, 0.5]}},
-            },
-        }
-    )
-    mi.util.write_bitmap(str(out), mi.render(scene, seed=seed))
+def mitsuba_render_here(mi, xml, envmap, seed, out):
+    tree = ET.parse(xml)
+    emitters = [e for e in tree.getroot().iter("emitter") if e.get("type") == "envmap"]
+    if len(emitters) != 1:
+        sys.exit(f"envmap.py: error: {xml} has {len(emitters)} envmap emitters, expected 1")
+    for s in emitters[0].iter("string"):
+        if s.get("name") == "filename":
+            s.set("value", str(Path(envmap).resolve()))
+    patched = Path(xml).with_name("envmap-" + Path(xml).name)
+    tree.write(patched, encoding="utf-8", xml_declaration=True)
+    mi.util.write_bitmap(str(out), mi.render(mi.load_file(str(patched)), seed=seed))
 
 
-def render_glint(binary, envmap, spp, seed, work, out):
+def export_scene(binary, scene, spp, out):
+    """The Glint scene as Mitsuba's, at `spp` samples per pixel and 4 emitter and
+    4 BSDF samples (Mitsuba's sampler is noisier than Glint's)."""
+    command = [str(binary), "export", "--mitsuba", str(scene), "--spp", str(spp), "--light-samples", "4", "-o", str(out)]
+    subprocess.run(command, check=True, capture_output=True)
+
+
+def write_scene(work, envmap, spp, seed):
     scene = work / "sphere.toml"
     scene.write_text(GLINT_SCENE.format(res=RESOLUTION, spp=spp, seed=seed, map=envmap.resolve().as_posix()))
+    return scene
+
+
+def render_glint(binary, scene, out):
     subprocess.run([str(binary), "render", str(scene), "-o", str(out)], check=True, capture_output=True)
 
 
@@ -164,18 +166,20 @@ def main():
     if not args.glint.is_file():
         sys.exit(f"envmap.py: error: no {args.glint}; build it: cargo build --release -p glint-cli")
     mi.set_variant("scalar_rgb")
-    if args.mitsuba_render:  # envmap spp seed out, from render_mitsuba
-        envmap, spp, seed, out = args.maps
-        return mitsuba_render_here(mi, envmap, int(str(spp)), int(str(seed)), out)
+    if args.mitsuba_render:  # xml envmap seed out, from render_mitsuba
+        xml, envmap, seed, out = args.maps
+        return mitsuba_render_here(mi, xml, envmap, int(str(seed)), out)
     print("| map | Glint / Mitsuba, map as is (R, G, B) | Glint / Mitsuba, rows resampled (R, G, B) |")
     print("|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         for envmap in args.maps:
-            render_glint(args.glint, envmap, args.spp, args.seed, work, work / "glint.exr")
-            render_mitsuba(envmap, 4 * args.spp, args.seed, work / "raw.exr")
+            scene = write_scene(work, envmap, args.spp, args.seed)
+            render_glint(args.glint, scene, work / "glint.exr")
+            export_scene(args.glint, scene, 4 * args.spp, work / "sphere.xml")
+            render_mitsuba(work / "sphere.xml", envmap, args.seed, work / "raw.exr")
             pole_rows(mi, envmap, work / "rows.exr")
-            render_mitsuba(work / "rows.exr", 4 * args.spp, args.seed, work / "resampled.exr")
+            render_mitsuba(work / "sphere.xml", work / "rows.exr", args.seed, work / "resampled.exr")
             g = disc_mean(mi, work / "glint.exr")
             ratios = [
                 ", ".join(f"{a / b:.4f}" for a, b in zip(g, disc_mean(mi, work / name)))

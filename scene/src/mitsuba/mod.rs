@@ -12,7 +12,7 @@
 //! | Glint | Mitsuba 3 |
 //! |---|---|
 //! | camera | `perspective` sensor, `fov_axis = "y"`, `to_world` = `lookat` |
-//! | `[render]` | `hdrfilm` (box filter), `independent` sampler (spp, seed), `direct` integrator (`emitter_samples` = `bsdf_samples` = light samples; one emitter sample with point lights) |
+//! | `[render]` | `hdrfilm` (box filter), `independent` sampler (spp, seed), `direct` integrator (`emitter_samples` = `bsdf_samples` = light samples; one emitter sample with point lights; [`Options`] may set `bsdf_samples`) |
 //! | sphere | `sphere` whose `to_world` turns its pole to +y and its u to Glint's |
 //! | parallelogram | `rectangle` with an affine `to_world` (any parallelogram) |
 //! | plane | a large `rectangle` (a warning gives its size) |
@@ -34,7 +34,7 @@ mod output;
 mod ply;
 mod xml;
 
-pub use convert::{convert, Conversion, SideContents, SideFile};
+pub use convert::{convert, convert_with, Conversion, Options, SideContents, SideFile};
 pub use output::{assets_folder, check_output};
 
 use crate::SceneDescription;
@@ -91,6 +91,15 @@ pub struct Exported {
 /// folder is replaced only if an earlier export wrote it (it holds a
 /// `.glint-export` marker).
 pub fn export(description: &SceneDescription, out: &Path) -> Result<Exported, ExportError> {
+    export_with(description, out, Options::default())
+}
+
+/// [`export`] with `options`.
+pub fn export_with(
+    description: &SceneDescription,
+    out: &Path,
+    options: Options,
+) -> Result<Exported, ExportError> {
     check_output(out)?;
     let folder = assets_folder(out);
     let name = folder
@@ -98,7 +107,7 @@ pub fn export(description: &SceneDescription, out: &Path) -> Result<Exported, Ex
         .expect("the assets folder has a name")
         .to_string_lossy()
         .into_owned();
-    let conversion = convert(description, &name);
+    let conversion = convert_with(description, &name, options);
     output::write(out, &folder, &conversion)?;
     Ok(Exported {
         assets: (!conversion.files.is_empty()).then_some((folder, conversion.files.len())),

@@ -440,13 +440,25 @@ def parse_args(argv):
     p.add_argument("--baseline", metavar="GLINT_BINARY", help="an earlier Glint build to time against as well")
     p.add_argument("--json", metavar="FILE", help="write every raw timing to this JSON file")
     p.add_argument("--out-dir", default=str(REPO / "target/mitsuba"), help="where the images go (default target/mitsuba)")
+    p.add_argument("--equal-error", action="store_true", help="time to equal error instead (its own options: --equal-error --help)")
     a = p.parse_args(argv)
     if a.pairs < 1:
         p.error("--pairs must be at least 1")
     return a
 
 
+def equal_error(argv: list[str]) -> int:
+    """`--equal-error`: time to reach equal error, each renderer against its own
+    reference (tools/mitsuba/equal_error.py, a module of its own)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import equal_error as mode
+
+    return mode.run(argv)
+
+
 def main(argv=None) -> int:
+    if "--equal-error" in (sys.argv[1:] if argv is None else argv):
+        return equal_error(sys.argv[1:] if argv is None else argv)
     args = parse_args(argv)
     cases = [CASES[n] for n in dict.fromkeys(args.case or list(CASES))]
     out_dir = Path(args.out_dir).resolve()

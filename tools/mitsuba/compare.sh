@@ -6,6 +6,7 @@
 #   tools/mitsuba/compare.sh                                  # every case, 5 pairs each
 #   tools/mitsuba/compare.sh --case cornell-set1-random --pairs 3
 #   tools/mitsuba/compare.sh --baseline /path/to/older/glint --json target/mitsuba/run.json
+#   tools/mitsuba/compare.sh --equal-error                    # time to equal error (equal_error.py)
 #
 # Environment: GLINT_MITSUBA_VENV (default target/mitsuba-venv) is where the virtual
 # environment lives; PYTHON (default python3) is the interpreter that creates it;
@@ -24,8 +25,9 @@ python="${PYTHON:-python3}"
 # Only --help: no venv, no build.
 for arg in "$@"; do
     if [[ "$arg" == "-h" || "$arg" == "--help" ]]; then
-        if [[ -x "$venv/bin/python" ]]; then exec "$venv/bin/python" "$here/compare.py" --help; fi
-        exec "$python" "$here/compare.py" --help
+        # All the arguments: --equal-error --help shows that mode's options.
+        if [[ -x "$venv/bin/python" ]]; then exec "$venv/bin/python" "$here/compare.py" "$@"; fi
+        exec "$python" "$here/compare.py" "$@"
     fi
 done
 

@@ -18,6 +18,8 @@ use crate::lanes::{self, F32Lanes, LANES};
 use crate::triangle::WatertightRay;
 use crate::{Ray, RayLanes, Shape};
 use glam::{Vec3, Vec4};
+use glint_lanes::Vector3;
+use wide::f32x4;
 
 /// The shapes of a [`ShapeList`] that may block shadow rays from one point to one
 /// light: bit `4k + lane` for lane `lane` of the linear loop's packet `k` (sphere
@@ -49,22 +51,20 @@ impl Occluders {
 const MAX_PACKETS: usize = 16;
 
 impl ShapeList {
-    /// The shapes that may lie on a segment from `from` to any point of the convex
-    /// polygon `corners` (an area light's corners, in order around it), short of
+    /// The shapes that may block a segment from `from` to any point of the convex
+    /// polygon `light` (an area light's corners, in order around it), short of
     /// its ends. The objects `exclude` names are left out if flat: the surface the
     /// segments leave (a flat shape cannot block rays leaving it) and the light's
-    /// own surface (shadow rays stop short of it). Culls only in the linear loop's
+    /// own surface (shadow rays stop short of it). So are one-sided parallelograms
+    /// with the whole light in front of them
+    /// ([`ParallelogramPacket::facing_away_from`](crate::ParallelogramPacket::facing_away_from)),
+    /// before any test against the pyramid. Culls only in the linear loop's
     /// layout; otherwise [`Occluders::ALL`].
-    pub fn occluders_towards(
-        &self,
-        from: Vec3,
-        corners: &[Vec3; 4],
-        exclude: [u32; 2],
-    ) -> Occluders {
+    pub fn occluders_towards(&self, from: Vec3, light: &[Vec3; 4], exclude: [u32; 2]) -> Occluders {
         let Some(linear) = &self.linear else {
             return Occluders::ALL;
         };
-        let Some(planes) = pyramid_planes(from, corners) else {
+        let Some(planes) = pyramid_planes(from, light) else {
             return Occluders::ALL;
         };
         if linear.sphere_bounds.len() + linear.parallelogram_corners.len() > MAX_PACKETS {
@@ -83,7 +83,19 @@ impl ShapeList {
             lanes |= (keep.bitmask() as u64) << bit;
             bit += 4;
         }
-        for corners in &linear.parallelogram_corners {
+        let margin = planes[0].margin;
+        for (corners, (packet, _)) in linear
+            .parallelogram_corners
+            .iter()
+            .zip(&linear.parallelograms)
+        {
+            // One-sided walls with the light in front of them never block it.
+            let facing_away = packet.facing_away_from(light, margin) as u64;
+            let used = corners[0][0].cmpeq(corners[0][0]).bitmask() as u64;
+            if used & !facing_away == 0 {
+                bit += 4;
+                continue;
+            }
             // A parallelogram is kept unless its four corners lie outside one face.
             let mut outside = Vec4::ZERO.cmpgt(Vec4::ONE);
             for plane in &planes {
@@ -96,7 +108,7 @@ impl ShapeList {
             }
             // NaN (unused) lanes are never outside: drop them by their corner.
             let used = corners[0][0].cmpeq(corners[0][0]);
-            lanes |= ((used & !outside).bitmask() as u64) << bit;
+            lanes |= ((used & !outside).bitmask() as u64 & !facing_away) << bit;
             bit += 4;
         }
         // A flat shape never blocks a ray leaving its own surface, nor one that
@@ -287,22 +299,7 @@ fn pyramid_planes(apex: Vec3, corners: &[Vec3; 4]) -> Option<[Face; 5]> {
         m.max(c.abs().max_element())
     });
     let margin = 1e-3 * (1.0 + size);
-    let outward = |normal: Vec3, on_face: Vec3| -> Option<Face> {
-        let normal = normal.try_normalize()?;
-        let inside = normal.dot(centroid - on_face);
-        // Also false for NaN: then nothing is culled.
-        let clear = inside.abs() > 1e-6 * (1.0 + size);
-        if !clear {
-            return None;
-        }
-        let normal = if inside > 0.0 { -normal } else { normal };
-        Some(Face {
-            normal,
-            offset: normal.dot(on_face),
-            margin,
-        })
-    };
-    let side = |i: usize| outward((corners[i] - apex).cross(corners[(i + 1) % 4] - apex), apex);
+    let sides = side_faces(apex, corners, centroid, 1e-6 * (1.0 + size), margin)?;
     // The base: the polygon's plane, outward away from the apex.
     let base = (corners[1] - corners[0])
         .cross(corners[3] - corners[0])
@@ -313,12 +310,53 @@ fn pyramid_planes(apex: Vec3, corners: &[Vec3; 4]) -> Option<[Face; 5]> {
         return None;
     }
     let normal = if height > 0.0 { -base } else { base };
-    let base = Some(Face {
+    let base = Face {
         normal,
         offset: normal.dot(corners[0]),
         margin,
-    });
-    Some([side(0)?, side(1)?, side(2)?, side(3)?, base?])
+    };
+    Some([sides[0], sides[1], sides[2], sides[3], base])
+}
+
+/// The pyramid's four sides, one per lane: the planes through the apex and
+/// each edge of the polygon, facing away from `centroid`. `None` if a side is
+/// degenerate or passes within `clearance` of the centroid.
+fn side_faces(
+    apex: Vec3,
+    corners: &[Vec3; 4],
+    centroid: Vec3,
+    clearance: f32,
+    margin: f32,
+) -> Option<[Face; 4]> {
+    let lanes = |axis: usize| f32x4::new(corners.map(|c| c[axis]));
+    let corners = Vector3::new(lanes(0), lanes(1), lanes(2));
+    let a = corners.sub_splat(apex);
+    // Lane i holds edge i's second corner: the lanes rotated by one.
+    let next = |v: f32x4| {
+        let [x, y, z, w] = v.to_array();
+        f32x4::new([y, z, w, x])
+    };
+    let b = Vector3::new(next(a.x), next(a.y), next(a.z));
+    let (normal, ok) = a.cross(&b).try_normalize();
+    let inside = normal.dot_splat(centroid - apex);
+    // Also false for NaN: then nothing is culled.
+    let usable = ok & inside.abs().simd_gt(f32x4::splat(clearance));
+    if !usable.all() {
+        return None;
+    }
+    let flip = inside.simd_gt(f32x4::ZERO);
+    let normal = Vector3::select(flip, &-normal, &normal);
+    let offset = normal.dot_splat(apex).to_array();
+    let (nx, ny, nz) = (
+        normal.x.to_array(),
+        normal.y.to_array(),
+        normal.z.to_array(),
+    );
+    Some(std::array::from_fn(|i| Face {
+        normal: Vec3::new(nx[i], ny[i], nz[i]),
+        offset: offset[i],
+        margin,
+    }))
 }
 
 #[cfg(test)]

@@ -130,6 +130,26 @@ impl ParallelogramPacket {
         self.used = self.used.max(lane as u32 + 1);
     }
 
+    /// The lanes (bit k for lane k) that no ray ending at any of `points` can
+    /// hit: one-sided parallelograms with every point in front of their plane
+    /// by more than `margin` (plus a rounding allowance of each lane's size).
+    /// A ray is hit only on the front side, crossing the plane from front to
+    /// back; a segment whose far end lies in front never does (if it starts
+    /// in front it stays there, if behind it crosses from back to front). So
+    /// shadow rays towards a light inside a room are never blocked by its
+    /// one-sided walls, wherever they start.
+    #[inline]
+    pub fn facing_away_from(&self, points: &[Vec3; 4], margin: f32) -> u32 {
+        let shapes = &self.shapes;
+        let margin = f32x4::splat(margin) + f32x4::splat(1e-3) * shapes.extent;
+        let mut in_front = shapes.one_sided;
+        for point in points {
+            let distance = shapes.normal.dot(&(Vector3::splat(*point) - shapes.origin));
+            in_front &= distance.simd_gt(margin);
+        }
+        in_front.bits()
+    }
+
     /// The scalar test of each lane, as [`SpherePacket::hit4`] for spheres.
     #[inline]
     pub fn hit4(&self, ray: &Ray, t_max: f32) -> (u32, Vec4) {
@@ -197,6 +217,50 @@ mod tests {
             }
         }
         assert!(hits > 1000, "the test rays hit something ({hits} hits)");
+    }
+
+    /// Walls dropped as facing away from a light are never hit by a segment
+    /// from anywhere (in front of them, behind, grazing) to any point of it.
+    #[test]
+    fn walls_facing_away_from_a_light_block_no_segment_to_it() {
+        let mut rng = XorShift(0x5851_f42d_4c95_7f2d);
+        let (mut dropped, mut kept_and_hit) = (0, 0);
+        for round in 0..3000 {
+            let walls: Vec<Parallelogram> = (0..4)
+                .map(|k| {
+                    Parallelogram::new(
+                        rng.vec3(-3.0, 3.0),
+                        rng.vec3(-4.0, 4.0),
+                        rng.vec3(-4.0, 4.0),
+                        (round + k) % 5 == 0,
+                    )
+                    .unwrap()
+                })
+                .collect();
+            let mut packet = ParallelogramPacket::EMPTY;
+            for (lane, p) in walls.iter().enumerate() {
+                packet.set_lane(lane, p);
+            }
+            let corner = rng.vec3(-3.0, 3.0);
+            let (e1, e2) = (rng.vec3(-1.0, 1.0), rng.vec3(-1.0, 1.0));
+            let light = [corner, corner + e1, corner + e1 + e2, corner + e2];
+            let away = packet.facing_away_from(&light, 1e-3);
+            for (lane, wall) in walls.iter().enumerate() {
+                let is_dropped = away >> lane & 1 == 1;
+                dropped += is_dropped as u32;
+                for _ in 0..8 {
+                    let from = rng.vec3(-6.0, 6.0);
+                    let to = corner + rng.unit() * e1 + rng.unit() * e2;
+                    let hit = wall.hit_distance(&Ray::new(from, to - from), 1.0).is_some();
+                    assert!(!(is_dropped && hit), "round {round}, lane {lane}");
+                    kept_and_hit += hit as u32;
+                }
+            }
+        }
+        assert!(
+            dropped > 1000 && kept_and_hit > 1000,
+            "{dropped} dropped, {kept_and_hit} kept and hit"
+        );
     }
 
     #[test]

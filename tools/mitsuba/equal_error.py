@@ -94,7 +94,6 @@ class Scene:
     width: int
     height: int
     has_environment: bool
-    has_area_lights: bool
 
 
 def read_scene(name: str, width: int) -> Scene:
@@ -114,7 +113,6 @@ def read_scene(name: str, width: int) -> Scene:
         width=width,
         height=max(1, round(width * h / w)),
         has_environment="environment" in toml,
-        has_area_lights=bool(toml.get("area_light")) or bool(toml.get("sphere_light")),
     )
 
 
@@ -123,9 +121,8 @@ def read_scene(name: str, width: int) -> Scene:
 
 
 class Glint:
-    def __init__(self, binary: Path, work: Path):
+    def __init__(self, binary: Path):
         self.binary = binary
-        self.work = work
 
     def run(self, args: list[str], what: str) -> subprocess.CompletedProcess:
         cmd = [str(self.binary), *args]
@@ -649,7 +646,7 @@ def parse_args(argv):
     p.add_argument("--glint-reference-spp", type=int, default=512, help="Glint's reference: spp, in two halves (default 512)")
     p.add_argument("--glint-reference-samples", type=int, default=4,
                    help="Glint's reference: light and environment samples, Sobol points (default 4)")
-    p.add_argument("--mitsuba-reference-spp", type=int, default=1024, help="Mitsuba's reference: spp, in two halves (default 1024)")
+    p.add_argument("--mitsuba-reference-spp", type=int, default=4096, help="Mitsuba's reference: spp, in two halves (default 4096)")
     p.add_argument("--mitsuba-reference-samples", type=int, default=1,
                    help="Mitsuba's reference: emitter and BSDF samples (default 1)")
     p.add_argument("--mitsuba-reference-sampler", default="ldsampler",
@@ -681,7 +678,7 @@ def main(argv) -> int:
     out_dir = Path(args.out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
     ms = compare.Mitsuba(args.variant)
-    glint = Glint(glint_bin, out_dir)
+    glint = Glint(glint_bin)
     machine = {
         "cpu": compare.machine_cpu(),
         "cores": os.cpu_count(),

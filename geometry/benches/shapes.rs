@@ -385,6 +385,7 @@ fn bench_shadows(
                 for (p, point) in shadows.points.iter().enumerate() {
                     let occluders = list.occluders_towards(
                         black_box(point.point),
+                        0.0,
                         &corners,
                         [point.shape, u32::MAX],
                     );
@@ -423,6 +424,7 @@ fn bench_shadows(
                 let point = &shadows.points[pair[0].0];
                 let occluders = list.occluders_towards(
                     black_box(point.point),
+                    0.0,
                     &corners,
                     [point.shape, u32::MAX],
                 );

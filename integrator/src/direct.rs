@@ -17,6 +17,13 @@ use glint_texture::TexCoord;
 /// ([`glint_geometry::ShapeList::occluders_towards`]).
 pub(crate) const CULL_FROM_SAMPLES: u32 = 4;
 
+/// How far from the point it was found for a culling serves, as a fraction of
+/// the point's distance to the light: a pixel's samples on one surface then
+/// share one (a pixel spans about a thousandth of its distance from the camera
+/// at 512², so a hundredth covers it with room), at the price of faces
+/// widened by that much.
+const CULL_REACH: f32 = 0.01;
+
 /// The direct-lighting integrator of the course report (section 2.5), with the
 /// environment and mirror reflections of section 2.7.
 ///
@@ -58,6 +65,20 @@ pub struct SampleContext<T: Tracer = ()> {
     pub detailed: bool,
     /// Sees every step of the integrator ([`crate::trace`]).
     pub tracer: T,
+    /// The last culling of shadow-ray occluders, for the next points near it.
+    occluders: Option<CachedOccluders>,
+}
+
+/// The shapes that may block shadow rays to one area light from anywhere
+/// within `reach` of `center`, on one surface, found for one pixel.
+#[derive(Clone, Copy, Debug)]
+struct CachedOccluders {
+    pixel: u64,
+    light: usize,
+    shape: u32,
+    center: Vec3,
+    reach: f32,
+    occluders: Occluders,
 }
 
 impl SampleContext {
@@ -78,6 +99,7 @@ impl<T: Tracer> SampleContext<T> {
             textures: TextureCounters::default(),
             detailed: false,
             tracer,
+            occluders: None,
         }
     }
 
@@ -166,6 +188,46 @@ impl DirectIntegrator {
             value,
         });
         value
+    }
+
+    /// The shapes that may block `point`'s shadow rays to area light `index`:
+    /// every shape below [`CULL_FROM_SAMPLES`] samples per light, where culling
+    /// costs more than it saves; else the culling found for an earlier sample of
+    /// the pixel on the same surface within its reach, or a new one.
+    pub(crate) fn occluders<T: Tracer>(
+        &self,
+        scene: &Scene,
+        point: &ShadingPoint,
+        index: usize,
+        light: &AreaLight,
+        ctx: &mut SampleContext<T>,
+    ) -> Occluders {
+        if self.light_samples < CULL_FROM_SAMPLES {
+            return Occluders::ALL;
+        }
+        let (p, shape, pixel) = (point.hit.point, point.hit.shape, ctx.sample.pixel);
+        if let Some(cached) = &ctx.occluders {
+            let same = (cached.pixel, cached.light, cached.shape) == (pixel, index, shape);
+            if same && p.distance(cached.center) <= cached.reach {
+                return cached.occluders;
+            }
+        }
+        let reach = CULL_REACH * p.distance(light.surface().center());
+        let occluders = scene.shapes.occluders_towards(
+            p,
+            reach,
+            &light.surface().corners(),
+            [shape, scene.light_objects[index]],
+        );
+        ctx.occluders = Some(CachedOccluders {
+            pixel,
+            light: index,
+            shape,
+            center: p,
+            reach,
+            occluders,
+        });
+        occluders
     }
 
     /// The environment's radiance along a ray that hits nothing (black without one).
@@ -384,17 +446,7 @@ impl DirectIntegrator {
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let samples = self.draw_light_points(pair, ctx);
-        // Culling the shapes that cannot block this point's shadow rays costs
-        // about as much as testing them once: it pays from a few samples on.
-        let occluders = if self.light_samples >= CULL_FROM_SAMPLES {
-            scene.shapes.occluders_towards(
-                point.hit.point,
-                &light.surface().corners(),
-                [point.hit.shape, scene.light_objects[index]],
-            )
-        } else {
-            Occluders::ALL
-        };
+        let occluders = self.occluders(scene, point, index, light, ctx);
         ctx.counters.light_samples += samples.len() as u64;
         let sum = point.area_light_sum(scene, light, &samples, &occluders, ctx);
         ctx.light_points = samples;

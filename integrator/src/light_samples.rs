@@ -265,6 +265,7 @@ mod tests {
                     samples[0] = Vec2::ZERO; // a corner, exactly
                     let culled = scene.shapes.occluders_towards(
                         hit.point,
+                        0.0,
                         &light.surface().corners(),
                         [hit.shape, scene.light_objects[0]],
                     );

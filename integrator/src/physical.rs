@@ -24,7 +24,7 @@
 //! the sharp highlight of a large light, where light samples alone are noisy.
 //! On a purely diffuse material only the light is sampled (weight 1).
 
-use crate::direct::{blocker, SampleContext, ShadingPoint, CULL_FROM_SAMPLES};
+use crate::direct::{blocker, SampleContext, ShadingPoint};
 use crate::sampling::DimensionPair;
 use crate::trace::{Event, Shadow, Skip, Technique, Tracer};
 use crate::{DirectIntegrator, Scene, ShadingCounters, Skips};
@@ -85,15 +85,7 @@ impl DirectIntegrator {
         let sampler = light.sampler(x, self.area_sampling);
         let mis = self.mis && point.has_specular;
         let samples = self.draw_light_points(pair, ctx);
-        let occluders = if n >= CULL_FROM_SAMPLES {
-            scene.shapes.occluders_towards(
-                x,
-                &light.surface().corners(),
-                [point.hit.shape, scene.light_objects[index]],
-            )
-        } else {
-            Occluders::ALL
-        };
+        let occluders = self.occluders(scene, point, index, light, ctx);
         let mut sum = Vec3::ZERO;
         for &u in &samples {
             let s = sampler.sample(u);

@@ -51,7 +51,8 @@ impl Occluders {
 const MAX_PACKETS: usize = 16;
 
 impl ShapeList {
-    /// The shapes that may block a segment from `from` to any point of the convex
+    /// The shapes that may block a segment from any point within `reach` of
+    /// `from` to any point of the convex
     /// polygon `light` (an area light's corners, in order around it), short of
     /// its ends. The objects `exclude` names are left out if flat: the surface the
     /// segments leave (a flat shape cannot block rays leaving it) and the light's
@@ -60,11 +61,23 @@ impl ShapeList {
     /// ([`ParallelogramPacket::facing_away_from`](crate::ParallelogramPacket::facing_away_from)),
     /// before any test against the pyramid. Culls only in the linear loop's
     /// layout; otherwise [`Occluders::ALL`].
-    pub fn occluders_towards(&self, from: Vec3, light: &[Vec3; 4], exclude: [u32; 2]) -> Occluders {
+    ///
+    /// With `reach` > 0 one answer serves nearby points (a pixel's samples on
+    /// one surface): a point `x = (1−s)p + s·q` of a segment from `p`, within
+    /// `reach` of `from`, to `q` on the light lies within `(1−s)·reach ≤ reach`
+    /// of the segment from `from` to `q`, so widening each face of the pyramid
+    /// by `reach` keeps every shape such segments can meet.
+    pub fn occluders_towards(
+        &self,
+        from: Vec3,
+        reach: f32,
+        light: &[Vec3; 4],
+        exclude: [u32; 2],
+    ) -> Occluders {
         let Some(linear) = &self.linear else {
             return Occluders::ALL;
         };
-        let Some(planes) = pyramid_planes(from, light) else {
+        let Some(planes) = pyramid_planes(from, light, reach) else {
             return Occluders::ALL;
         };
         if linear.sphere_bounds.len() + linear.parallelogram_corners.len() > MAX_PACKETS {
@@ -83,7 +96,7 @@ impl ShapeList {
             lanes |= (keep.bitmask() as u64) << bit;
             bit += 4;
         }
-        let margin = planes[0].margin;
+        let margin = planes[0].margin - reach;
         for (corners, (packet, _)) in linear
             .parallelogram_corners
             .iter()
@@ -291,14 +304,14 @@ impl Face {
 /// The outward faces of the pyramid with apex `apex` over the convex polygon
 /// `corners`. `None` if the apex lies in the polygon's plane (no pyramid: nothing
 /// is culled).
-fn pyramid_planes(apex: Vec3, corners: &[Vec3; 4]) -> Option<[Face; 5]> {
+fn pyramid_planes(apex: Vec3, corners: &[Vec3; 4], reach: f32) -> Option<[Face; 5]> {
     let centroid = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
     // Shadow rays start up to a few hundred ULPs off `apex` and end within rounding
     // of the polygon: a margin far above both, relative to the coordinates' size.
     let size = corners.iter().fold(apex.abs().max_element(), |m, c| {
         m.max(c.abs().max_element())
     });
-    let margin = 1e-3 * (1.0 + size);
+    let margin = 1e-3 * (1.0 + size) + reach;
     let sides = side_faces(apex, corners, centroid, 1e-6 * (1.0 + size), margin)?;
     // The base: the polygon's plane, outward away from the apex.
     let base = (corners[1] - corners[0])
@@ -422,10 +435,10 @@ mod tests {
     fn a_floor_point_keeps_only_what_stands_between_it_and_the_light() {
         let (list, light) = cornell();
         // Far from the spheres: nothing at all (the floor is its own surface).
-        let open = list.occluders_towards(Vec3::new(4.0, -6.0, 0.0), &light, [3, 9]);
+        let open = list.occluders_towards(Vec3::new(4.0, -6.0, 0.0), 0.0, &light, [3, 9]);
         assert_eq!(open.count(), 0, "{open:?}");
         // Under the small sphere at (2, −3.2, −5): that sphere alone.
-        let under = list.occluders_towards(Vec3::new(1.9, -6.0, -5.0), &light, [3, 9]);
+        let under = list.occluders_towards(Vec3::new(1.9, -6.0, -5.0), 0.0, &light, [3, 9]);
         assert_eq!(under, Occluders { lanes: 1 << 1 });
     }
 
@@ -442,7 +455,7 @@ mod tests {
         }
         let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
         let mut next = move || rng.unit();
-        let (mut blocked, mut culled) = (0, 0);
+        let (mut blocked, mut culled, mut culled_near) = (0, 0, 0);
         for _ in 0..4000 {
             let aim = Vec3::new(
                 next() * 12.0 - 6.0,
@@ -454,8 +467,14 @@ mod tests {
             let Some(hit) = plain.closest_hit(&ray, f32::INFINITY) else {
                 continue;
             };
-            let occluders = list.occluders_towards(hit.point, &light, [hit.shape, 9]);
+            let occluders = list.occluders_towards(hit.point, 0.0, &light, [hit.shape, 9]);
             culled += 64 - occluders.count().min(64);
+            // The answer for a ball around a point near this one serves this one.
+            let reach = 0.5 * next();
+            let off = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+            let near = hit.point + off.normalize_or_zero() * reach * next();
+            let widened = list.occluders_towards(near, reach, &light, [hit.shape, 9]);
+            culled_near += 64 - widened.count().min(64);
             for _ in 0..4 {
                 let (a, b) = (next(), next());
                 let target = light[0] + a * (light[1] - light[0]) + b * (light[3] - light[0]);
@@ -463,12 +482,13 @@ mod tests {
                 let t_max = 1.0;
                 let expected = plain.any_hit(&shadow, t_max);
                 assert_eq!(list.any_hit_among(&occluders, &shadow, t_max), expected);
+                assert_eq!(list.any_hit_among(&widened, &shadow, t_max), expected);
                 blocked += expected as u32;
             }
         }
         assert!(
-            blocked > 500 && culled > 1000,
-            "{blocked} blocked, {culled} culled"
+            blocked > 500 && culled > 1000 && culled_near > 1000,
+            "{blocked} blocked, {culled} culled, {culled_near} culled near"
         );
     }
 }

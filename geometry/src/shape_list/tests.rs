@@ -145,7 +145,7 @@ mod bvh_agreement {
                     std::array::from_fn(|_| corner + rng.next() * e1 + rng.next() * e2);
                 // Odd rounds: no culling, and targets off the quad.
                 let occluders = if round % 2 == 0 {
-                    list.occluders_towards(from, &corners, [u32::MAX; 2])
+                    list.occluders_towards(from, 0.0, &corners, [u32::MAX; 2])
                 } else {
                     targets[1].x = from.x;
                     targets[2].y = from.y;

@@ -428,6 +428,7 @@ fn judge_pixel(
         let culled = match &scene.lights[p.light] {
             Light::Area(a) => scene.shapes.occluders_towards(
                 hit.point,
+                0.0,
                 &a.surface().corners(),
                 [hit.shape, scene.light_objects[p.light]],
             ),

@@ -165,6 +165,21 @@ mod tests {
     use super::*;
     use crate::bvh::test_support::XorShift;
 
+    /// Four random parallelograms about the origin, wall `k` two-sided where
+    /// `two_sided(k)`.
+    fn random_walls(rng: &mut XorShift, two_sided: impl Fn(usize) -> bool) -> Vec<Parallelogram> {
+        (0..4)
+            .map(|k| {
+                let (origin, e1, e2) = (
+                    rng.vec3(-3.0, 3.0),
+                    rng.vec3(-4.0, 4.0),
+                    rng.vec3(-4.0, 4.0),
+                );
+                Parallelogram::new(origin, e1, e2, two_sided(k)).unwrap()
+            })
+            .collect()
+    }
+
     /// Every lane agrees with the scalar test bit for bit, on random rays
     /// (origins inside and outside, grazing and tangent ones included by volume).
     #[test]
@@ -175,17 +190,7 @@ mod tests {
             let spheres: Vec<Sphere> = (0..3)
                 .map(|_| Sphere::new(rng.vec3(-3.0, 3.0), 0.2 + 2.0 * rng.unit()).unwrap())
                 .collect();
-            let walls: Vec<Parallelogram> = (0..4)
-                .map(|k| {
-                    Parallelogram::new(
-                        rng.vec3(-3.0, 3.0),
-                        rng.vec3(-4.0, 4.0),
-                        rng.vec3(-4.0, 4.0),
-                        k % 2 == 0,
-                    )
-                    .unwrap()
-                })
-                .collect();
+            let walls = random_walls(&mut rng, |k| k % 2 == 0);
             let mut sphere_packet = SpherePacket::EMPTY;
             for (lane, s) in spheres.iter().enumerate() {
                 sphere_packet.set_lane(lane, s);
@@ -226,17 +231,7 @@ mod tests {
         let mut rng = XorShift(0x5851_f42d_4c95_7f2d);
         let (mut dropped, mut kept_and_hit) = (0, 0);
         for round in 0..3000 {
-            let walls: Vec<Parallelogram> = (0..4)
-                .map(|k| {
-                    Parallelogram::new(
-                        rng.vec3(-3.0, 3.0),
-                        rng.vec3(-4.0, 4.0),
-                        rng.vec3(-4.0, 4.0),
-                        (round + k) % 5 == 0,
-                    )
-                    .unwrap()
-                })
-                .collect();
+            let walls = random_walls(&mut rng, |k| (round + k) % 5 == 0);
             let mut packet = ParallelogramPacket::EMPTY;
             for (lane, p) in walls.iter().enumerate() {
                 packet.set_lane(lane, p);

@@ -206,14 +206,14 @@ impl Scrambles {
         let index = U32Lanes::new(std::array::from_fn(|k| i.wrapping_add(k as u32)));
         let shuffled = owen_scramble_lanes(reverse_bits_lanes(index), self.index).to_array();
         let tables = self.tables();
-        let sobol = |axis: usize| {
-            U32Lanes::new(std::array::from_fn(|k| {
-                let (low, high) = (shuffled[k] >> 24, shuffled[k] >> 16 & 0xff);
-                tables[axis][0][low as usize] ^ tables[axis][1][high as usize]
-            }))
-        };
-        let x = unit_lanes(sobol(0), self.x);
-        let y = unit_lanes(sobol(1), self.y);
+        let (mut xs, mut ys) = ([0u32; LANES], [0u32; LANES]);
+        for (k, &shuffled) in shuffled.iter().enumerate() {
+            let (low, high) = (shuffled >> 24, shuffled >> 16 & 0xff);
+            let both = tables[0][low as usize] ^ tables[1][high as usize];
+            (xs[k], ys[k]) = (both as u32, (both >> 32) as u32);
+        }
+        let x = unit_lanes(U32Lanes::new(xs), self.x);
+        let y = unit_lanes(U32Lanes::new(ys), self.y);
         for (k, p) in out.iter_mut().enumerate() {
             *p = Vec2::new(x[k], y[k]);
         }
@@ -221,7 +221,7 @@ impl Scrambles {
 
     /// The generator tables of this sequence's two dimensions.
     #[inline]
-    fn tables(self) -> &'static [[[u32; 256]; 2]; 2] {
+    fn tables(self) -> &'static PairTables {
         match self.dimensions {
             0 => &GENERATOR_TABLES,
             k => &JOINT_TABLES[k as usize - 1],
@@ -236,11 +236,8 @@ impl Scrambles {
         // The shuffled index's bits 0–7 and 8–15, still reversed.
         let (low, high) = ((shuffled >> 24) as usize, (shuffled >> 16 & 0xff) as usize);
         let tables = self.tables();
-        // By reference: `map` on the arrays themselves would copy 4 KB a point.
-        let (x, y) = (
-            tables[0][0][low] ^ tables[0][1][high],
-            tables[1][0][low] ^ tables[1][1][high],
-        );
+        let both = tables[0][low] ^ tables[1][high];
+        let (x, y) = (both as u32, (both >> 32) as u32);
         let unit =
             |v: u32, scramble: u32| u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits());
         Vec2::new(unit(x, self.x), unit(y, self.y))
@@ -289,13 +286,34 @@ fn unit_lanes(v: U32Lanes, scramble: u32) -> [f32; LANES] {
 /// `v_{8k+j}` of dimension `d` for the bits `j` set in `b` read from the top
 /// (bit 7 of `b` is index bit `8k`), as `sobol_burley::parts::sobol_rev` gives it.
 /// Point `i` of dimension `d` is then `t[0][low byte] ^ t[1][high byte]` (a Sobol
-/// point is linear in its index's bits over GF(2)).
-static GENERATOR_TABLES: [[[u32; 256]; 2]; 2] = generator_tables();
+/// point is linear in its index's bits over GF(2)). Both dimensions are looked
+/// up at once: an entry holds dimension 0 in its low 32 bits and dimension 1 in
+/// its high ones ([`PairTables`]), and XOR keeps the halves apart.
+static GENERATOR_TABLES: PairTables = pack(generator_tables());
+
+/// A pair of dimensions' tables by index byte, `[byte][b]`, each entry the
+/// first dimension's value in its low 32 bits and the second's in its high.
+type PairTables = [[u64; 256]; 2];
+
+/// Two dimensions' tables `[d][byte][b]` as [`PairTables`].
+const fn pack(t: [[[u32; 256]; 2]; 2]) -> PairTables {
+    let mut packed = [[0u64; 256]; 2];
+    let mut k = 0;
+    while k < 2 {
+        let mut b = 0;
+        while b < 256 {
+            packed[k][b] = t[0][k][b] as u64 | (t[1][k][b] as u64) << 32;
+            b += 1;
+        }
+        k += 1;
+    }
+    packed
+}
 
 /// The same tables for Sobol dimensions 2 to 5 (the joint pairs), made once from
 /// `sobol_burley::parts::sobol_rev`: a point is linear in its index's bits, so a
 /// byte's entry is the point of that byte alone.
-static JOINT_TABLES: std::sync::LazyLock<[[[[u32; 256]; 2]; 2]; MAX_JOINT as usize]> =
+static JOINT_TABLES: std::sync::LazyLock<[PairTables; MAX_JOINT as usize]> =
     std::sync::LazyLock::new(|| {
         let mut tables = [[[[0u32; 256]; 2]; 2]; MAX_JOINT as usize];
         for (k, pair) in tables.iter_mut().enumerate() {
@@ -311,7 +329,7 @@ static JOINT_TABLES: std::sync::LazyLock<[[[[u32; 256]; 2]; 2]; MAX_JOINT as usi
                 }
             }
         }
-        tables
+        tables.map(pack)
     });
 
 /// Joe and Kuo's direction numbers `v_1 … v_16` of dimensions 0 and 1 as 32-bit

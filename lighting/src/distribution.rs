@@ -13,6 +13,12 @@ pub struct PiecewiseConstant1D {
     cdf: Vec<f64>,
     /// Integral of the weights over [0, 1] (their mean).
     integral: f32,
+    /// A guide table (Chen and Asau, "On generating random variates from an
+    /// empirical distribution", AIIE Transactions 6(2), 1974): entry `j` is
+    /// the number of CDF values at most `j / n`, so the search for `u` need only
+    /// look between the entries either side of `u·n`. The bin found is the
+    /// full search's.
+    guide: Vec<u32>,
 }
 
 impl PiecewiseConstant1D {
@@ -41,11 +47,29 @@ impl PiecewiseConstant1D {
         } else {
             (total / n as f64) as f32
         };
+        let guide = (0..=n)
+            .map(|j| cdf.partition_point(|&c| c <= j as f64 / n as f64) as u32)
+            .collect();
         Self {
             weights,
             cdf,
             integral,
+            guide,
         }
+    }
+
+    /// The number of CDF values at most `u`, searching only between the guide
+    /// entries a bucket either side of `u`'s (a margin for the rounding of `u·n`).
+    #[inline]
+    fn values_at_most(&self, u: f64) -> usize {
+        let n = self.len();
+        if !(0.0..1.0).contains(&u) {
+            return self.cdf.partition_point(|&c| c <= u);
+        }
+        let bucket = ((u * n as f64) as usize).min(n);
+        let lo = self.guide[bucket.saturating_sub(1)] as usize;
+        let hi = self.guide[(bucket + 2).min(n)] as usize;
+        lo + self.cdf[lo..hi].partition_point(|&c| c <= u)
     }
 
     pub fn len(&self) -> usize {
@@ -66,11 +90,7 @@ impl PiecewiseConstant1D {
     pub fn sample(&self, u: f32) -> (f32, f32, usize) {
         let u = u as f64;
         // The last bin whose cdf is ≤ u, skipping empty bins.
-        let bin = self
-            .cdf
-            .partition_point(|&c| c <= u)
-            .saturating_sub(1)
-            .min(self.len() - 1);
+        let bin = self.values_at_most(u).saturating_sub(1).min(self.len() - 1);
         let (lo, hi) = (self.cdf[bin], self.cdf[bin + 1]);
         let within = if hi > lo {
             ((u - lo) / (hi - lo)).clamp(0.0, 1.0)
@@ -163,6 +183,45 @@ mod tests {
             .map(|i| d.pdf((i as f32 + 0.5) / 1000.0) / 1000.0)
             .sum();
         assert!((integral - 1.0).abs() < 1e-4);
+    }
+
+    /// The guide table only narrows the search: every `u` finds the bin of the
+    /// full binary search, on uneven, zero-filled and peaked weights, at bucket
+    /// edges, CDF values and their neighbours.
+    #[test]
+    fn the_guided_search_finds_the_full_searchs_bin() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let weights: [Vec<f32>; 4] = [
+            (0..1000).map(|_| next().powi(8)).collect(),
+            (0..257)
+                .map(|k| if k % 7 == 0 { 1.0 } else { 0.0 })
+                .collect(),
+            (0..64).map(|k| if k == 40 { 1e6 } else { 1e-3 }).collect(),
+            vec![0.0; 9],
+        ];
+        for w in weights {
+            let d = PiecewiseConstant1D::new(w);
+            let n = d.len();
+            let mut us: Vec<f64> = (0..=4 * n).map(|j| j as f64 / (4 * n) as f64).collect();
+            for &c in &d.cdf {
+                us.extend([
+                    c,
+                    f64::from_bits(c.to_bits().saturating_sub(1)),
+                    c.next_up(),
+                ]);
+            }
+            us.extend((0..2000).map(|_| next() as f64));
+            for u in us.into_iter().filter(|u| (0.0..1.0).contains(u)) {
+                let full = d.cdf.partition_point(|&c| c <= u);
+                assert_eq!(d.values_at_most(u), full, "u = {u}, n = {n}");
+            }
+        }
     }
 
     #[test]

@@ -65,27 +65,7 @@ impl DirectIntegrator {
         let mut shaded = ShadedLanes::default();
         let hit_lanes = closest.hits & ((1 << used) - 1);
         if !shaded.set_common(scene, rays, closest, hit_lanes, &mut radiance, ctx) {
-            for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
-                let ray = rays.lane(k);
-                let found = closest.hit(k).expect("a hit lane");
-                let Some(hit) = scene.shapes.surface_point(&ray, found) else {
-                    continue;
-                };
-                match scene.surface_of(&hit) {
-                    SurfaceKind::Emitter(Light::Area(area)) => radiance.set_lane(k, area.color),
-                    SurfaceKind::Emitter(_) => {}
-                    SurfaceKind::Material(material) => {
-                        if ctx.detailed {
-                            ctx.textures.record(material, &TexCoord::point(hit.uv));
-                        }
-                        let reflectances = material.reflectances_at(hit.uv);
-                        let point =
-                            ShadingPoint::with_reflectances(&hit, material, &ray, reflectances);
-                        radiance.set_lane(k, scene.ambient * point.kd);
-                        shaded.set(k, &point, material);
-                    }
-                }
-            }
+            shaded.set_one_by_one(scene, rays, closest, hit_lanes, &mut radiance, ctx);
         }
         if shaded.lanes == 0 {
             return radiance;
@@ -116,17 +96,7 @@ impl DirectIntegrator {
             let pair = pairs.take(own, self.light_samples);
             let u = match &mut rngs {
                 Some(rngs) => rngs.uniform2(),
-                None => {
-                    let u: [Vec2; LANES] = std::array::from_fn(|k| {
-                        let mut u = [Vec2::ZERO];
-                        if shaded.lanes >> k & 1 == 1 {
-                            let sobol = samples[k].sobol_points(pair, 1);
-                            self.light_pattern.fill(&mut ctx.rng, sobol, &mut u);
-                        }
-                        u[0]
-                    });
-                    (F32Lanes::new(u.map(|u| u.x)), F32Lanes::new(u.map(|u| u.y)))
-                }
+                None => self.pattern_points(&samples, pair, shaded.lanes, ctx),
             };
             ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
             let reflected = shaded.area_light(scene, area, u, ctx);
@@ -139,6 +109,26 @@ impl DirectIntegrator {
         // `li_at` adds the absent environment and mirror terms, zeros: a −0
         // component becomes +0 there, so it must here too.
         Vec3Lanes::select(shaded_mask, &(radiance + Vec3Lanes::default()), &radiance)
+    }
+
+    /// The light-sample point of pair `pair` of each of the `lanes` camera
+    /// samples, from the light pattern (grid or Sobol: nothing to draw).
+    fn pattern_points<T: Tracer>(
+        &self,
+        samples: &[PixelSample; LANES],
+        pair: DimensionPair,
+        lanes: u32,
+        ctx: &mut SampleContext<T>,
+    ) -> (F32Lanes, F32Lanes) {
+        let u: [Vec2; LANES] = std::array::from_fn(|k| {
+            let mut u = [Vec2::ZERO];
+            if lanes >> k & 1 == 1 {
+                let sobol = samples[k].sobol_points(pair, 1);
+                self.light_pattern.fill(&mut ctx.rng, sobol, &mut u);
+            }
+            u[0]
+        });
+        (F32Lanes::new(u.map(|u| u.x)), F32Lanes::new(u.map(|u| u.y)))
     }
 }
 
@@ -158,6 +148,39 @@ struct ShadedLanes<'a> {
 }
 
 impl<'a> ShadedLanes<'a> {
+    /// The lanes of `hit_lanes` set one by one: each lane's surface point,
+    /// its emitted light or ambient term in `radiance`, and its shading point.
+    fn set_one_by_one<T: Tracer>(
+        &mut self,
+        scene: &'a Scene,
+        rays: &RayLanes,
+        closest: &ClosestLanes,
+        hit_lanes: u32,
+        radiance: &mut Vec3Lanes,
+        ctx: &mut SampleContext<T>,
+    ) {
+        for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
+            let ray = rays.lane(k);
+            let found = closest.hit(k).expect("a hit lane");
+            let Some(hit) = scene.shapes.surface_point(&ray, found) else {
+                continue;
+            };
+            match scene.surface_of(&hit) {
+                SurfaceKind::Emitter(Light::Area(area)) => radiance.set_lane(k, area.color),
+                SurfaceKind::Emitter(_) => {}
+                SurfaceKind::Material(material) => {
+                    if ctx.detailed {
+                        ctx.textures.record(material, &TexCoord::point(hit.uv));
+                    }
+                    let reflectances = material.reflectances_at(hit.uv);
+                    let point = ShadingPoint::with_reflectances(&hit, material, &ray, reflectances);
+                    radiance.set_lane(k, scene.ambient * point.kd);
+                    self.set(k, &point, material);
+                }
+            }
+        }
+    }
+
     /// Puts `p`, of `material`, in lane `k`.
     fn set(&mut self, k: usize, p: &ShadingPoint, material: &'a PhongMaterial) {
         self.phong

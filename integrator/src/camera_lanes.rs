@@ -18,7 +18,7 @@
 //! are those of [`DirectIntegrator::li_at`], bit for bit (the tests compare).
 
 use crate::direct::{PairAllocation, SampleContext, ShadingPoint};
-use crate::light_samples::count_lanes;
+use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::sampling::{pixel_key, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern};
 use crate::trace::Tracer;
 use crate::{DirectIntegrator, Scene, SurfaceKind};
@@ -257,20 +257,17 @@ impl<'a> ShadedLanes<'a> {
         (ux, uy): (F32Lanes, F32Lanes),
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        let position = light.sample_points(ux, uy);
-        let towards = position - self.point;
-        let (l, normalized) = towards.try_normalize();
-        let reflected = self.phong.reflect(&l);
-        let normal = light.surface().normal();
-        let lit = self.lanes
-            & lanes::bits(lanes::gt(
-                (self.point - position).dot_splat(normal),
-                F32Lanes::ZERO,
-            ));
-        let normalized = lanes::bits(normalized);
-        let above = lanes::bits(lanes::gt(l.dot(&self.ng), F32Lanes::ZERO));
-        let shaded = lit & normalized & above;
-        let traced = shaded & !lanes::bits(reflected.is_zero());
+        let reflect = |l: &Vec3Lanes| self.phong.reflect(l);
+        let sample =
+            LightSampleLanes::new(light, (ux, uy), &self.point, &self.ng, self.lanes, reflect);
+        let LightSampleLanes {
+            position,
+            towards,
+            reflected,
+            lit,
+            shaded,
+            traced,
+        } = sample;
         let specular = self.phong.specular_lanes();
         count_lanes(&mut ctx.counters, self.lanes, lit, shaded, traced, specular);
         let ends = light.shadow_ends(&position);

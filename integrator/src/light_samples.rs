@@ -21,6 +21,53 @@ use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{offset_ray_origin, Occluders, RayLanes};
 use glint_lighting::AreaLight;
 
+/// One sample of an area light per lane, seen from each lane's receiving point,
+/// before its shadow ray: the light point, the (unnormalised) direction to it,
+/// the reflection of a unit light from it, and the lanes (bit k for lane k) it
+/// lights, shades (normalisable and above the surface) and needs a shadow ray
+/// for (a non-zero reflection). The one kernel of a point's light samples in
+/// lanes and of a pixel's camera samples' first hits in lanes.
+pub(crate) struct LightSampleLanes {
+    pub(crate) position: Vec3Lanes,
+    pub(crate) towards: Vec3Lanes,
+    pub(crate) reflected: Vec3Lanes,
+    pub(crate) lit: u32,
+    pub(crate) shaded: u32,
+    pub(crate) traced: u32,
+}
+
+impl LightSampleLanes {
+    /// Lane k: the point `(ux, uy)_k` of `light` seen from `receiver_k`, whose
+    /// geometric normal on the viewer's side is `ng_k`; `reflect` gives the
+    /// reflection of a unit light from unit directions. Only the lanes `used`.
+    #[inline(always)]
+    pub(crate) fn new(
+        light: &AreaLight,
+        (ux, uy): (F32Lanes, F32Lanes),
+        receiver: &Vec3Lanes,
+        ng: &Vec3Lanes,
+        used: u32,
+        reflect: impl FnOnce(&Vec3Lanes) -> Vec3Lanes,
+    ) -> Self {
+        let position = light.sample_points(ux, uy);
+        let towards = position - *receiver;
+        let (l, normalized) = towards.try_normalize();
+        let reflected = reflect(&l);
+        let lit = used & lanes::bits(light.illuminates_lanes(&position, receiver));
+        let above = lanes::bits(lanes::gt(l.dot(ng), F32Lanes::ZERO));
+        let shaded = lit & lanes::bits(normalized) & above;
+        let traced = shaded & !lanes::bits(reflected.is_zero());
+        Self {
+            position,
+            towards,
+            reflected,
+            lit,
+            shaded,
+            traced,
+        }
+    }
+}
+
 /// From this many samples per light on, the samples are shaded in lanes; below
 /// it, one by one (the same result: the lanes only cost more for one sample).
 pub(crate) const LANES_FROM_SAMPLES: usize = 2;
@@ -49,24 +96,23 @@ impl ShadingPoint<'_> {
             Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, -normal)),
         ];
         let mut sum = Vec3::ZERO;
+        let (receiver, ng) = (Vec3Lanes::splat(point), Vec3Lanes::splat(self.ng));
         for chunk in samples.chunks(LANES) {
-            let (ux, uy) = gather(chunk);
-            let position = light.sample_points(ux, uy);
-            let towards = position.sub_splat(point);
-            let (l, normalized) = towards.try_normalize();
-            let reflected = self.material.reflect_lanes(
-                self.kd,
-                self.ks,
-                self.n,
-                &l,
-                self.v,
-                self.has_specular,
-            );
             let used = lanes::bits(lanes::first_lanes(chunk.len()));
-            let lit = used & lanes::bits(light.illuminates_lanes(&position, point));
-            let above = lanes::bits(lanes::gt(l.dot_splat(self.ng), F32Lanes::ZERO));
-            let shaded = lit & lanes::bits(normalized) & above;
-            let traced = shaded & !lanes::bits(reflected.is_zero());
+            let reflect = |l: &Vec3Lanes| {
+                let (kd, ks, n, v) = (self.kd, self.ks, self.n, self.v);
+                self.material
+                    .reflect_lanes(kd, ks, n, l, v, self.has_specular)
+            };
+            let sample = LightSampleLanes::new(light, gather(chunk), &receiver, &ng, used, reflect);
+            let LightSampleLanes {
+                position,
+                towards,
+                reflected,
+                lit,
+                shaded,
+                traced,
+            } = sample;
             let from_back = lanes::lt(towards.dot_splat(normal), F32Lanes::ZERO);
             self.count(ctx, used, lit, shaded, traced);
             let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);

@@ -79,11 +79,12 @@ impl AreaLight {
         )
     }
 
-    /// [`Self::illuminates`] for [`LANES`](glint_geometry::lanes::LANES) light points at once: the mask of the
-    /// lanes whose point shines on `receiver`.
+    /// [`Self::illuminates`] for [`LANES`](glint_geometry::lanes::LANES) light
+    /// points at once, each seen from its own lane's receiver: the mask of the
+    /// lanes whose point shines on it.
     #[inline]
-    pub fn illuminates_lanes(&self, light_points: &Vec3Lanes, receiver: Vec3) -> F32Lanes {
-        let towards = Vec3Lanes::splat_sub(receiver, light_points);
+    pub fn illuminates_lanes(&self, light_points: &Vec3Lanes, receivers: &Vec3Lanes) -> F32Lanes {
+        let towards = *receivers - *light_points;
         lanes::gt(towards.dot_splat(self.surface.normal()), F32Lanes::ZERO)
     }
 }

@@ -258,21 +258,23 @@ impl<'a> ShadedLanes<'a> {
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let reflect = |l: &Vec3Lanes| self.phong.reflect(l);
-        let sample =
-            LightSampleLanes::new(light, (ux, uy), &self.point, &self.ng, self.lanes, reflect);
-        let LightSampleLanes {
-            position,
-            towards,
-            reflected,
-            lit,
-            shaded,
-            traced,
-        } = sample;
+        let s = LightSampleLanes::new(light, (ux, uy), &self.point, &self.ng, self.lanes, reflect);
         let specular = self.phong.specular_lanes();
-        count_lanes(&mut ctx.counters, self.lanes, lit, shaded, traced, specular);
-        let ends = light.shadow_ends(&position);
-        let visible = traced & !self.blocked(scene, &ends, &towards, traced);
-        Vec3Lanes::select(lanes::from_bits(visible), &reflected, &Vec3Lanes::default())
+        count_lanes(
+            &mut ctx.counters,
+            self.lanes,
+            s.lit,
+            s.shaded,
+            s.traced,
+            specular,
+        );
+        let ends = light.shadow_ends(&s.position);
+        let visible = s.traced & !self.blocked(scene, &ends, &s.towards, s.traced);
+        Vec3Lanes::select(
+            lanes::from_bits(visible),
+            &s.reflected,
+            &Vec3Lanes::default(),
+        )
     }
 
     /// The `traced` lanes whose shadow ray, from the point (offset to the side

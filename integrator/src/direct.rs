@@ -170,13 +170,19 @@ impl DirectIntegrator {
             SurfaceKind::Material(m) => m,
         };
         let r = material.reflectivity;
+        let at = SurfaceHit {
+            hit: &hit,
+            material,
+            ray,
+            diff,
+        };
         let local = if material.has_local_shading() {
-            self.local_shading(scene, &hit, material, ray, diff, depth, ctx)
+            self.local_shading(scene, &at, depth, ctx)
         } else {
             Vec3::ZERO
         };
         let mirror = if r > 0.0 && depth < self.max_depth {
-            self.mirror_reflection(scene, &hit, material, ray, diff, depth, ctx)
+            self.mirror_reflection(scene, &at, depth, ctx)
         } else {
             Vec3::ZERO
         };
@@ -263,25 +269,21 @@ impl DirectIntegrator {
 
     /// The light reflected at `hit` by its material (ambient, lights and
     /// environment), its textures read over the ray's footprint.
-    #[allow(clippy::too_many_arguments)]
     fn local_shading<T: Tracer>(
         &self,
         scene: &Scene,
-        hit: &Hit,
-        material: &PhongMaterial,
-        ray: &Ray,
-        diff: &RayDifferential,
+        at: &SurfaceHit,
         depth: u32,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        if material.uses_footprint() {
+        if at.material.uses_footprint() {
             ctx.counters.footprints += 1;
         }
-        let tc = texture_footprint(material, hit, diff);
+        let tc = texture_footprint(at.material, at.hit, at.diff);
         if ctx.detailed {
-            ctx.textures.record(material, &tc);
+            ctx.textures.record(at.material, &tc);
         }
-        let point = ShadingPoint::new(hit, material, ray, &tc);
+        let point = ShadingPoint::new(at.hit, at.material, at.ray, &tc);
         ctx.tracer.record(|| Event::Surface {
             tc,
             kd: point.kd,
@@ -298,27 +300,24 @@ impl DirectIntegrator {
 
     /// The radiance a mirror at `hit` reflects towards the ray, tinted: the
     /// reflected ray followed one level deeper, with its differentials.
-    #[allow(clippy::too_many_arguments)]
     fn mirror_reflection<T: Tracer>(
         &self,
         scene: &Scene,
-        hit: &Hit,
-        material: &PhongMaterial,
-        ray: &Ray,
-        diff: &RayDifferential,
+        at: &SurfaceHit,
         depth: u32,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let surface = hit.differentials(diff);
-        let (wi, reflected_diff) = reflect_differential(hit, ray.direction, diff, &surface);
-        let reflected = spawn_ray(hit, wi);
+        let surface = at.hit.differentials(at.diff);
+        let (wi, reflected_diff) =
+            reflect_differential(at.hit, at.ray.direction, at.diff, &surface);
+        let reflected = spawn_ray(at.hit, wi);
         ctx.counters.reflection_rays += 1;
         ctx.tracer.record(|| Event::Mirror {
-            reflectivity: material.reflectivity,
-            tint: material.mirror_tint,
+            reflectivity: at.material.reflectivity,
+            tint: at.material.mirror_tint,
             direction: wi,
         });
-        material.mirror_tint * self.li(scene, &reflected, &reflected_diff, depth + 1, ctx)
+        at.material.mirror_tint * self.li(scene, &reflected, &reflected_diff, depth + 1, ctx)
     }
 
     /// The local shading of `point`, `depth` reflections deep: ambient, the
@@ -711,6 +710,16 @@ impl PairAllocation {
             own
         }
     }
+}
+
+/// A ray's hit on a material, with what shading it reads: the ray and its
+/// differentials.
+#[derive(Clone, Copy)]
+struct SurfaceHit<'a> {
+    hit: &'a Hit,
+    material: &'a PhongMaterial,
+    ray: &'a Ray,
+    diff: &'a RayDifferential,
 }
 
 /// The radiance of a light's surface seen directly: its color.

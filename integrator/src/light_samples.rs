@@ -104,30 +104,22 @@ impl ShadingPoint<'_> {
                 self.material
                     .reflect_lanes(kd, ks, n, l, v, self.has_specular)
             };
-            let sample = LightSampleLanes::new(light, gather(chunk), &receiver, &ng, used, reflect);
-            let LightSampleLanes {
-                position,
-                towards,
-                reflected,
-                lit,
-                shaded,
-                traced,
-            } = sample;
-            let from_back = lanes::lt(towards.dot_splat(normal), F32Lanes::ZERO);
-            self.count(ctx, used, lit, shaded, traced);
+            let s = LightSampleLanes::new(light, gather(chunk), &receiver, &ng, used, reflect);
+            let from_back = lanes::lt(s.towards.dot_splat(normal), F32Lanes::ZERO);
+            self.count(ctx, used, s.lit, s.shaded, s.traced);
             let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);
             let shadow_rays = RayLanes {
                 origin,
-                direction: light.shadow_ends(&position) - origin,
+                direction: light.shadow_ends(&s.position) - origin,
             };
             let blocked = scene
                 .shapes
-                .any_hits_among(occluders, &shadow_rays, 1.0, traced);
-            let visible = traced & !blocked;
+                .any_hits_among(occluders, &shadow_rays, 1.0, s.traced);
+            let visible = s.traced & !blocked;
             for k in 0..chunk.len() {
-                if lit >> k & 1 == 1 {
+                if s.lit >> k & 1 == 1 {
                     sum += if visible >> k & 1 == 1 {
-                        reflected.lane(k)
+                        s.reflected.lane(k)
                     } else {
                         Vec3::ZERO
                     };

@@ -25,12 +25,14 @@
 //! On a purely diffuse material only the light is sampled (weight 1).
 
 use crate::direct::{blocker, SampleContext, ShadingPoint};
+use crate::light_samples::LANES_FROM_SAMPLES;
 use crate::sampling::DimensionPair;
 use crate::trace::{Event, Shadow, Skip, Technique, Tracer};
 use crate::{DirectIntegrator, Scene, ShadingCounters, Skips};
-use glam::Vec3;
-use glint_geometry::{spawn_ray, spawn_ray_to, Occluders, RayTarget};
-use glint_lighting::{AreaLight, Light, PointLight, SphereLight};
+use glam::{Vec2, Vec3};
+use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
+use glint_geometry::{offset_ray_origin, spawn_ray, spawn_ray_to, Occluders, RayLanes, RayTarget};
+use glint_lighting::{AreaLight, AreaLightSampler, Light, PointLight, SphereLight};
 
 impl DirectIntegrator {
     /// The local shading of `point` in physical units, `depth` reflections deep.
@@ -86,12 +88,19 @@ impl DirectIntegrator {
         let mis = self.mis && point.has_specular;
         let samples = self.draw_light_points(pair, ctx);
         let occluders = self.occluders(scene, point, index, light, ctx);
-        let mut sum = Vec3::ZERO;
-        for &u in &samples {
-            let s = sampler.sample(u);
-            let target = light.shadow_target(s.point);
-            sum += point.light_sample(scene, &target, s.pdf, mis, &occluders, ctx);
-        }
+        let mut sum = if T::ON || samples.len() < LANES_FROM_SAMPLES {
+            let mut sum = Vec3::ZERO;
+            for &u in &samples {
+                let s = sampler.sample(u);
+                let target = light.shadow_target(s.point);
+                sum += point.light_sample(scene, &target, s.pdf, mis, &occluders, ctx);
+            }
+            sum
+        } else {
+            point.light_samples_shadowed_in_lanes(
+                scene, light, &sampler, &samples, mis, &occluders, ctx,
+            )
+        };
         ctx.light_points = samples;
         if mis {
             sum += self.lobe_samples(scene, point, index, depth, |y| sampler.pdf(y), ctx);
@@ -247,61 +256,145 @@ impl ShadingPoint<'_> {
         occluders: &Occluders,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let record = |ctx: &mut SampleContext<T>, f_cos: Vec3, shadow: Shadow, value: Vec3| {
-            ctx.tracer.record(|| {
-                let l = (target.point - self.hit.point).normalize_or_zero();
-                let lobe_pdf = if mis {
-                    self.material.specular_pdf(self.n, l, self.v)
-                } else {
-                    0.0
-                };
-                Event::PhysicalSample {
-                    technique: Technique::Light,
-                    l,
-                    f_cos,
-                    light_pdf: pdf,
-                    lobe_pdf,
-                    weight: if mis {
-                        power_heuristic(pdf, lobe_pdf)
-                    } else {
-                        1.0
-                    },
-                    shadow,
-                    value,
-                }
-            })
-        };
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            ctx.counters.light_skips.zero_density += 1;
-            record(ctx, Vec3::ZERO, Shadow::Skipped(Skip::ZeroPdf), Vec3::ZERO);
-            return Vec3::ZERO;
-        }
-        let Some(l) = (target.point - self.hit.point).try_normalize() else {
-            // The light's point is the shading point: counted as below the surface.
-            ctx.counters.light_skips.below_surface += 1;
+        let Some((f, value)) = self.light_sample_unshadowed(target, pdf, mis, ctx) else {
             return Vec3::ZERO;
         };
-        let Some(f) = self.reflection_towards(l, light_skips, ctx) else {
-            record(ctx, Vec3::ZERO, self.skip_reason(l), Vec3::ZERO);
-            return Vec3::ZERO;
-        };
-        ctx.counters.light_shadow_rays += 1;
         let shadow = spawn_ray_to(self.hit, target);
         if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
             if T::ON {
                 // Finding the blocker costs a query: only when tracing.
-                record(ctx, f, blocker(scene, &shadow, 1.0), Vec3::ZERO);
+                let blocked = blocker(scene, &shadow, 1.0);
+                self.record_physical_sample(ctx, target, pdf, mis, f, blocked, Vec3::ZERO);
             }
             return Vec3::ZERO;
         }
+        self.record_physical_sample(ctx, target, pdf, mis, f, Shadow::Unoccluded, value);
+        value
+    }
+
+    /// The sum of [`Self::light_sample`] over `samples` (coordinates on
+    /// `light`, drawn by `sampler`), in order: each sample up to its shadow ray
+    /// one by one, then the shadow rays of [`LANES`] samples tested together,
+    /// as [`ShadingPoint::area_light_sum`] does (the same origins and ends, so
+    /// the same answers and the same sum, bit for bit).
+    #[allow(clippy::too_many_arguments)]
+    fn light_samples_shadowed_in_lanes<T: Tracer>(
+        &self,
+        scene: &Scene,
+        light: &AreaLight,
+        sampler: &AreaLightSampler,
+        samples: &[Vec2],
+        mis: bool,
+        occluders: &Occluders,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
+        let (point, normal) = (self.hit.point, self.hit.geometric_normal);
+        let origins = [
+            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, normal)),
+            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, -normal)),
+        ];
+        let mut sum = Vec3::ZERO;
+        for chunk in samples.chunks(LANES) {
+            let mut values = [Vec3::ZERO; LANES];
+            let mut positions = [point; LANES];
+            let mut traced = 0u32;
+            for (k, &u) in chunk.iter().enumerate() {
+                let s = sampler.sample(u);
+                let target = light.shadow_target(s.point);
+                if let Some((_, value)) = self.light_sample_unshadowed(&target, s.pdf, mis, ctx) {
+                    (values[k], positions[k]) = (value, s.point);
+                    traced |= 1 << k;
+                }
+            }
+            let position = Vec3Lanes::from_lanes(positions);
+            let from_back = lanes::lt(position.sub_splat(point).dot_splat(normal), F32Lanes::ZERO);
+            let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);
+            let rays = RayLanes {
+                origin,
+                direction: light.shadow_ends(&position) - origin,
+            };
+            let visible = traced & !scene.shapes.any_hits_among(occluders, &rays, 1.0, traced);
+            for (k, value) in values.iter().enumerate().take(chunk.len()) {
+                sum += if visible >> k & 1 == 1 {
+                    *value
+                } else {
+                    Vec3::ZERO
+                };
+            }
+        }
+        sum
+    }
+
+    /// [`Self::light_sample`] short of its shadow ray: the sample's `f · cos θ`
+    /// and its value `f · cos θ · w / p` if unblocked, or `None` (counted, and
+    /// recorded) where it needs no shadow ray. Counts the shadow ray it needs.
+    fn light_sample_unshadowed<T: Tracer>(
+        &self,
+        target: &RayTarget,
+        pdf: f32,
+        mis: bool,
+        ctx: &mut SampleContext<T>,
+    ) -> Option<(Vec3, Vec3)> {
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            ctx.counters.light_skips.zero_density += 1;
+            let skipped = Shadow::Skipped(Skip::ZeroPdf);
+            self.record_physical_sample(ctx, target, pdf, mis, Vec3::ZERO, skipped, Vec3::ZERO);
+            return None;
+        }
+        let Some(l) = (target.point - self.hit.point).try_normalize() else {
+            // The light's point is the shading point: counted as below the surface.
+            ctx.counters.light_skips.below_surface += 1;
+            return None;
+        };
+        let Some(f) = self.reflection_towards(l, light_skips, ctx) else {
+            let skipped = self.skip_reason(l);
+            self.record_physical_sample(ctx, target, pdf, mis, Vec3::ZERO, skipped, Vec3::ZERO);
+            return None;
+        };
+        ctx.counters.light_shadow_rays += 1;
         let weight = if mis {
             power_heuristic(pdf, self.material.specular_pdf(self.n, l, self.v))
         } else {
             1.0
         };
-        let value = f * (weight / pdf);
-        record(ctx, f, Shadow::Unoccluded, value);
-        value
+        Some((f, f * (weight / pdf)))
+    }
+
+    /// Tells the tracer of a light sample towards `target` (density `pdf`):
+    /// its `f · cos θ`, its shadow ray's fate and its value.
+    #[allow(clippy::too_many_arguments)]
+    fn record_physical_sample<T: Tracer>(
+        &self,
+        ctx: &mut SampleContext<T>,
+        target: &RayTarget,
+        pdf: f32,
+        mis: bool,
+        f_cos: Vec3,
+        shadow: Shadow,
+        value: Vec3,
+    ) {
+        ctx.tracer.record(|| {
+            let l = (target.point - self.hit.point).normalize_or_zero();
+            let lobe_pdf = if mis {
+                self.material.specular_pdf(self.n, l, self.v)
+            } else {
+                0.0
+            };
+            Event::PhysicalSample {
+                technique: Technique::Light,
+                l,
+                f_cos,
+                light_pdf: pdf,
+                lobe_pdf,
+                weight: if mis {
+                    power_heuristic(pdf, lobe_pdf)
+                } else {
+                    1.0
+                },
+                shadow,
+                value,
+            }
+        })
     }
 
     /// One specular-lobe sample's `f · cos θ · V · w / p` towards the light

@@ -31,7 +31,8 @@ fn bits(v: Vec3) -> [u32; 3] {
 /// Each case takes another of the render loop's paths: whole samples in
 /// lanes (one light sample), first hits in lanes with light samples in lanes,
 /// the scalar path with footprints, mirrors and environment samples, the BVH,
-/// and physical shading with MIS.
+/// and physical shading with MIS and without (its light samples' shadow rays
+/// in lanes when rendered, one by one when explained).
 fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
     let size = UVec2::new(24, 18);
     let few = |s: &mut RenderSettings| {
@@ -56,6 +57,7 @@ fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
         ("ground-mipmap", scene("ground-mipmap", size, few)),
         ("bunny-cornell", scene("bunny-cornell", size, few)),
         ("physical-glossy", scene("physical-glossy", size, few)),
+        ("cornell-physical", scene("cornell-physical", size, few)),
     ]
     .into_iter()
     .map(|(name, (scene, settings))| (name, scene, settings))

@@ -295,18 +295,11 @@ impl ShadingPoint<'_> {
         ];
         let mut sum = Vec3::ZERO;
         for chunk in samples.chunks(LANES) {
-            let mut values = [Vec3::ZERO; LANES];
-            let mut positions = [point; LANES];
-            let mut traced = 0u32;
-            for (k, &u) in chunk.iter().enumerate() {
-                let s = sampler.sample(u);
-                let target = light.shadow_target(s.point);
-                if let Some((_, value)) = self.light_sample_unshadowed(&target, s.pdf, mis, ctx) {
-                    (values[k], positions[k]) = (value, s.point);
-                    traced |= 1 << k;
-                }
-            }
-            let position = Vec3Lanes::from_lanes(positions);
+            let (position, values, traced) = if self.has_specular {
+                self.unshadowed_one_by_one(light, sampler, chunk, mis, ctx)
+            } else {
+                self.unshadowed_diffuse_lanes(sampler, chunk, ctx)
+            };
             let from_back = lanes::lt(position.sub_splat(point).dot_splat(normal), F32Lanes::ZERO);
             let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);
             let rays = RayLanes {
@@ -323,6 +316,70 @@ impl ShadingPoint<'_> {
             }
         }
         sum
+    }
+
+    /// Up to [`LANES`] light samples short of their shadow rays, one by one
+    /// ([`Self::light_sample_unshadowed`]): each lane's light point, its value
+    /// if unblocked, and the lanes that need a shadow ray.
+    fn unshadowed_one_by_one<T: Tracer>(
+        &self,
+        light: &AreaLight,
+        sampler: &AreaLightSampler,
+        chunk: &[Vec2],
+        mis: bool,
+        ctx: &mut SampleContext<T>,
+    ) -> (Vec3Lanes, [Vec3; LANES], u32) {
+        let mut values = [Vec3::ZERO; LANES];
+        let mut positions = [self.hit.point; LANES];
+        let mut traced = 0u32;
+        for (k, &u) in chunk.iter().enumerate() {
+            let s = sampler.sample(u);
+            let target = light.shadow_target(s.point);
+            if let Some((_, value)) = self.light_sample_unshadowed(&target, s.pdf, mis, ctx) {
+                (values[k], positions[k]) = (value, s.point);
+                traced |= 1 << k;
+            }
+        }
+        (Vec3Lanes::from_lanes(positions), values, traced)
+    }
+
+    /// [`Self::unshadowed_one_by_one`] for a diffuse point (no lobe, so no
+    /// MIS), the direction, horizon test and `kd/π · cos θ / p` in lanes: each
+    /// lane [`Self::light_sample_unshadowed`]'s value and counts, bit for bit.
+    fn unshadowed_diffuse_lanes<T: Tracer>(
+        &self,
+        sampler: &AreaLightSampler,
+        chunk: &[Vec2],
+        ctx: &mut SampleContext<T>,
+    ) -> (Vec3Lanes, [Vec3; LANES], u32) {
+        let mut positions = [self.hit.point; LANES];
+        let mut pdfs = [0.0; LANES];
+        for (k, &u) in chunk.iter().enumerate() {
+            let s = sampler.sample(u);
+            (positions[k], pdfs[k]) = (s.point, s.pdf);
+        }
+        let (position, pdf) = (Vec3Lanes::from_lanes(positions), F32Lanes::new(pdfs));
+        let used = lanes::bits(lanes::first_lanes(chunk.len()));
+        let dense = used & lanes::bits(lanes::gt(pdf, F32Lanes::ZERO) & pdf.is_finite());
+        let (l, normalized) = position.sub_splat(self.hit.point).try_normalize();
+        let above = lanes::bits(normalized & lanes::gt(l.dot_splat(self.ng), F32Lanes::ZERO));
+        // `brdf_cos_diffuse`: kd/π · n·l, zero where n·l ≤ 0.
+        let n_dot_l = l.dot_splat(self.n);
+        let f = Vec3Lanes::scaled_splat(self.kd * std::f32::consts::FRAC_1_PI, n_dot_l);
+        let f = Vec3Lanes::select(
+            lanes::le(n_dot_l, F32Lanes::ZERO),
+            &Vec3Lanes::default(),
+            &f,
+        );
+        let reflects = dense & above & !lanes::bits(f.is_zero());
+        let skips = &mut ctx.counters.light_skips;
+        skips.zero_density += u64::from((used & !dense).count_ones());
+        skips.below_surface += u64::from((dense & !above).count_ones());
+        skips.zero_brdf += u64::from((dense & above & !reflects).count_ones());
+        ctx.counters.light_shadow_rays += u64::from(reflects.count_ones());
+        let value = f.scale(F32Lanes::ONE / pdf);
+        let values = std::array::from_fn(|k| value.lane(k));
+        (position, values, reflects)
     }
 
     /// [`Self::light_sample`] short of its shadow ray: the sample's `f · cos θ`

@@ -7,8 +7,9 @@
 //! holds in every lane), as Mitsuba 3 writes its code once over its `Float`.
 //! Each lane performs the IEEE operation the scalar type performs, so a lane's
 //! result is bit for bit the scalar one; `min` and `max` keep each type's own
-//! NaN rule ([`f32::min`] returns the other operand, a SIMD `min` the second),
-//! which matters only where an input is already NaN.
+//! NaN rule ([`f32::min`] returns the non-NaN operand; `wide`'s `min` leaves
+//! it to the instruction, `minps` returning the second operand), which matters
+//! only where an input is already NaN.
 
 use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, BitOrAssign, Div, Mul, Neg, Not, Sub};

@@ -1,4 +1,5 @@
 use crate::counters::{ShadingCounters, TextureCounters};
+use crate::light_samples::LANES_FROM_SAMPLES;
 use crate::sampling::Pcg32;
 use crate::sampling::{DimensionPair, PixelSample, SamplePattern, MAX_JOINT};
 use crate::settings::RenderSettings;
@@ -6,10 +7,15 @@ use crate::texture_lookup::texture_footprint;
 use crate::trace::{Event, Shadow, Skip, Tracer};
 use crate::{Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
+use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{
-    reflect_differential, spawn_ray, spawn_ray_to, Hit, Occluders, Ray, RayDifferential, RayTarget,
+    offset_ray_origin, reflect_differential, spawn_ray, spawn_ray_to, Hit, Occluders, Ray,
+    RayDifferential, RayLanes, RayTarget,
 };
-use glint_lighting::{AreaLight, AreaSampling, Light, PhongMaterial, ShadingModel};
+use glint_lighting::{
+    AreaLight, AreaSampling, EnvironmentLight, EnvironmentSample, Light, PhongMaterial,
+    ShadingModel,
+};
 use glint_texture::TexCoord;
 
 /// From this many samples per area light on, each shading point first culls the
@@ -471,55 +477,127 @@ impl DirectIntegrator {
         self.environment_pattern
             .fill(&mut ctx.rng, sobol, &mut samples);
         ctx.counters.environment_samples += samples.len() as u64;
-        let mut sum = Vec3::ZERO;
-        for &u in &samples {
-            let s = env.sample(point.n, u);
-            let record = |ctx: &mut SampleContext<T>, f_cos: Vec3, shadow: Shadow, value: Vec3| {
-                ctx.tracer.record(|| Event::EnvironmentSample {
-                    direction: s.direction,
-                    pdf: s.pdf,
-                    radiance: s.radiance,
-                    f_cos,
-                    shadow,
-                    value,
-                })
-            };
-            if s.pdf.is_nan() || s.pdf <= 0.0 || s.radiance == Vec3::ZERO {
-                ctx.counters.environment_skips.zero_density += 1;
-                record(ctx, Vec3::ZERO, Shadow::Skipped(Skip::ZeroPdf), Vec3::ZERO);
-                continue;
+        let sum = if T::ON || samples.len() < LANES_FROM_SAMPLES {
+            let mut sum = Vec3::ZERO;
+            for &u in &samples {
+                let s = env.sample(point.n, u);
+                let Some((f, value)) = point.environment_sample_unshadowed(&s, ctx) else {
+                    continue;
+                };
+                let shadow_ray = spawn_ray(point.hit, s.direction);
+                if !scene.shapes.any_hit(&shadow_ray, f32::INFINITY) {
+                    record_environment_sample(ctx, &s, f, Shadow::Unoccluded, value);
+                    sum += value;
+                } else if T::ON {
+                    // Finding the blocker costs a query: only when tracing.
+                    let shadow = blocker(scene, &shadow_ray, f32::INFINITY);
+                    record_environment_sample(ctx, &s, f, shadow, Vec3::ZERO);
+                }
             }
-            if !point.above_surface(s.direction) {
-                ctx.counters.environment_skips.below_surface += 1;
-                record(
-                    ctx,
-                    Vec3::ZERO,
-                    Shadow::Skipped(Skip::BehindSurface),
-                    Vec3::ZERO,
-                );
-                continue;
-            }
-            let f = point.brdf_cos(s.direction, ctx);
-            if f == Vec3::ZERO {
-                ctx.counters.environment_skips.zero_brdf += 1;
-                record(ctx, f, Shadow::Skipped(Skip::ZeroBrdf), Vec3::ZERO);
-                continue;
-            }
-            ctx.counters.environment_shadow_rays += 1;
-            let shadow_ray = spawn_ray(point.hit, s.direction);
-            if !scene.shapes.any_hit(&shadow_ray, f32::INFINITY) {
-                let value = s.radiance * f / s.pdf;
-                record(ctx, f, Shadow::Unoccluded, value);
-                sum += value;
-            } else if T::ON {
-                // Finding the blocker costs a query: only when tracing.
-                let shadow = blocker(scene, &shadow_ray, f32::INFINITY);
-                record(ctx, f, shadow, Vec3::ZERO);
-            }
-        }
+            sum
+        } else {
+            point.environment_sum_in_lanes(scene, env, &samples, ctx)
+        };
         ctx.environment_points = samples;
         sum / self.environment_samples as f32
     }
+}
+
+impl ShadingPoint<'_> {
+    /// An environment sample short of its shadow ray: its `f · cos θ` and its
+    /// value `L · f · cos θ / p` if unblocked, or `None` (counted, and
+    /// recorded) where it needs no shadow ray. Counts the shadow ray it needs.
+    fn environment_sample_unshadowed<T: Tracer>(
+        &self,
+        s: &EnvironmentSample,
+        ctx: &mut SampleContext<T>,
+    ) -> Option<(Vec3, Vec3)> {
+        if s.pdf.is_nan() || s.pdf <= 0.0 || s.radiance == Vec3::ZERO {
+            ctx.counters.environment_skips.zero_density += 1;
+            let skipped = Shadow::Skipped(Skip::ZeroPdf);
+            record_environment_sample(ctx, s, Vec3::ZERO, skipped, Vec3::ZERO);
+            return None;
+        }
+        if !self.above_surface(s.direction) {
+            ctx.counters.environment_skips.below_surface += 1;
+            let skipped = Shadow::Skipped(Skip::BehindSurface);
+            record_environment_sample(ctx, s, Vec3::ZERO, skipped, Vec3::ZERO);
+            return None;
+        }
+        let f = self.brdf_cos(s.direction, ctx);
+        if f == Vec3::ZERO {
+            ctx.counters.environment_skips.zero_brdf += 1;
+            record_environment_sample(ctx, s, f, Shadow::Skipped(Skip::ZeroBrdf), Vec3::ZERO);
+            return None;
+        }
+        ctx.counters.environment_shadow_rays += 1;
+        Some((f, s.radiance * f / s.pdf))
+    }
+
+    /// The sum of the unblocked environment samples' values over `samples`,
+    /// in order: each sample up to its shadow ray one by one, then the shadow
+    /// rays of [`LANES`] samples tested together (the origins of `spawn_ray`,
+    /// so the same answers and the same sum, bit for bit).
+    fn environment_sum_in_lanes<T: Tracer>(
+        &self,
+        scene: &Scene,
+        env: &EnvironmentLight,
+        samples: &[Vec2],
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
+        let (point, normal) = (self.hit.point, self.hit.geometric_normal);
+        let origins = [
+            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, normal)),
+            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, -normal)),
+        ];
+        let mut sum = Vec3::ZERO;
+        for chunk in samples.chunks(LANES) {
+            let mut values = [Vec3::ZERO; LANES];
+            let mut directions = [normal; LANES];
+            let mut traced = 0u32;
+            for (k, &u) in chunk.iter().enumerate() {
+                let s = env.sample(self.n, u);
+                if let Some((_, value)) = self.environment_sample_unshadowed(&s, ctx) {
+                    (values[k], directions[k]) = (value, s.direction);
+                    traced |= 1 << k;
+                }
+            }
+            let direction = Vec3Lanes::from_lanes(directions);
+            let from_back = lanes::lt(direction.dot_splat(normal), F32Lanes::ZERO);
+            let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);
+            let rays = RayLanes { origin, direction };
+            let blocked =
+                scene
+                    .shapes
+                    .any_hits_among(&Occluders::ALL, &rays, f32::INFINITY, traced);
+            let visible = traced & !blocked;
+            for (k, value) in values.iter().enumerate().take(chunk.len()) {
+                if visible >> k & 1 == 1 {
+                    sum += *value;
+                }
+            }
+        }
+        sum
+    }
+}
+
+/// Tells the tracer of environment sample `s`: its `f · cos θ`, its shadow
+/// ray's fate and its value.
+fn record_environment_sample<T: Tracer>(
+    ctx: &mut SampleContext<T>,
+    s: &EnvironmentSample,
+    f_cos: Vec3,
+    shadow: Shadow,
+    value: Vec3,
+) {
+    ctx.tracer.record(|| Event::EnvironmentSample {
+        direction: s.direction,
+        pdf: s.pdf,
+        radiance: s.radiance,
+        f_cos,
+        shadow,
+        value,
+    })
 }
 
 /// A surface point being shaded: the hit, its material and reflectances, the

@@ -504,6 +504,16 @@ impl DirectIntegrator {
 }
 
 impl ShadingPoint<'_> {
+    /// The origins of this point's shadow rays, for rays tested in lanes.
+    pub(crate) fn shadow_origins(&self) -> ShadowOrigins {
+        let (point, error, normal) = (self.hit.point, self.hit.error, self.hit.geometric_normal);
+        ShadowOrigins {
+            front: Vec3Lanes::splat(offset_ray_origin(point, error, normal)),
+            back: Vec3Lanes::splat(offset_ray_origin(point, error, -normal)),
+            normal,
+        }
+    }
+
     /// An environment sample short of its shadow ray: its `f · cos θ` and its
     /// value `L · f · cos θ / p` if unblocked, or `None` (counted, and
     /// recorded) where it needs no shadow ray. Counts the shadow ray it needs.
@@ -545,15 +555,11 @@ impl ShadingPoint<'_> {
         samples: &[Vec2],
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let (point, normal) = (self.hit.point, self.hit.geometric_normal);
-        let origins = [
-            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, normal)),
-            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, -normal)),
-        ];
+        let origins = self.shadow_origins();
         let mut sum = Vec3::ZERO;
         for chunk in samples.chunks(LANES) {
             let mut values = [Vec3::ZERO; LANES];
-            let mut directions = [normal; LANES];
+            let mut directions = [self.hit.geometric_normal; LANES];
             let mut traced = 0u32;
             for (k, &u) in chunk.iter().enumerate() {
                 let s = env.sample(self.n, u);
@@ -563,8 +569,7 @@ impl ShadingPoint<'_> {
                 }
             }
             let direction = Vec3Lanes::from_lanes(directions);
-            let from_back = lanes::lt(direction.dot_splat(normal), F32Lanes::ZERO);
-            let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);
+            let origin = origins.leaving_towards(&direction);
             let rays = RayLanes { origin, direction };
             let blocked =
                 scene
@@ -578,6 +583,24 @@ impl ShadingPoint<'_> {
             }
         }
         sum
+    }
+}
+
+/// The origins of a shading point's shadow rays in lanes: its point offset
+/// to either side of its surface, made once for all its samples.
+pub(crate) struct ShadowOrigins {
+    front: Vec3Lanes,
+    back: Vec3Lanes,
+    normal: Vec3,
+}
+
+impl ShadowOrigins {
+    /// Each lane's origin on the side of the surface its direction `towards`
+    /// leaves on, as `spawn_ray` and `spawn_ray_to` choose it.
+    #[inline]
+    pub(crate) fn leaving_towards(&self, towards: &Vec3Lanes) -> Vec3Lanes {
+        let from_back = lanes::lt(towards.dot_splat(self.normal), F32Lanes::ZERO);
+        Vec3Lanes::select(from_back, &self.back, &self.front)
     }
 }
 

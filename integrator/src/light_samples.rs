@@ -18,7 +18,7 @@ use crate::trace::{Shadow, Skip, Tracer};
 use crate::{Scene, ShadingCounters};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
-use glint_geometry::{offset_ray_origin, Occluders, RayLanes};
+use glint_geometry::{Occluders, RayLanes};
 use glint_lighting::AreaLight;
 
 /// One sample of an area light per lane, seen from each lane's receiving point,
@@ -88,13 +88,7 @@ impl ShadingPoint<'_> {
             return self.area_light_sum_one_by_one(scene, light, samples, occluders, ctx);
         }
         let point = self.hit.point;
-        let normal = self.hit.geometric_normal;
-        // A shadow ray leaves from the side of the surface its target is on: one of
-        // two offset origins, the same for all of the point's samples.
-        let origins = [
-            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, normal)),
-            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, -normal)),
-        ];
+        let origins = self.shadow_origins();
         let mut sum = Vec3::ZERO;
         let (receiver, ng) = (Vec3Lanes::splat(point), Vec3Lanes::splat(self.ng));
         for chunk in samples.chunks(LANES) {
@@ -105,9 +99,8 @@ impl ShadingPoint<'_> {
                     .reflect_lanes(kd, ks, n, l, v, self.has_specular)
             };
             let s = LightSampleLanes::new(light, gather(chunk), &receiver, &ng, used, reflect);
-            let from_back = lanes::lt(s.towards.dot_splat(normal), F32Lanes::ZERO);
             self.count(ctx, used, s.lit, s.shaded, s.traced);
-            let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);
+            let origin = origins.leaving_towards(&s.towards);
             let shadow_rays = RayLanes {
                 origin,
                 direction: light.shadow_ends(&s.position) - origin,

@@ -31,7 +31,7 @@ use crate::trace::{Event, Shadow, Skip, Technique, Tracer};
 use crate::{DirectIntegrator, Scene, ShadingCounters, Skips};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
-use glint_geometry::{offset_ray_origin, spawn_ray, spawn_ray_to, Occluders, RayLanes, RayTarget};
+use glint_geometry::{spawn_ray, spawn_ray_to, Occluders, RayLanes, RayTarget};
 use glint_lighting::{AreaLight, AreaLightSampler, Light, PointLight, SphereLight};
 
 impl DirectIntegrator {
@@ -288,11 +288,7 @@ impl ShadingPoint<'_> {
         occluders: &Occluders,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let (point, normal) = (self.hit.point, self.hit.geometric_normal);
-        let origins = [
-            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, normal)),
-            Vec3Lanes::splat(offset_ray_origin(point, self.hit.error, -normal)),
-        ];
+        let origins = self.shadow_origins();
         let mut sum = Vec3::ZERO;
         for chunk in samples.chunks(LANES) {
             let (position, values, traced) = if self.has_specular {
@@ -300,8 +296,7 @@ impl ShadingPoint<'_> {
             } else {
                 self.unshadowed_diffuse_lanes(sampler, chunk, ctx)
             };
-            let from_back = lanes::lt(position.sub_splat(point).dot_splat(normal), F32Lanes::ZERO);
-            let origin = Vec3Lanes::select(from_back, &origins[1], &origins[0]);
+            let origin = origins.leaving_towards(&position.sub_splat(self.hit.point));
             let rays = RayLanes {
                 origin,
                 direction: light.shadow_ends(&position) - origin,

@@ -9,7 +9,7 @@
 //! magnitude of the point, as its error does, and with nothing else: there is no
 //! fixed epsilon.
 
-use crate::lanes::{self, F32Lanes, Vec3Lanes};
+use crate::lanes::{Float, Vec3Lanes, Vector3};
 use crate::{Hit, Ray};
 use glam::Vec3;
 
@@ -17,39 +17,33 @@ use glam::Vec3;
 /// to the side that the unit `normal` points to.
 #[inline(always)]
 pub fn offset_ray_origin(point: Vec3, error: Vec3, normal: Vec3) -> Vec3 {
-    let d = normal.abs().dot(error);
-    let offset = d * normal;
-    let moved = point + offset;
-    // Both neighbours, then a choice: selects rather than branches on the
-    // offset's sign, which varies unpredictably from point to point.
-    let away = |p: f32, o: f32| {
-        let (up, down) = (p.next_up(), p.next_down());
-        let up_or_p = if o > 0.0 { up } else { p };
-        if o < 0.0 {
-            down
-        } else {
-            up_or_p
-        }
-    };
-    Vec3::new(
-        away(moved.x, offset.x),
-        away(moved.y, offset.y),
-        away(moved.z, offset.z),
-    )
+    offset_origin(&point.into(), &error.into(), &normal.into()).into()
 }
 
 /// [`offset_ray_origin`] for [`LANES`](crate::lanes::LANES) points at once, each
 /// lane bit for bit the scalar origin.
 #[inline]
 pub fn offset_ray_origins(point: &Vec3Lanes, error: &Vec3Lanes, normal: &Vec3Lanes) -> Vec3Lanes {
+    offset_origin(point, error, normal)
+}
+
+/// The one kernel of both: `point + (|n|·error)·n`, then each coordinate one
+/// float further the way it moved. Selects rather than branches on the
+/// offset's sign, which varies unpredictably from point to point.
+#[inline(always)]
+fn offset_origin<F: Float>(
+    point: &Vector3<F>,
+    error: &Vector3<F>,
+    normal: &Vector3<F>,
+) -> Vector3<F> {
     let d = normal.abs().dot(error);
     let offset = normal.scale(d);
     let moved = *point + offset;
-    let away = |p: F32Lanes, o: F32Lanes| {
-        let down = lanes::lt(o, F32Lanes::ZERO).select(lanes::next_down(p), p);
-        lanes::gt(o, F32Lanes::ZERO).select(lanes::next_up(p), down)
+    let away = |p: F, o: F| {
+        let down = F::select(o.lt(F::ZERO), p.next_down(), p);
+        F::select(o.gt(F::ZERO), p.next_up(), down)
     };
-    Vec3Lanes {
+    Vector3 {
         x: away(moved.x, offset.x),
         y: away(moved.y, offset.y),
         z: away(moved.z, offset.z),

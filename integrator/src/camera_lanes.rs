@@ -112,7 +112,10 @@ impl DirectIntegrator {
     }
 
     /// The light-sample point of pair `pair` of each of the `lanes` camera
-    /// samples, from the light pattern (grid or Sobol: nothing to draw).
+    /// samples, from the light pattern (grid or Sobol: nothing to draw). With
+    /// one point per camera sample, the lanes' Sobol points are consecutive
+    /// points of the pixel's one sequence for `pair`, filled together (the
+    /// sequence hashed once, not once a lane).
     fn pattern_points<T: Tracer>(
         &self,
         samples: &[PixelSample; LANES],
@@ -120,14 +123,20 @@ impl DirectIntegrator {
         lanes: u32,
         ctx: &mut SampleContext<T>,
     ) -> (F32Lanes, F32Lanes) {
-        let u: [Vec2; LANES] = std::array::from_fn(|k| {
-            let mut u = [Vec2::ZERO];
-            if lanes >> k & 1 == 1 {
-                let sobol = samples[k].sobol_points(pair, 1);
-                self.light_pattern.fill(&mut ctx.rng, sobol, &mut u);
+        let mut u = [Vec2::ZERO; LANES];
+        if self.light_pattern == SamplePattern::Sobol {
+            let sobol = samples[0].sobol_points(pair, 1);
+            let sequences = &mut ctx.sequences;
+            (self.light_pattern).fill_cached(&mut ctx.rng, sobol, sequences, &mut u);
+        } else {
+            for (k, u) in u.iter_mut().enumerate() {
+                if lanes >> k & 1 == 1 {
+                    let sobol = samples[k].sobol_points(pair, 1);
+                    self.light_pattern
+                        .fill(&mut ctx.rng, sobol, std::slice::from_mut(u));
+                }
             }
-            u[0]
-        });
+        }
         (F32Lanes::new(u.map(|u| u.x)), F32Lanes::new(u.map(|u| u.y)))
     }
 }

@@ -1,7 +1,7 @@
 use crate::counters::{ShadingCounters, TextureCounters};
 use crate::light_samples::LANES_FROM_SAMPLES;
 use crate::sampling::Pcg32;
-use crate::sampling::{DimensionPair, PixelSample, SamplePattern, MAX_JOINT};
+use crate::sampling::{DimensionPair, PixelSample, SamplePattern, SequenceCache, MAX_JOINT};
 use crate::settings::RenderSettings;
 use crate::texture_lookup::texture_footprint;
 use crate::trace::{Event, Shadow, Skip, Tracer};
@@ -73,6 +73,8 @@ pub struct SampleContext<T: Tracer = ()> {
     pub tracer: T,
     /// The last culling of shadow-ray occluders, for the next points near it.
     occluders: Option<CachedOccluders>,
+    /// The Sobol sequences of the pixel's pairs, hashed once for its samples.
+    pub(crate) sequences: SequenceCache,
 }
 
 /// The shapes that may block shadow rays to one area light from anywhere
@@ -106,6 +108,7 @@ impl<T: Tracer> SampleContext<T> {
             detailed: false,
             tracer,
             occluders: None,
+            sequences: SequenceCache::default(),
         }
     }
 
@@ -118,6 +121,20 @@ impl<T: Tracer> SampleContext<T> {
             sample,
         };
         self.rng = self.sample.rng();
+    }
+
+    /// Fills `out` with this camera sample's points of `pair` in `pattern`, as
+    /// [`SamplePattern::fill`] does with [`PixelSample::sobol_points`]`(pair,
+    /// out.len())`.
+    #[inline]
+    pub(crate) fn fill_points(
+        &mut self,
+        pattern: SamplePattern,
+        pair: DimensionPair,
+        out: &mut [Vec2],
+    ) {
+        let sobol = self.sample.sobol_points(pair, out.len() as u32);
+        pattern.fill_cached(&mut self.rng, sobol, &mut self.sequences, out);
     }
 }
 
@@ -411,8 +428,7 @@ impl DirectIntegrator {
         ctx: &mut SampleContext<T>,
     ) -> Vec<Vec2> {
         let mut samples = std::mem::take(&mut ctx.light_points);
-        let sobol = ctx.sample.sobol_points(pair, self.light_samples);
-        self.light_pattern.fill(&mut ctx.rng, sobol, &mut samples);
+        ctx.fill_points(self.light_pattern, pair, &mut samples);
         samples
     }
 
@@ -473,9 +489,7 @@ impl DirectIntegrator {
             return Vec3::ZERO;
         };
         let mut samples = std::mem::take(&mut ctx.environment_points);
-        let sobol = ctx.sample.sobol_points(pair, self.environment_samples);
-        self.environment_pattern
-            .fill(&mut ctx.rng, sobol, &mut samples);
+        ctx.fill_points(self.environment_pattern, pair, &mut samples);
         ctx.counters.environment_samples += samples.len() as u64;
         let sum = if T::ON || samples.len() < LANES_FROM_SAMPLES {
             let mut sum = Vec3::ZERO;
@@ -505,6 +519,8 @@ impl DirectIntegrator {
 
 impl ShadingPoint<'_> {
     /// The origins of this point's shadow rays, for rays tested in lanes.
+    /// Inlined: returned through memory, the lanes cost a store-forwarding stall.
+    #[inline(always)]
     pub(crate) fn shadow_origins(&self) -> ShadowOrigins {
         let (point, error, normal) = (self.hit.point, self.hit.error, self.hit.geometric_normal);
         ShadowOrigins {

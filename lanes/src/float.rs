@@ -61,6 +61,14 @@ pub trait Float:
     fn eq(self, other: Self) -> Self::Mask;
     /// Per lane, `if_true` where `mask` holds, else `if_false`.
     fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
+    /// [`f32::next_up`]: the least float greater than `self` (∞ and NaN kept,
+    /// −0 and +0 both to the least positive float), without a branch.
+    fn next_up(self) -> Self;
+    /// [`f32::next_down`]: `−next_up(−self)`.
+    #[inline(always)]
+    fn next_down(self) -> Self {
+        -(-self).next_up()
+    }
     /// `self` in `(0, t_max)`, the open range of a ray's valid distances.
     #[inline(always)]
     fn in_ray_range(self, t_max: Self) -> Self::Mask {
@@ -146,12 +154,26 @@ impl Float for f32 {
             if_false
         }
     }
+    #[inline(always)]
+    fn next_up(self) -> Self {
+        // Adding +0 turns −0 into +0, whose bits stepped up are the least
+        // positive float; the step is a select, not the library's branches.
+        let zeroed = self + 0.0;
+        let bits = zeroed.to_bits();
+        let step = if zeroed >= 0.0 { 1 } else { u32::MAX };
+        let stepped = f32::from_bits(bits.wrapping_add(step));
+        if self < f32::INFINITY {
+            stepped
+        } else {
+            self
+        }
+    }
 }
 
 /// [`Float`] and [`Mask`] for a `wide` vector of f32: its masks are the same
 /// register type, each lane all ones (true) or all zeros (false).
 macro_rules! lanes_of_f32 {
-    ($t:ty, $width:expr) => {
+    ($t:ty, $i:ty, $width:expr) => {
         impl Mask for $t {
             const TRUE: Self = <$t>::new([f32::from_bits(u32::MAX); $width]);
             const FALSE: Self = <$t>::ZERO;
@@ -226,10 +248,88 @@ macro_rules! lanes_of_f32 {
             fn select(mask: Self, if_true: Self, if_false: Self) -> Self {
                 mask.select(if_true, if_false)
             }
+            #[inline(always)]
+            fn next_up(self) -> Self {
+                // As for `f32`, lane by lane.
+                let zeroed = self + <$t>::ZERO;
+                let bits: $i = bytemuck::cast(zeroed);
+                let one = <$i>::splat(1);
+                let non_negative: $i = bytemuck::cast(zeroed.simd_ge(<$t>::ZERO));
+                let stepped: $t = bytemuck::cast(non_negative.select(bits + one, bits - one));
+                self.simd_lt(<$t>::splat(f32::INFINITY))
+                    .select(stepped, self)
+            }
         }
     };
 }
 
-lanes_of_f32!(wide::f32x4, 4);
-lanes_of_f32!(wide::f32x8, 8);
-lanes_of_f32!(wide::f32x16, 16);
+lanes_of_f32!(wide::f32x4, wide::i32x4, 4);
+lanes_of_f32!(wide::f32x8, wide::i32x8, 8);
+lanes_of_f32!(wide::f32x16, wide::i32x16, 16);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const VALUES: [f32; 16] = [
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        f32::MIN_POSITIVE,
+        -f32::MIN_POSITIVE,
+        f32::from_bits(1),
+        -f32::from_bits(1),
+        f32::MAX,
+        -f32::MAX,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        123.456,
+        -1e-30,
+        3e38,
+    ];
+
+    /// `F`'s `next_up` and `next_down` of `values` lane by lane, as `f32`s.
+    fn stepped<F: Float>(
+        values: &[f32],
+        lanes: impl Fn(&[f32]) -> F,
+        array: impl Fn(F) -> Vec<f32>,
+    ) {
+        for chunk in values.chunks(F::WIDTH) {
+            let mut v = chunk.to_vec();
+            v.resize(F::WIDTH, 0.0);
+            let (up, down) = (array(lanes(&v).next_up()), array(lanes(&v).next_down()));
+            for (k, x) in chunk.iter().enumerate() {
+                assert_eq!(
+                    up[k].to_bits(),
+                    x.next_up().to_bits(),
+                    "up {x}, {} lanes",
+                    F::WIDTH
+                );
+                let scalar = x.next_down().to_bits();
+                assert_eq!(down[k].to_bits(), scalar, "down {x}, {} lanes", F::WIDTH);
+            }
+        }
+    }
+
+    #[test]
+    fn next_up_and_down_are_the_library_functions_bit_for_bit_at_every_width() {
+        stepped::<f32>(&VALUES, |v| v[0], |f| vec![f]);
+        stepped::<wide::f32x4>(
+            &VALUES,
+            |v| wide::f32x4::new(v.try_into().unwrap()),
+            |f| f.to_array().to_vec(),
+        );
+        stepped::<wide::f32x8>(
+            &VALUES,
+            |v| wide::f32x8::new(v.try_into().unwrap()),
+            |f| f.to_array().to_vec(),
+        );
+        stepped::<wide::f32x16>(
+            &VALUES,
+            |v| wide::f32x16::new(v.try_into().unwrap()),
+            |f| f.to_array().to_vec(),
+        );
+    }
+}

@@ -87,25 +87,6 @@ pub fn le(a: F32Lanes, b: F32Lanes) -> F32Lanes {
     a.simd_le(b)
 }
 
-/// [`f32::next_up`] per lane: the least float greater than each lane (∞ and
-/// NaN kept, −0 and +0 both to the least positive float).
-#[inline]
-pub fn next_up(v: F32Lanes) -> F32Lanes {
-    // Adding +0 turns −0 into +0, whose bits stepped up are the least positive float.
-    let zeroed = v + F32Lanes::ZERO;
-    let bits: I32Lanes = bytemuck::cast(zeroed);
-    let one = I32Lanes::splat(1);
-    let non_negative: I32Lanes = bytemuck::cast(zeroed.simd_ge(F32Lanes::ZERO));
-    let stepped: F32Lanes = bytemuck::cast(non_negative.select(bits + one, bits - one));
-    v.simd_lt(F32Lanes::splat(f32::INFINITY)).select(stepped, v)
-}
-
-/// [`f32::next_down`] per lane: `−next_up(−v)`.
-#[inline]
-pub fn next_down(v: F32Lanes) -> F32Lanes {
-    -next_up(-v)
-}
-
 /// The lanes of `mask` as bits, lane k as bit k.
 #[inline]
 pub fn bits(mask: F32Lanes) -> u32 {
@@ -262,42 +243,5 @@ mod tests {
         assert_eq!(bits(first_lanes(3)), 0b111);
         assert_eq!(bits(first_lanes(LANES)), all_bits());
         assert_eq!(all_bits().count_ones() as usize, LANES);
-    }
-}
-
-#[cfg(test)]
-mod next_float_tests {
-    use super::*;
-
-    #[test]
-    fn next_up_and_down_in_lanes_are_the_scalar_functions_bit_for_bit() {
-        let values = [
-            0.0,
-            -0.0,
-            1.0,
-            -1.0,
-            f32::MIN_POSITIVE,
-            -f32::MIN_POSITIVE,
-            f32::from_bits(1),
-            -f32::from_bits(1),
-            f32::MAX,
-            -f32::MAX,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            123.456,
-            -1e-30,
-            3e38,
-        ];
-        for chunk in values.chunks(LANES) {
-            let mut v = [0.0; LANES];
-            v[..chunk.len()].copy_from_slice(chunk);
-            let (up, down) = (next_up(F32Lanes::new(v)), next_down(F32Lanes::new(v)));
-            for (k, x) in chunk.iter().enumerate() {
-                assert_eq!(up.as_array()[k].to_bits(), x.next_up().to_bits(), "up {x}");
-                let scalar = x.next_down().to_bits();
-                assert_eq!(down.as_array()[k].to_bits(), scalar, "down {x}");
-            }
-        }
     }
 }

@@ -87,5 +87,5 @@ mod streams;
 pub use mix::mix64;
 pub use pattern::SamplePattern;
 pub use pcg::{Pcg32, Pcg32Lanes, STREAM};
-pub use sobol::{DimensionPair, SobolPoints, SobolSequence, MAX_JOINT};
+pub use sobol::{DimensionPair, SequenceCache, SobolPoints, SobolSequence, MAX_JOINT};
 pub use streams::{pixel_key, pixel_rng, stream_seed, uniform, PixelSample, PIXEL_STREAM};

@@ -14,13 +14,16 @@
 //!
 //! # Evaluation
 //! `sobol_burley::sample` hashes its seed three times and walks the index's bits
-//! for every coordinate. A fill hashes once per block instead ([`Scrambles`]) and
-//! looks the unscrambled points up in tables of the two dimensions' generator
-//! matrices, one per byte of the (shuffled) index ([`GENERATOR_TABLES`]), built
-//! at compile time from Joe and Kuo's direction numbers; the scrambles are
+//! for every coordinate. A fill hashes once per block instead ([`Scrambles`]).
+//! Dimensions 0 and 1 need no generator matrix in memory: dimension 0 (van der
+//! Corput) is the index's bits reversed, and dimension 1, whose matrix is
+//! Pascal's triangle mod 2, is a superset transform of them (four shifts and
+//! XORs, [`sobol_dimension_1`]), so sixteen points are computed in SIMD lanes
+//! without a lookup. The joint pairs' dimensions look the points up in tables,
+//! one per byte of the (shuffled) index ([`JOINT_TABLES`]). The scrambles are
 //! `sobol_burley::parts`'s own, with the constants of `sobol_burley::sample`
 //! (version 0.5). The points are bit for bit those of
-//! `sobol_burley::sample(index, 0 or 1, seed)`, which the tests check for every
+//! `sobol_burley::sample(index, dimension, seed)`, which the tests check for every
 //! index of several sequences; a point costs about a quarter of the two calls.
 
 use super::mix::mix64;
@@ -28,6 +31,7 @@ use glam::Vec2;
 use glint_geometry::lanes::U32Lanes;
 use glint_geometry::lanes::{F32Lanes, LANES};
 use sobol_burley::parts::{hash, owen_scramble_rev, u32_to_f32_norm};
+use std::ops::{BitAnd, BitXor, Shr};
 use wide::bytemuck::cast;
 
 /// Which 2D sample dimensions of a pixel a set of points is for; each has its own
@@ -199,32 +203,39 @@ impl Scrambles {
 
     /// Points `i..i + out.len()` (at most [`LANES`], all below 2^16), as
     /// [`Self::point`] computes each, bit for bit: the integer hashing of them
-    /// all in SIMD lanes (wrapping products, exact), the table lookups lane by
-    /// lane.
+    /// all in SIMD lanes (wrapping products, exact), a joint pair's table
+    /// lookups lane by lane.
     #[inline]
     fn points(self, i: u32, out: &mut [Vec2]) {
         let index = U32Lanes::new(std::array::from_fn(|k| i.wrapping_add(k as u32)));
-        let shuffled = owen_scramble_lanes(reverse_bits_lanes(index), self.index).to_array();
-        let tables = self.tables();
-        let (mut xs, mut ys) = ([0u32; LANES], [0u32; LANES]);
-        for (k, &shuffled) in shuffled.iter().enumerate() {
-            let (low, high) = (shuffled >> 24, shuffled >> 16 & 0xff);
-            let both = tables[0][low as usize] ^ tables[1][high as usize];
-            (xs[k], ys[k]) = (both as u32, (both >> 32) as u32);
-        }
-        let x = unit_lanes(U32Lanes::new(xs), self.x);
-        let y = unit_lanes(U32Lanes::new(ys), self.y);
+        let shuffled = owen_scramble_lanes(reverse_bits_lanes(index), self.index);
+        let (xs, ys) = match self.joint_tables() {
+            None => {
+                let x = reverse_bits_lanes(shuffled) & U32Lanes::splat(BLOCK_MASK);
+                (x, sobol_dimension_1(x, U32Lanes::splat))
+            }
+            Some(tables) => {
+                let (mut xs, mut ys) = ([0u32; LANES], [0u32; LANES]);
+                for (k, &shuffled) in shuffled.to_array().iter().enumerate() {
+                    (xs[k], ys[k]) = lookup(tables, shuffled);
+                }
+                (U32Lanes::new(xs), U32Lanes::new(ys))
+            }
+        };
+        let x = unit_lanes(xs, self.x);
+        let y = unit_lanes(ys, self.y);
         for (k, p) in out.iter_mut().enumerate() {
             *p = Vec2::new(x[k], y[k]);
         }
     }
 
-    /// The generator tables of this sequence's two dimensions.
+    /// The tables of this sequence's two dimensions where it reads a joint
+    /// pair; `None` for dimensions 0 and 1, which need none.
     #[inline]
-    fn tables(self) -> &'static PairTables {
+    fn joint_tables(self) -> Option<&'static PairTables> {
         match self.dimensions {
-            0 => &GENERATOR_TABLES,
-            k => &JOINT_TABLES[k as usize - 1],
+            0 => None,
+            k => Some(&JOINT_TABLES[k as usize - 1]),
         }
     }
 
@@ -233,15 +244,53 @@ impl Scrambles {
     #[inline]
     fn point(self, i: u32) -> Vec2 {
         let shuffled = owen_scramble_rev(i.reverse_bits(), self.index);
-        // The shuffled index's bits 0–7 and 8–15, still reversed.
-        let (low, high) = ((shuffled >> 24) as usize, (shuffled >> 16 & 0xff) as usize);
-        let tables = self.tables();
-        let both = tables[0][low] ^ tables[1][high];
-        let (x, y) = (both as u32, (both >> 32) as u32);
+        let (x, y) = match self.joint_tables() {
+            None => {
+                let x = shuffled.reverse_bits() & BLOCK_MASK;
+                (x, sobol_dimension_1(x, |m| m))
+            }
+            Some(tables) => lookup(tables, shuffled),
+        };
         let unit =
             |v: u32, scramble: u32| u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits());
         Vec2::new(unit(x, self.x), unit(y, self.y))
     }
+}
+
+/// The unscrambled points of a pair of dimensions, bits reversed (as
+/// `sobol_burley::parts::sobol_rev` gives them), of the index whose reversed
+/// bits are `index_rev`, from the pair's `tables`.
+#[inline]
+fn lookup(tables: &PairTables, index_rev: u32) -> (u32, u32) {
+    // The index's bits 0–7 and 8–15, still reversed.
+    let (low, high) = (
+        (index_rev >> 24) as usize,
+        (index_rev >> 16 & 0xff) as usize,
+    );
+    let both = tables[0][low] ^ tables[1][high];
+    (both as u32, (both >> 32) as u32)
+}
+
+/// Sobol dimension 1 of an index below 2^16 whose bits are `index`, bits
+/// reversed (as `sobol_burley::parts::sobol_rev` gives it): no table needed.
+/// Its direction numbers `v_1 = 1/2`, `v_j = v_{j−1} ⊕ v_{j−1}/2` make the
+/// generator matrix Pascal's triangle mod 2: `v_j` has the bit of `2^−(m+1)`
+/// where `C(j, m)` is odd, which by Lucas's theorem is where the bits of `m`
+/// are a subset of those of `j`. Reversed, bit `m` of the point is then the
+/// XOR of the index bits `j ⊇ m`: a superset transform over the four bits of
+/// the bit positions, one shift-and-XOR per bit. Dimension 0 (van der Corput)
+/// is the index itself. For one `u32` or for lanes of them (`splat` makes a
+/// constant of the type).
+#[inline(always)]
+fn sobol_dimension_1<T>(index: T, splat: impl Fn(u32) -> T) -> T
+where
+    T: Copy + Shr<u32, Output = T> + BitAnd<Output = T> + BitXor<Output = T>,
+{
+    let mut x = index;
+    for (shift, positions) in [(1, 0x5555), (2, 0x3333), (4, 0x0f0f), (8, 0x00ff)] {
+        x = x ^ ((x >> shift) & splat(positions));
+    }
+    x
 }
 
 /// `sobol_burley::parts::owen_scramble_rev` on [`LANES`] integers (wrapping
@@ -281,16 +330,6 @@ fn unit_lanes(v: U32Lanes, scramble: u32) -> [f32; LANES] {
     (cast::<U32Lanes, F32Lanes>(bits) - F32Lanes::ONE).to_array()
 }
 
-/// The unscrambled Sobol points of dimensions 0 and 1 by bytes of the index, bits
-/// reversed: `GENERATOR_TABLES[d][k][b]` is the XOR of the direction numbers
-/// `v_{8k+j}` of dimension `d` for the bits `j` set in `b` read from the top
-/// (bit 7 of `b` is index bit `8k`), as `sobol_burley::parts::sobol_rev` gives it.
-/// Point `i` of dimension `d` is then `t[0][low byte] ^ t[1][high byte]` (a Sobol
-/// point is linear in its index's bits over GF(2)). Both dimensions are looked
-/// up at once: an entry holds dimension 0 in its low 32 bits and dimension 1 in
-/// its high ones ([`PairTables`]), and XOR keeps the halves apart.
-static GENERATOR_TABLES: PairTables = pack(generator_tables());
-
 /// A pair of dimensions' tables by index byte, `[byte][b]`, each entry the
 /// first dimension's value in its low 32 bits and the second's in its high.
 type PairTables = [[u64; 256]; 2];
@@ -310,7 +349,8 @@ const fn pack(t: [[[u32; 256]; 2]; 2]) -> PairTables {
     packed
 }
 
-/// The same tables for Sobol dimensions 2 to 5 (the joint pairs), made once from
+/// The generator tables of Sobol dimensions 2 to 5 (the joint pairs) by bytes
+/// of the index, bits reversed, made once from
 /// `sobol_burley::parts::sobol_rev`: a point is linear in its index's bits, so a
 /// byte's entry is the point of that byte alone.
 static JOINT_TABLES: std::sync::LazyLock<[PairTables; MAX_JOINT as usize]> =
@@ -331,48 +371,6 @@ static JOINT_TABLES: std::sync::LazyLock<[PairTables; MAX_JOINT as usize]> =
         }
         tables.map(pack)
     });
-
-/// Joe and Kuo's direction numbers `v_1 … v_16` of dimensions 0 and 1 as 32-bit
-/// fractions: dimension 0 is van der Corput's (`v_j = 2^-j`); dimension 1 has
-/// `s = 1`, `a = 0`, `m_1 = 1`, so `v_1 = 1/2` and `v_j = v_{j−1} ⊕ v_{j−1}/2`.
-const fn direction_numbers() -> [[u32; 16]; 2] {
-    let mut v = [[0u32; 16]; 2];
-    v[1][0] = 1 << 31;
-    let mut j = 0;
-    while j < 16 {
-        v[0][j] = 1 << (31 - j);
-        if j > 0 {
-            v[1][j] = v[1][j - 1] ^ (v[1][j - 1] >> 1);
-        }
-        j += 1;
-    }
-    v
-}
-
-const fn generator_tables() -> [[[u32; 256]; 2]; 2] {
-    let v = direction_numbers();
-    let mut t = [[[0u32; 256]; 2]; 2];
-    let mut d = 0;
-    while d < 2 {
-        let mut k = 0;
-        while k < 2 {
-            let mut b = 0;
-            while b < 256 {
-                let mut j = 0;
-                while j < 8 {
-                    if (b >> (7 - j)) & 1 == 1 {
-                        t[d][k][b] ^= v[d][8 * k + j].reverse_bits();
-                    }
-                    j += 1;
-                }
-                b += 1;
-            }
-            k += 1;
-        }
-        d += 1;
-    }
-    t
-}
 
 /// Consecutive points of one pixel's sequence for one pair, named but not yet
 /// hashed: [`crate::SamplePattern::fill`] makes the [`SobolSequence`] only for the
@@ -409,6 +407,36 @@ impl SobolPoints {
     #[inline]
     pub fn fill(self, out: &mut [Vec2]) {
         self.sequence().fill(self.first, out);
+    }
+}
+
+/// The last few [`SobolSequence`]s a thread made, by the points that named them:
+/// a pixel's camera samples take their points of a pair from one sequence, so
+/// the sequence is hashed once per pixel and pair rather than once per sample.
+#[derive(Clone, Debug, Default)]
+pub struct SequenceCache {
+    entries: [Option<(SobolPoints, SobolSequence)>; CACHED_SEQUENCES],
+    /// The entry the next new sequence replaces.
+    next: usize,
+}
+
+/// Enough for a few lights, their BRDF pairs and the environment.
+const CACHED_SEQUENCES: usize = 4;
+
+impl SequenceCache {
+    /// The sequence `points` come from ([`SobolPoints::sequence`]).
+    #[inline]
+    pub fn sequence(&mut self, points: SobolPoints) -> SobolSequence {
+        let same = |named: &SobolPoints| {
+            (named.seed, named.pixel, named.pair) == (points.seed, points.pixel, points.pair)
+        };
+        if let Some((_, sequence)) = self.entries.iter().flatten().find(|(n, _)| same(n)) {
+            return *sequence;
+        }
+        let sequence = points.sequence();
+        self.entries[self.next] = Some((points, sequence));
+        self.next = (self.next + 1) % CACHED_SEQUENCES;
+        sequence
     }
 }
 

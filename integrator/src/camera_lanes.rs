@@ -123,18 +123,16 @@ impl DirectIntegrator {
         lanes: u32,
         ctx: &mut SampleContext<T>,
     ) -> (F32Lanes, F32Lanes) {
-        let mut u = [Vec2::ZERO; LANES];
         if self.light_pattern == SamplePattern::Sobol {
             let sobol = samples[0].sobol_points(pair, 1);
-            let sequences = &mut ctx.sequences;
-            (self.light_pattern).fill_cached(&mut ctx.rng, sobol, sequences, &mut u);
-        } else {
-            for (k, u) in u.iter_mut().enumerate() {
-                if lanes >> k & 1 == 1 {
-                    let sobol = samples[k].sobol_points(pair, 1);
-                    self.light_pattern
-                        .fill(&mut ctx.rng, sobol, std::slice::from_mut(u));
-                }
+            let u = ctx.sequences.sequence(sobol).lanes_at(sobol.first);
+            return (u.x, u.y);
+        }
+        let mut u = [Vec2::ZERO; LANES];
+        for (k, u) in u.iter_mut().enumerate() {
+            if lanes >> k & 1 == 1 {
+                let sobol = samples[k].sobol_points(pair, 1);
+                (self.light_pattern).fill(&mut ctx.rng, sobol, std::slice::from_mut(u));
             }
         }
         (F32Lanes::new(u.map(|u| u.x)), F32Lanes::new(u.map(|u| u.y)))

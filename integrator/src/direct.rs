@@ -1,12 +1,14 @@
 use crate::counters::{ShadingCounters, TextureCounters};
 use crate::light_samples::LANES_FROM_SAMPLES;
 use crate::sampling::Pcg32;
-use crate::sampling::{DimensionPair, PixelSample, SamplePattern, SequenceCache, MAX_JOINT};
+use crate::sampling::{
+    DimensionPair, PixelSample, SamplePattern, SamplePoints, SequenceCache, MAX_JOINT,
+};
 use crate::settings::RenderSettings;
 use crate::texture_lookup::texture_footprint;
 use crate::trace::{Event, Shadow, Skip, Tracer};
 use crate::{Scene, SurfaceKind};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{
     offset_ray_origin, reflect_differential, spawn_ray, spawn_ray_to, Hit, Occluders, Ray,
@@ -61,8 +63,8 @@ pub struct SampleContext<T: Tracer = ()> {
     pub sample: PixelSample,
     /// Its PCG stream (for the patterns other than Sobol).
     pub rng: Pcg32,
-    pub light_points: Vec<Vec2>,
-    pub environment_points: Vec<Vec2>,
+    pub light_points: SamplePoints,
+    pub environment_points: SamplePoints,
     /// What the integrator did so far.
     pub counters: ShadingCounters,
     /// Texture lookups by kind and level, counted when `detailed` is set.
@@ -101,8 +103,8 @@ impl<T: Tracer> SampleContext<T> {
         Self {
             sample: PixelSample::default(),
             rng: PixelSample::default().rng(),
-            light_points: vec![Vec2::ZERO; light_samples as usize],
-            environment_points: vec![Vec2::ZERO; environment_samples as usize],
+            light_points: SamplePoints::new(light_samples as usize),
+            environment_points: SamplePoints::new(environment_samples as usize),
             counters: ShadingCounters::default(),
             textures: TextureCounters::default(),
             detailed: false,
@@ -131,10 +133,10 @@ impl<T: Tracer> SampleContext<T> {
         &mut self,
         pattern: SamplePattern,
         pair: DimensionPair,
-        out: &mut [Vec2],
+        out: &mut SamplePoints,
     ) {
         let sobol = self.sample.sobol_points(pair, out.len() as u32);
-        pattern.fill_cached(&mut self.rng, sobol, &mut self.sequences, out);
+        pattern.fill_lanes(&mut self.rng, sobol, &mut self.sequences, out);
     }
 }
 
@@ -426,7 +428,7 @@ impl DirectIntegrator {
         &self,
         pair: DimensionPair,
         ctx: &mut SampleContext<T>,
-    ) -> Vec<Vec2> {
+    ) -> SamplePoints {
         let mut samples = std::mem::take(&mut ctx.light_points);
         ctx.fill_points(self.light_pattern, pair, &mut samples);
         samples
@@ -493,7 +495,7 @@ impl DirectIntegrator {
         ctx.counters.environment_samples += samples.len() as u64;
         let sum = if T::ON || samples.len() < LANES_FROM_SAMPLES {
             let mut sum = Vec3::ZERO;
-            for &u in &samples {
+            for u in samples.iter() {
                 let s = env.sample(point.n, u);
                 let Some((f, value)) = point.environment_sample_unshadowed(&s, ctx) else {
                     continue;
@@ -568,16 +570,16 @@ impl ShadingPoint<'_> {
         &self,
         scene: &Scene,
         env: &EnvironmentLight,
-        samples: &[Vec2],
+        samples: &SamplePoints,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let origins = self.shadow_origins();
         let mut sum = Vec3::ZERO;
-        for chunk in samples.chunks(LANES) {
+        for chunk in samples.chunks() {
             let mut values = [Vec3::ZERO; LANES];
             let mut directions = [self.hit.geometric_normal; LANES];
             let mut traced = 0u32;
-            for (k, &u) in chunk.iter().enumerate() {
+            for (k, u) in chunk.iter().enumerate() {
                 let s = env.sample(self.n, u);
                 if let Some((_, value)) = self.environment_sample_unshadowed(&s, ctx) {
                     (values[k], directions[k]) = (value, s.direction);
@@ -592,7 +594,7 @@ impl ShadingPoint<'_> {
                     .shapes
                     .any_hits_among(&Occluders::ALL, &rays, f32::INFINITY, traced);
             let visible = traced & !blocked;
-            for (k, value) in values.iter().enumerate().take(chunk.len()) {
+            for (k, value) in values.iter().enumerate().take(chunk.len) {
                 if visible >> k & 1 == 1 {
                     sum += *value;
                 }

@@ -14,10 +14,11 @@
 //! lanes, a shape counts one test per ray in the batch.
 
 use crate::direct::{SampleContext, ShadingPoint};
+use crate::sampling::SamplePoints;
 use crate::trace::{Shadow, Skip, Tracer};
 use crate::{Scene, ShadingCounters};
-use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
+use glam::Vec3;
+use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes};
 use glint_geometry::{Occluders, RayLanes};
 use glint_lighting::AreaLight;
 
@@ -80,7 +81,7 @@ impl ShadingPoint<'_> {
         &self,
         scene: &Scene,
         light: &AreaLight,
-        samples: &[Vec2],
+        samples: &SamplePoints,
         occluders: &Occluders,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
@@ -91,14 +92,15 @@ impl ShadingPoint<'_> {
         let origins = self.shadow_origins();
         let mut sum = Vec3::ZERO;
         let (receiver, ng) = (Vec3Lanes::splat(point), Vec3Lanes::splat(self.ng));
-        for chunk in samples.chunks(LANES) {
-            let used = lanes::bits(lanes::first_lanes(chunk.len()));
+        for chunk in samples.chunks() {
+            let used = chunk.used();
             let reflect = |l: &Vec3Lanes| {
                 let (kd, ks, n, v) = (self.kd, self.ks, self.n, self.v);
                 self.material
                     .reflect_lanes(kd, ks, n, l, v, self.has_specular)
             };
-            let s = LightSampleLanes::new(light, gather(chunk), &receiver, &ng, used, reflect);
+            let u = (chunk.lanes.x, chunk.lanes.y);
+            let s = LightSampleLanes::new(light, u, &receiver, &ng, used, reflect);
             self.count(ctx, used, s.lit, s.shaded, s.traced);
             let origin = origins.leaving_towards(&s.towards);
             let shadow_rays = RayLanes {
@@ -109,7 +111,7 @@ impl ShadingPoint<'_> {
                 .shapes
                 .any_hits_among(occluders, &shadow_rays, 1.0, s.traced);
             let visible = s.traced & !blocked;
-            for k in 0..chunk.len() {
+            for k in 0..chunk.len {
                 if s.lit >> k & 1 == 1 {
                     sum += if visible >> k & 1 == 1 {
                         s.reflected.lane(k)
@@ -140,12 +142,12 @@ impl ShadingPoint<'_> {
         &self,
         scene: &Scene,
         light: &AreaLight,
-        samples: &[Vec2],
+        samples: &SamplePoints,
         occluders: &Occluders,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let mut sum = Vec3::ZERO;
-        for &u in samples {
+        for u in samples.iter() {
             let position = light.sample_point(u);
             if light.illuminates(position, self.hit.point) {
                 let target = light.shadow_target(position);
@@ -187,22 +189,11 @@ pub(crate) fn count_lanes(
     counters.light_shadow_rays += ones(traced);
 }
 
-/// Up to [`LANES`] sample coordinates as x and y lanes (unused lanes 0).
-#[inline]
-fn gather(chunk: &[Vec2]) -> (F32Lanes, F32Lanes) {
-    let coordinate = |axis: usize| {
-        F32Lanes::new(std::array::from_fn(|k| {
-            chunk.get(k).map_or(0.0, |u| u[axis])
-        }))
-    };
-    (coordinate(0), coordinate(1))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::{SceneBuilder, SurfaceKind};
-    use glam::UVec2;
+    use glam::{UVec2, Vec2};
     use glint_camera::Camera;
     use glint_geometry::{Parallelogram, Ray, Sphere};
     use glint_lighting::{Light, PhongMaterial, SpecularLobe};
@@ -291,9 +282,10 @@ mod tests {
                 };
                 let point = ShadingPoint::new(&hit, material, &ray, &TexCoord::point(hit.uv));
                 for n in [1usize, 2, 7, 8, 9, 16, 19] {
-                    let mut samples: Vec<Vec2> =
+                    let mut points: Vec<Vec2> =
                         (0..n).map(|_| Vec2::new(uniform(), uniform())).collect();
-                    samples[0] = Vec2::ZERO; // a corner, exactly
+                    points[0] = Vec2::ZERO; // a corner, exactly
+                    let samples = SamplePoints::from_points(&points);
                     let culled = scene.shapes.occluders_towards(
                         hit.point,
                         0.0,

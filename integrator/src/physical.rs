@@ -26,10 +26,10 @@
 
 use crate::direct::{blocker, SampleContext, ShadingPoint};
 use crate::light_samples::LANES_FROM_SAMPLES;
-use crate::sampling::DimensionPair;
+use crate::sampling::{DimensionPair, PointChunk, SamplePoints};
 use crate::trace::{Event, Shadow, Skip, Technique, Tracer};
 use crate::{DirectIntegrator, Scene, ShadingCounters, Skips};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{spawn_ray, spawn_ray_to, Occluders, RayLanes, RayTarget};
 use glint_lighting::{AreaLight, AreaLightSampler, Light, PointLight, SphereLight};
@@ -90,7 +90,7 @@ impl DirectIntegrator {
         let occluders = self.occluders(scene, point, index, light, ctx);
         let mut sum = if T::ON || samples.len() < LANES_FROM_SAMPLES {
             let mut sum = Vec3::ZERO;
-            for &u in &samples {
+            for u in samples.iter() {
                 let s = sampler.sample(u);
                 let target = light.shadow_target(s.point);
                 sum += point.light_sample(scene, &target, s.pdf, mis, &occluders, ctx);
@@ -136,7 +136,7 @@ impl DirectIntegrator {
         let mis = self.mis && point.has_specular;
         let samples = self.draw_light_points(pair, ctx);
         let mut sum = Vec3::ZERO;
-        for &u in &samples {
+        for u in samples.iter() {
             match light.sample(x, u) {
                 Some(s) => {
                     sum += point.light_sample(scene, &s.target, s.pdf, mis, &Occluders::ALL, ctx)
@@ -173,7 +173,7 @@ impl DirectIntegrator {
         ctx.counters.lobe_samples += samples.len() as u64;
         let object = scene.light_objects[index];
         let mut sum = Vec3::ZERO;
-        for &u in &samples {
+        for u in samples.iter() {
             match point.material.sample_specular(point.n, point.v, u) {
                 Some(l) => sum += point.lobe_sample(scene, &light_pdf, object, l, ctx),
                 None => ctx.counters.lobe_skips.zero_density += 1,
@@ -283,18 +283,18 @@ impl ShadingPoint<'_> {
         scene: &Scene,
         light: &AreaLight,
         sampler: &AreaLightSampler,
-        samples: &[Vec2],
+        samples: &SamplePoints,
         mis: bool,
         occluders: &Occluders,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let origins = self.shadow_origins();
         let mut sum = Vec3::ZERO;
-        for chunk in samples.chunks(LANES) {
+        for chunk in samples.chunks() {
             let (position, values, traced) = if self.has_specular {
-                self.unshadowed_one_by_one(light, sampler, chunk, mis, ctx)
+                self.unshadowed_one_by_one(light, sampler, &chunk, mis, ctx)
             } else {
-                self.unshadowed_diffuse_lanes(sampler, chunk, ctx)
+                self.unshadowed_diffuse_lanes(sampler, &chunk, ctx)
             };
             let origin = origins.leaving_towards(&position.sub_splat(self.hit.point));
             let rays = RayLanes {
@@ -302,7 +302,7 @@ impl ShadingPoint<'_> {
                 direction: light.shadow_ends(&position) - origin,
             };
             let visible = traced & !scene.shapes.any_hits_among(occluders, &rays, 1.0, traced);
-            for (k, value) in values.iter().enumerate().take(chunk.len()) {
+            for (k, value) in values.iter().enumerate().take(chunk.len) {
                 sum += if visible >> k & 1 == 1 {
                     *value
                 } else {
@@ -320,14 +320,14 @@ impl ShadingPoint<'_> {
         &self,
         light: &AreaLight,
         sampler: &AreaLightSampler,
-        chunk: &[Vec2],
+        chunk: &PointChunk,
         mis: bool,
         ctx: &mut SampleContext<T>,
     ) -> (Vec3Lanes, [Vec3; LANES], u32) {
         let mut values = [Vec3::ZERO; LANES];
         let mut positions = [self.hit.point; LANES];
         let mut traced = 0u32;
-        for (k, &u) in chunk.iter().enumerate() {
+        for (k, u) in chunk.iter().enumerate() {
             let s = sampler.sample(u);
             let target = light.shadow_target(s.point);
             if let Some((_, value)) = self.light_sample_unshadowed(&target, s.pdf, mis, ctx) {
@@ -344,17 +344,17 @@ impl ShadingPoint<'_> {
     fn unshadowed_diffuse_lanes<T: Tracer>(
         &self,
         sampler: &AreaLightSampler,
-        chunk: &[Vec2],
+        chunk: &PointChunk,
         ctx: &mut SampleContext<T>,
     ) -> (Vec3Lanes, [Vec3; LANES], u32) {
         let mut positions = [self.hit.point; LANES];
         let mut pdfs = [0.0; LANES];
-        for (k, &u) in chunk.iter().enumerate() {
+        for (k, u) in chunk.iter().enumerate() {
             let s = sampler.sample(u);
             (positions[k], pdfs[k]) = (s.point, s.pdf);
         }
         let (position, pdf) = (Vec3Lanes::from_lanes(positions), F32Lanes::new(pdfs));
-        let used = lanes::bits(lanes::first_lanes(chunk.len()));
+        let used = chunk.used();
         let dense = used & lanes::bits(lanes::gt(pdf, F32Lanes::ZERO) & pdf.is_finite());
         let (l, normalized) = position.sub_splat(self.hit.point).try_normalize();
         let above = lanes::bits(normalized & lanes::gt(l.dot_splat(self.ng), F32Lanes::ZERO));

@@ -352,8 +352,7 @@ impl<'a> PixelRenderer<'a> {
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let (scene, used) = (self.scene, jitters.len());
-        let jitter =
-            |axis: usize| F32Lanes::new(std::array::from_fn(|k| jitters[k.min(used - 1)][axis]));
+        let jitter = |axis: usize| lanes::from_fn(|k| jitters[k.min(used - 1)][axis]);
         let c = scene.camera.generate_rays_lanes(
             F32Lanes::splat(x as f32) + jitter(0),
             F32Lanes::splat(y as f32) + jitter(1),

@@ -44,9 +44,9 @@ impl Vector3<F32Lanes> {
     #[inline]
     pub fn from_lanes(v: [Vec3; LANES]) -> Self {
         Self {
-            x: F32Lanes::new(v.map(|v| v.x)),
-            y: F32Lanes::new(v.map(|v| v.y)),
-            z: F32Lanes::new(v.map(|v| v.z)),
+            x: from_fn(|k| v[k].x),
+            y: from_fn(|k| v[k].y),
+            z: from_fn(|k| v[k].z),
         }
     }
 
@@ -91,6 +91,18 @@ pub fn le(a: F32Lanes, b: F32Lanes) -> F32Lanes {
 #[inline]
 pub fn bits(mask: F32Lanes) -> u32 {
     mask.to_bitmask()
+}
+
+/// Lane k set to `f(k)`. A plain loop: the compiler inlines and vectorizes
+/// it, where `std::array::from_fn` and `map` over sixteen lanes are called out
+/// of line and fill the array through memory.
+#[inline(always)]
+pub fn from_fn(mut f: impl FnMut(usize) -> f32) -> F32Lanes {
+    let mut lanes = [0.0; LANES];
+    for (k, lane) in lanes.iter_mut().enumerate() {
+        *lane = f(k);
+    }
+    F32Lanes::new(lanes)
 }
 
 /// The mask of the lanes whose bit is set in `bits` (lane k as bit k): the

@@ -79,6 +79,7 @@
 mod mix;
 mod pattern;
 mod pcg;
+mod points;
 mod sobol;
 #[cfg(test)]
 mod sobol_tests;
@@ -87,5 +88,6 @@ mod streams;
 pub use mix::mix64;
 pub use pattern::SamplePattern;
 pub use pcg::{Pcg32, Pcg32Lanes, STREAM};
+pub use points::{PointChunk, PointLanes, SamplePoints};
 pub use sobol::{DimensionPair, SequenceCache, SobolPoints, SobolSequence, MAX_JOINT};
 pub use streams::{pixel_key, pixel_rng, stream_seed, uniform, PixelSample, PIXEL_STREAM};

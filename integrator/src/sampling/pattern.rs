@@ -1,6 +1,7 @@
 //! The sample patterns: where N points fall in [0, 1)².
 
 use super::pcg::{fill_uniform_pairs, Pcg32};
+use super::points::SamplePoints;
 use super::sobol::{SequenceCache, SobolPoints};
 use glam::Vec2;
 
@@ -60,23 +61,10 @@ impl SamplePattern {
     /// of a non-square count); [`crate::RenderSettings::validate`] rules this out.
     #[inline]
     pub fn fill(self, rng: &mut Pcg32, sobol: SobolPoints, out: &mut [Vec2]) {
-        self.fill_cached(rng, sobol, &mut SequenceCache::default(), out);
-    }
-
-    /// [`Self::fill`], taking the Sobol sequence from `sequences` where it holds
-    /// it (the same points).
-    #[inline]
-    pub fn fill_cached(
-        self,
-        rng: &mut Pcg32,
-        sobol: SobolPoints,
-        sequences: &mut SequenceCache,
-        out: &mut [Vec2],
-    ) {
         let n = out.len() as u32;
         match self {
             Self::Random => fill_uniform_pairs(rng, out),
-            Self::Sobol => sequences.sequence(sobol).fill(sobol.first, out),
+            Self::Sobol => sobol.fill(out),
             Self::Grid => match exact_sqrt(n) {
                 Some(k) => fill_grid(k, out, |_| Vec2::splat(0.5)),
                 None => panic!("grid pattern needs a square count, got {n}"),
@@ -85,6 +73,23 @@ impl SamplePattern {
                 Some(k) => fill_grid(k, out, |_| rng.uniform2()),
                 None => fill_latin_hypercube(rng, out),
             },
+        }
+    }
+
+    /// [`Self::fill`] into lanes, taking the Sobol sequence from `sequences`
+    /// where it holds it (the same points): Sobol points are made in lanes, the
+    /// other patterns' one by one.
+    #[inline]
+    pub fn fill_lanes(
+        self,
+        rng: &mut Pcg32,
+        sobol: SobolPoints,
+        sequences: &mut SequenceCache,
+        out: &mut SamplePoints,
+    ) {
+        match self {
+            Self::Sobol => sequences.sequence(sobol).fill_lanes(sobol.first, out),
+            _ => out.place(|points| self.fill(rng, sobol, points)),
         }
     }
 }

@@ -12,7 +12,7 @@
 //! of one stream.
 
 use super::mix::mix64;
-use glint_geometry::lanes::{F32Lanes, LANES};
+use glint_geometry::lanes::{self, F32Lanes, LANES};
 
 /// The LCG's multiplier (Knuth's MMIX constant, PCG's default).
 const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
@@ -39,6 +39,16 @@ const fn jump(delta: u64) -> (u64, u64) {
         d /= 2;
     }
     (acc_mult, acc_plus)
+}
+
+/// `f` of every lane's state, in a loop the compiler vectorizes (`map` over
+/// sixteen lanes is called out of line).
+#[inline(always)]
+fn each(mut states: [u64; LANES], f: impl Fn(u64) -> u64) -> [u64; LANES] {
+    for state in &mut states {
+        *state = f(*state);
+    }
+    states
 }
 
 /// XSH-RR: the top bits xor-shifted down, rotated by the top five bits.
@@ -141,22 +151,27 @@ impl Pcg32Lanes {
     #[inline(always)]
     pub fn new(seeds: [u64; LANES]) -> Self {
         Self {
-            state: seeds.map(seeded),
+            state: each(seeds, seeded),
         }
     }
 
     /// Each lane's next 32 random bits.
     #[inline(always)]
     pub fn next_u32(&mut self) -> [u32; LANES] {
-        let out = self.state.map(output);
-        self.state = self.state.map(step);
+        let mut out = [0; LANES];
+        for (out, &state) in out.iter_mut().zip(&self.state) {
+            *out = output(state);
+        }
+        self.state = each(self.state, step);
         out
     }
 
     /// Each lane's next uniform f32 in [0, 1), as [`Pcg32::uniform`].
     #[inline(always)]
     pub fn uniform(&mut self) -> F32Lanes {
-        F32Lanes::new(self.next_u32().map(unit))
+        let state = self.state;
+        self.state = each(state, step);
+        lanes::from_fn(|k| unit(output(state[k])))
     }
 
     /// Each lane's next two uniforms, as [`Pcg32::uniform2`]: the second
@@ -165,9 +180,9 @@ impl Pcg32Lanes {
     #[inline(always)]
     pub fn uniform2(&mut self) -> (F32Lanes, F32Lanes) {
         let first = self.state;
-        let second = first.map(step);
-        self.state = first.map(|s| jumped(TWO_DRAWS, s));
-        let uniforms = |states: [u64; LANES]| F32Lanes::new(states.map(|s| unit(output(s))));
+        let second = each(first, step);
+        self.state = each(first, |s| jumped(TWO_DRAWS, s));
+        let uniforms = |states: [u64; LANES]| lanes::from_fn(|k| unit(output(states[k])));
         (uniforms(first), uniforms(second))
     }
 

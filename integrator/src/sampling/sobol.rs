@@ -27,6 +27,7 @@
 //! index of several sequences; a point costs about a quarter of the two calls.
 
 use super::mix::mix64;
+use super::points::{PointLanes, SamplePoints};
 use glam::Vec2;
 use glint_geometry::lanes::U32Lanes;
 use glint_geometry::lanes::{F32Lanes, LANES};
@@ -157,14 +158,31 @@ impl SobolSequence {
     #[inline]
     pub fn fill(self, first: u64, out: &mut [Vec2]) {
         for (chunk, start) in out.chunks_mut(LANES).zip((first..).step_by(LANES)) {
-            let i = start as u32 & BLOCK_MASK;
-            if i as usize + chunk.len() <= 1 << BLOCK_BITS {
-                self.scrambles(start).points(i, chunk);
-            } else {
-                for (p, index) in chunk.iter_mut().zip(start..) {
-                    *p = self.point(index);
-                }
+            let lanes = self.lanes_at(start);
+            for (k, p) in chunk.iter_mut().enumerate() {
+                *p = lanes.lane(k);
             }
+        }
+    }
+
+    /// Points `first..first + out.len()`, as lanes.
+    #[inline]
+    pub fn fill_lanes(self, first: u64, out: &mut SamplePoints) {
+        for (lanes, start) in out.chunks_mut().iter_mut().zip((first..).step_by(LANES)) {
+            *lanes = self.lanes_at(start);
+        }
+    }
+
+    /// Points `first..first + LANES` in lanes: hashed together where they
+    /// share a block, else point by point.
+    #[inline]
+    pub fn lanes_at(self, first: u64) -> PointLanes {
+        let i = first as u32 & BLOCK_MASK;
+        if i as usize + LANES <= 1 << BLOCK_BITS {
+            self.scrambles(first).points(i)
+        } else {
+            let points: [Vec2; LANES] = std::array::from_fn(|k| self.point(first + k as u64));
+            PointLanes::from_points(&points)
         }
     }
 }
@@ -201,12 +219,11 @@ impl Scrambles {
         }
     }
 
-    /// Points `i..i + out.len()` (at most [`LANES`], all below 2^16), as
-    /// [`Self::point`] computes each, bit for bit: the integer hashing of them
-    /// all in SIMD lanes (wrapping products, exact), a joint pair's table
-    /// lookups lane by lane.
+    /// Points `i..i + LANES` (all below 2^16), as [`Self::point`] computes
+    /// each, bit for bit: the integer hashing of them all in SIMD lanes
+    /// (wrapping products, exact), a joint pair's table lookups lane by lane.
     #[inline]
-    fn points(self, i: u32, out: &mut [Vec2]) {
+    fn points(self, i: u32) -> PointLanes {
         let index = U32Lanes::new(std::array::from_fn(|k| i.wrapping_add(k as u32)));
         let shuffled = owen_scramble_lanes(reverse_bits_lanes(index), self.index);
         let (xs, ys) = match self.joint_tables() {
@@ -222,10 +239,9 @@ impl Scrambles {
                 (U32Lanes::new(xs), U32Lanes::new(ys))
             }
         };
-        let x = unit_lanes(xs, self.x);
-        let y = unit_lanes(ys, self.y);
-        for (k, p) in out.iter_mut().enumerate() {
-            *p = Vec2::new(x[k], y[k]);
+        PointLanes {
+            x: unit_lanes(xs, self.x),
+            y: unit_lanes(ys, self.y),
         }
     }
 
@@ -305,29 +321,23 @@ fn owen_scramble_lanes(mut n_rev: U32Lanes, scramble: u32) -> U32Lanes {
     n_rev
 }
 
-/// `u32::reverse_bits` on [`LANES`] integers: swaps of ever larger bit groups.
+/// `u32::reverse_bits` on [`LANES`] integers. Written lane by lane, the
+/// compiler makes it one vector bit reversal: on a CPU with GFNI a byte shuffle
+/// and one affine transform over GF(2), two instructions where swapping ever
+/// larger bit groups takes twenty.
 #[inline]
-fn reverse_bits_lanes(mut v: U32Lanes) -> U32Lanes {
-    for (shift, mask) in [
-        (1, 0x5555_5555),
-        (2, 0x3333_3333),
-        (4, 0x0f0f_0f0f),
-        (8, 0x00ff_00ff),
-    ] {
-        let mask = U32Lanes::splat(mask);
-        v = ((v >> shift) & mask) | ((v & mask) << shift);
-    }
-    (v >> 16) | (v << 16)
+fn reverse_bits_lanes(v: U32Lanes) -> U32Lanes {
+    U32Lanes::new(v.to_array().map(u32::reverse_bits))
 }
 
 /// The coordinates in [0, 1) of [`LANES`] scrambled Sobol values, as
 /// `u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits())`: the top 23
 /// bits as the mantissa of a float in [1, 2), minus 1.
 #[inline]
-fn unit_lanes(v: U32Lanes, scramble: u32) -> [f32; LANES] {
+fn unit_lanes(v: U32Lanes, scramble: u32) -> F32Lanes {
     let bits =
         (reverse_bits_lanes(owen_scramble_lanes(v, scramble)) >> 9) | U32Lanes::splat(0x3f80_0000);
-    (cast::<U32Lanes, F32Lanes>(bits) - F32Lanes::ONE).to_array()
+    cast::<U32Lanes, F32Lanes>(bits) - F32Lanes::ONE
 }
 
 /// A pair of dimensions' tables by index byte, `[byte][b]`, each entry the

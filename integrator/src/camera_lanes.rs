@@ -1,25 +1,31 @@
 //! The first hits of a pixel's camera samples shaded [`LANES`] at once.
 //!
-//! With one sample per area light per camera sample (`--light-samples 1`, the
-//! way Mitsuba's `direct` integrator is usually run), a shading point has no
-//! light samples for [`crate::light_samples`]' lanes to batch. The lanes are
-//! then the camera samples: the [`LANES`] samples of a pixel that
+//! The lanes are the camera samples: the [`LANES`] samples of a pixel that
 //! [`glint_geometry::ShapeList::closest_primitives_lanes`] found the hits of
-//! together are shaded together too. Their light points, directions, Phong
-//! reflections ([`PhongLanes`], each lane with its own material) and
-//! horizon tests run in SIMD lanes, and their shadow rays, from as many origins,
-//! are traced as one batch.
+//! together are shaded together too. Their surface points, reflectances and
+//! shadow-ray origins are set up once; then, for each of a light's N samples in
+//! turn, every lane's light point, direction, Phong reflection ([`PhongLanes`],
+//! each lane with its own material) and horizon test run in SIMD lanes, the
+//! shadow rays from as many origins are traced as one batch, and each lane adds
+//! its own sample to its own sum. With one sample per light (`--light-samples
+//! 1`, the way Mitsuba's `direct` integrator is usually run) a shading point has
+//! no light samples for [`crate::light_samples`]' lanes to batch; with more,
+//! this is the wavefront form of the same sums.
 //!
 //! This is only done where a scene needs nothing else at a first hit
 //! ([`DirectIntegrator::shades_first_hits_in_lanes`]): area lights only, no
-//! environment, no mirrors, no texture footprints. Every lane repeats the
-//! scalar path's operations in its order, and its random numbers come from its
-//! own camera sample's stream, so each sample's radiance and the shading counts
-//! are those of [`DirectIntegrator::li_at`], bit for bit (the tests compare).
+//! environment, no mirrors, no texture footprints, and light points that each
+//! sample can draw alone (not a stratified pattern of several). Every lane
+//! repeats the scalar path's operations in its order, and its random numbers
+//! come from its own camera sample's stream or its own points of the pixel's
+//! Sobol sequence, so each sample's radiance and the shading counts are those
+//! of [`DirectIntegrator::li_at`], bit for bit (the tests compare).
 
-use crate::direct::{PairAllocation, SampleContext, ShadingPoint};
+use crate::direct::{PairAllocation, SampleContext, ShadingPoint, CULL_FROM_SAMPLES};
 use crate::light_samples::{count_lanes, LightSampleLanes};
-use crate::sampling::{pixel_key, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern};
+use crate::sampling::{
+    pixel_key, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern, SamplePoints,
+};
 use crate::trace::Tracer;
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::Vec2;
@@ -36,7 +42,7 @@ impl DirectIntegrator {
     /// lights, no environment, and materials without mirrors or texture
     /// footprints.
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
-        self.light_samples == 1
+        self.light_samples_in_lanes()
             && scene.shading == ShadingModel::Phong
             && scene.environment.is_none()
             && scene.lights.iter().all(|l| matches!(l, Light::Area(_)))
@@ -44,6 +50,14 @@ impl DirectIntegrator {
                 .materials
                 .iter()
                 .all(|m| m.reflectivity == 0.0 && !m.uses_footprint())
+    }
+
+    /// Whether each camera sample's light points can be drawn lane by lane, the
+    /// lanes being camera samples: one point each from any pattern, or any
+    /// number from the patterns whose points do not depend on their count
+    /// (Sobol, random, grid; not stratified, whose cells do).
+    fn light_samples_in_lanes(&self) -> bool {
+        self.light_samples == 1 || self.light_pattern != SamplePattern::Stratified
     }
 
     /// The radiance of the first `used` of [`LANES`] camera samples of one pixel,
@@ -71,10 +85,7 @@ impl DirectIntegrator {
             return radiance;
         }
         let shaded_mask = lanes::from_bits(shaded.lanes);
-        let samples: [PixelSample; LANES] = std::array::from_fn(|k| PixelSample {
-            sample: first.sample + k as u64,
-            ..first
-        });
+        shaded.origins = ShadowOrigins::of(&shaded);
         // Each lane's own stream, as `SampleContext::begin_sample` makes it. The
         // random pattern draws a point as two uniforms; so does the stratified
         // one for a single point (its one cell is the whole square, and
@@ -94,14 +105,30 @@ impl DirectIntegrator {
                 depth: 0,
             };
             let pair = pairs.take(own, self.light_samples);
-            let u = match &mut rngs {
-                Some(rngs) => rngs.uniform2(),
-                None => self.pattern_points(&samples, pair, shaded.lanes, ctx),
+            let grid = self.grid_points(pair, ctx);
+            let occluders = match self.light_samples >= CULL_FROM_SAMPLES {
+                true => shaded.occluders(scene, index, area),
+                false => Occluders::ALL,
             };
-            ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
-            let reflected = shaded.area_light(scene, area, u, ctx);
-            // `li_at`'s `L · (0 + Σ reflected) / n` for its one sample.
-            let sum = Vec3Lanes::default() + reflected;
+            // `li_at`'s `L · (0 + Σ reflected) / n`, each lane summing its own
+            // samples in order. A sample a lane's point does not see adds +0
+            // where `li_at` adds nothing: the same, as the sum is never −0.
+            let mut sum = Vec3Lanes::default();
+            for j in 0..self.light_samples {
+                let u = match (&mut rngs, &grid) {
+                    (Some(rngs), _) => rngs.uniform2(),
+                    (None, Some(grid)) => {
+                        let p = grid.get(j as usize);
+                        (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
+                    }
+                    (None, None) => self.sobol_points(first, pair, j, ctx),
+                };
+                ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
+                sum = sum + shaded.area_light(scene, area, &occluders, u, ctx);
+            }
+            if let Some(grid) = grid {
+                ctx.light_points = grid;
+            }
             let term = Vec3Lanes::scaled_splat_lanes(area.color, &sum)
                 .div_splat(self.light_samples as f32);
             radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
@@ -111,31 +138,36 @@ impl DirectIntegrator {
         Vec3Lanes::select(shaded_mask, &(radiance + Vec3Lanes::default()), &radiance)
     }
 
-    /// The light-sample point of pair `pair` of each of the `lanes` camera
-    /// samples, from the light pattern (grid or Sobol: nothing to draw). With
-    /// one point per camera sample, the lanes' Sobol points are consecutive
-    /// points of the pixel's one sequence for `pair`, filled together (the
-    /// sequence hashed once, not once a lane).
-    fn pattern_points<T: Tracer>(
+    /// Light sample `j` of pair `pair` of each lane's camera sample (lane k:
+    /// sample `first.sample + k`), from the pixel's Sobol sequence for the
+    /// pair: points `(first.sample + k)·n + j` for `n` samples per light, the
+    /// points [`SampleContext::fill_points`] gives each sample alone.
+    fn sobol_points<T: Tracer>(
         &self,
-        samples: &[PixelSample; LANES],
+        first: PixelSample,
         pair: DimensionPair,
-        lanes: u32,
+        j: u32,
         ctx: &mut SampleContext<T>,
     ) -> (F32Lanes, F32Lanes) {
-        if self.light_pattern == SamplePattern::Sobol {
-            let sobol = samples[0].sobol_points(pair, 1);
-            let u = ctx.sequences.sequence(sobol).lanes_at(sobol.first);
-            return (u.x, u.y);
-        }
-        let mut u = [Vec2::ZERO; LANES];
-        for (k, u) in u.iter_mut().enumerate() {
-            if lanes >> k & 1 == 1 {
-                let sobol = samples[k].sobol_points(pair, 1);
-                (self.light_pattern).fill(&mut ctx.rng, sobol, std::slice::from_mut(u));
-            }
-        }
-        (F32Lanes::new(u.map(|u| u.x)), F32Lanes::new(u.map(|u| u.y)))
+        let n = u64::from(self.light_samples);
+        let sobol = first.sobol_points(pair, self.light_samples);
+        let u = (ctx.sequences.sequence(sobol)).lanes_strided(sobol.first + u64::from(j), n);
+        (u.x, u.y)
+    }
+
+    /// The grid pattern's points for `pair` (the same for every camera sample),
+    /// in the buffer taken from `ctx.light_points` (the caller puts it back);
+    /// `None` for the other patterns.
+    fn grid_points<T: Tracer>(
+        &self,
+        pair: DimensionPair,
+        ctx: &mut SampleContext<T>,
+    ) -> Option<SamplePoints> {
+        (self.light_pattern == SamplePattern::Grid).then(|| {
+            let mut points = std::mem::take(&mut ctx.light_points);
+            ctx.fill_points(self.light_pattern, pair, &mut points);
+            points
+        })
     }
 }
 
@@ -152,6 +184,28 @@ struct ShadedLanes<'a> {
     /// The geometric normals on the viewer's side.
     ng: Vec3Lanes,
     phong: PhongLanes<'a>,
+    /// The shadow rays' origins, once the lanes are set.
+    origins: ShadowOrigins,
+    /// The one object every lane is on, where set together.
+    object: Option<u32>,
+}
+
+/// The points of [`ShadedLanes`] offset to either side of their surfaces, the
+/// origins of their shadow rays, made once for all their light samples.
+#[derive(Default)]
+struct ShadowOrigins {
+    front: Vec3Lanes,
+    back: Vec3Lanes,
+}
+
+impl ShadowOrigins {
+    fn of(shaded: &ShadedLanes) -> Self {
+        let (point, error, g) = (&shaded.point, &shaded.error, &shaded.geometric_normal);
+        Self {
+            front: offset_ray_origins(point, error, g),
+            back: offset_ray_origins(point, error, &-*g),
+        }
+    }
 }
 
 impl<'a> ShadedLanes<'a> {
@@ -247,11 +301,34 @@ impl<'a> ShadedLanes<'a> {
         let ambient = Vec3Lanes::scaled_splat_lanes(scene.ambient, &kd);
         *radiance = Vec3Lanes::select(lanes::from_bits(hit_lanes), &ambient, radiance);
         self.lanes = hit_lanes;
+        self.object = Some(object);
         self.point = surface.point;
         self.error = surface.error;
         self.geometric_normal = surface.normal;
         self.ng = ng;
         true
+    }
+
+    /// The shapes that may block the lanes' shadow rays to area light `index`,
+    /// as [`DirectIntegrator::occluders`] culls them for one point: from a
+    /// centre, widened by a reach that holds every lane's point, where the
+    /// lanes lie on one object; every shape otherwise.
+    fn occluders(&self, scene: &Scene, index: usize, light: &AreaLight) -> Occluders {
+        let Some(object) = self.object else {
+            return Occluders::ALL;
+        };
+        let center = self.point.lane(self.lanes.trailing_zeros() as usize);
+        let offsets = self.point.sub_splat(center);
+        let distances = offsets.dot(&offsets).sqrt();
+        // A tenth wider than the farthest lane: far past the rounding of the
+        // distances, which the reach must not fall short of.
+        let reach = lanes::max_lane(distances, lanes::from_bits(self.lanes)) * 1.1;
+        scene.shapes.occluders_towards(
+            center,
+            reach,
+            &light.surface().corners(),
+            [object, scene.light_objects[index]],
+        )
     }
 
     /// Per lane, the Phong reflection of the light point at `(ux, uy)` on `light`, or
@@ -261,6 +338,7 @@ impl<'a> ShadedLanes<'a> {
         &self,
         scene: &Scene,
         light: &AreaLight,
+        occluders: &Occluders,
         (ux, uy): (F32Lanes, F32Lanes),
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
@@ -276,7 +354,7 @@ impl<'a> ShadedLanes<'a> {
             specular,
         );
         let ends = light.shadow_ends(&s.position);
-        let visible = s.traced & !self.blocked(scene, &ends, &s.towards, s.traced);
+        let visible = s.traced & !self.blocked(scene, occluders, &ends, &s.towards, s.traced);
         Vec3Lanes::select(
             lanes::from_bits(visible),
             &s.reflected,
@@ -286,18 +364,21 @@ impl<'a> ShadedLanes<'a> {
 
     /// The `traced` lanes whose shadow ray, from the point (offset to the side
     /// `towards` leaves on) to `end` (a light point off its surface), is blocked.
-    fn blocked(&self, scene: &Scene, end: &Vec3Lanes, towards: &Vec3Lanes, traced: u32) -> u32 {
+    fn blocked(
+        &self,
+        scene: &Scene,
+        occluders: &Occluders,
+        end: &Vec3Lanes,
+        towards: &Vec3Lanes,
+        traced: u32,
+    ) -> u32 {
         let from_back = lanes::lt(towards.dot(&self.geometric_normal), F32Lanes::ZERO);
-        let outgoing =
-            Vec3Lanes::select(from_back, &-self.geometric_normal, &self.geometric_normal);
-        let origin = offset_ray_origins(&self.point, &self.error, &outgoing);
+        let origin = Vec3Lanes::select(from_back, &self.origins.back, &self.origins.front);
         let rays = RayLanes {
             origin,
             direction: *end - origin,
         };
-        scene
-            .shapes
-            .any_hits_among(&Occluders::ALL, &rays, 1.0, traced)
+        scene.shapes.any_hits_among(occluders, &rays, 1.0, traced)
     }
 }
 
@@ -451,14 +532,17 @@ mod tests {
         let mut total = ShadingCounters::default();
         // Chunks whose lanes hit several objects, one shape, one light.
         let mut common = [0; 3];
-        for pattern in [
-            SamplePattern::Random,
-            SamplePattern::Stratified,
-            SamplePattern::Sobol,
-            SamplePattern::Grid,
+        for (pattern, light_samples) in [
+            (SamplePattern::Random, 1),
+            (SamplePattern::Stratified, 1),
+            (SamplePattern::Sobol, 1),
+            (SamplePattern::Grid, 1),
+            (SamplePattern::Random, 3),
+            (SamplePattern::Sobol, 5),
+            (SamplePattern::Grid, 4),
         ] {
             let integrator = DirectIntegrator {
-                light_samples: 1,
+                light_samples,
                 light_pattern: pattern,
                 environment_samples: 4,
                 environment_pattern: SamplePattern::Sobol,
@@ -496,10 +580,10 @@ mod tests {
                         pixel,
                         sample: chunk * LANES as u64,
                     };
-                    let mut lanes = SampleContext::new(1, 4);
+                    let mut lanes = SampleContext::new(light_samples, 4);
                     let values = integrator
                         .li_first_hits(&scene, &ray_lanes, &closest, used, first, &mut lanes);
-                    let mut scalar = SampleContext::new(1, 4);
+                    let mut scalar = SampleContext::new(light_samples, 4);
                     for (k, ray) in rays.iter().enumerate().take(used) {
                         scalar.begin_sample(first.seed, pixel, first.sample + k as u64);
                         let hit = scene.shapes.closest_hit(ray, f32::INFINITY);
@@ -514,7 +598,7 @@ mod tests {
                         assert_eq!(
                             values.lane(k).to_array().map(f32::to_bits),
                             expected.to_array().map(f32::to_bits),
-                            "{pattern:?}, pixel ({x}, {y}), sample {}: {} against {expected}",
+                            "{pattern:?} × {light_samples}, pixel ({x}, {y}), sample {}: {} against {expected}",
                             first.sample + k as u64,
                             values.lane(k)
                         );
@@ -522,7 +606,7 @@ mod tests {
                     }
                     assert_eq!(
                         lanes.counters, scalar.counters,
-                        "{pattern:?} pixel ({x}, {y})"
+                        "{pattern:?} × {light_samples}, pixel ({x}, {y})"
                     );
                     total += scalar.counters;
                 }
@@ -554,8 +638,14 @@ mod tests {
             mis: true,
         };
         assert!(integrator(1).shades_first_hits_in_lanes(&scene));
-        // Several light samples: those are the lanes (`light_samples`).
-        assert!(!integrator(2).shades_first_hits_in_lanes(&scene));
+        assert!(integrator(2).shades_first_hits_in_lanes(&scene));
+        // Stratified points depend on their count: several are drawn one by one.
+        let stratified = |light_samples| DirectIntegrator {
+            light_pattern: SamplePattern::Stratified,
+            ..integrator(light_samples)
+        };
+        assert!(stratified(1).shades_first_hits_in_lanes(&scene));
+        assert!(!stratified(2).shades_first_hits_in_lanes(&scene));
         let with = |change: fn(&mut Scene)| {
             let mut scene = room();
             change(&mut scene);

@@ -45,9 +45,14 @@ fn area_light(b: &mut SceneBuilder) {
 }
 
 fn stats_of(scene: &Scene) -> RenderStats {
+    stats_with(scene, 4)
+}
+
+/// `scene`'s counts at 4 spp with `light_samples` per light.
+fn stats_with(scene: &Scene, light_samples: u32) -> RenderStats {
     let settings = RenderSettings {
         spp: 4,
-        light_samples: 4,
+        light_samples,
         stats: true,
         ..RenderSettings::default()
     };
@@ -258,17 +263,19 @@ fn parallelogram_walls_cull_their_own_shadow_rays() {
         .shape(Sphere::new(Vec3::new(0.0, 1.0, -2.0), 0.5).unwrap(), m);
     area_light(&mut b);
     let scene = b.build(camera()).unwrap();
-    let stats = stats_of(&scene);
-    assert!(stats.shading.light_shadow_rays > 0);
-    // Camera rays test both parallelograms (floor and light). A floor point's
-    // shadow rays test neither (they cannot hit the floor, and end short of the
-    // light); only the sphere's points keep the floor (the pyramid's faces do not
-    // separate it from them), so shadow rays test very few.
-    let by_shadow_rays = stats.queries.parallelogram_tests - 2 * stats.camera_rays;
+    // A floor point's shadow rays test neither parallelogram (they cannot hit
+    // the floor, and end short of the light); only the sphere's points keep the
+    // floor (the pyramid's faces do not separate it from them), so shadow rays
+    // test very few. Doubling the light samples doubles the shadow rays and
+    // their tests and leaves the camera rays' alone: the difference is theirs.
+    let (four, eight) = (stats_with(&scene, 4), stats_with(&scene, 8));
+    let shadow_rays = eight.shading.light_shadow_rays - four.shading.light_shadow_rays;
+    let tests = eight.queries.parallelogram_tests - four.queries.parallelogram_tests;
+    assert_eq!(eight.camera_rays, four.camera_rays);
+    assert!(shadow_rays > 1000, "{shadow_rays} shadow rays");
     assert!(
-        by_shadow_rays * 10 < stats.shading.light_shadow_rays,
-        "{by_shadow_rays} tests by {} shadow rays",
-        stats.shading.light_shadow_rays
+        tests * 10 < shadow_rays,
+        "{tests} tests by {shadow_rays} shadow rays"
     );
 }
 

@@ -173,15 +173,24 @@ impl SobolSequence {
         }
     }
 
-    /// Points `first..first + LANES` in lanes: hashed together where they
-    /// share a block, else point by point.
+    /// Points `first..first + LANES` in lanes.
     #[inline]
     pub fn lanes_at(self, first: u64) -> PointLanes {
-        let i = first as u32 & BLOCK_MASK;
-        if i as usize + LANES <= 1 << BLOCK_BITS {
-            self.scrambles(first).points(i)
+        self.lanes_strided(first, 1)
+    }
+
+    /// Points `first + k·stride`, lane k: hashed together where they share a
+    /// block, else point by point.
+    #[inline]
+    pub fn lanes_strided(self, first: u64, stride: u64) -> PointLanes {
+        let last = first + (LANES as u64 - 1) * stride;
+        if first >> BLOCK_BITS == last >> BLOCK_BITS {
+            let i = first as u32 & BLOCK_MASK;
+            let index = U32Lanes::new(std::array::from_fn(|k| i + k as u32 * stride as u32));
+            self.scrambles(first).points(index)
         } else {
-            let points: [Vec2; LANES] = std::array::from_fn(|k| self.point(first + k as u64));
+            let points: [Vec2; LANES] =
+                std::array::from_fn(|k| self.point(first + k as u64 * stride));
             PointLanes::from_points(&points)
         }
     }
@@ -219,12 +228,12 @@ impl Scrambles {
         }
     }
 
-    /// Points `i..i + LANES` (all below 2^16), as [`Self::point`] computes
-    /// each, bit for bit: the integer hashing of them all in SIMD lanes
-    /// (wrapping products, exact), a joint pair's table lookups lane by lane.
+    /// The points of the indices `index` (all below 2^16), as [`Self::point`]
+    /// computes each, bit for bit: the integer hashing of them all in SIMD
+    /// lanes (wrapping products, exact), a joint pair's table lookups lane by
+    /// lane.
     #[inline]
-    fn points(self, i: u32) -> PointLanes {
-        let index = U32Lanes::new(std::array::from_fn(|k| i.wrapping_add(k as u32)));
+    fn points(self, index: U32Lanes) -> PointLanes {
         let shuffled = owen_scramble_lanes(reverse_bits_lanes(index), self.index);
         let (xs, ys) = match self.joint_tables() {
             None => {

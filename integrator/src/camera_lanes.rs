@@ -26,12 +26,14 @@ use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::sampling::{
     pixel_key, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern, SamplePoints,
 };
+use crate::texture_lookup::texture_footprint;
 use crate::trace::Tracer;
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::Vec2;
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{
-    offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayLanes, Shape, SurfaceLanes,
+    offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayDifferential, RayLanes, Shape,
+    SurfaceLanes,
 };
 use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial, ShadingModel};
 use glint_texture::{TexCoord, Texture};
@@ -46,10 +48,7 @@ impl DirectIntegrator {
             && scene.shading == ShadingModel::Phong
             && scene.environment.is_none()
             && scene.lights.iter().all(|l| matches!(l, Light::Area(_)))
-            && scene
-                .materials
-                .iter()
-                .all(|m| m.reflectivity == 0.0 && !m.uses_footprint())
+            && scene.materials.iter().all(|m| m.reflectivity == 0.0)
     }
 
     /// Whether each camera sample's light points can be drawn lane by lane, the
@@ -65,10 +64,12 @@ impl DirectIntegrator {
     /// have the closest hits `closest`: for each, what [`Self::li_at`] gives it
     /// alone (with [`SampleContext::begin_sample`] for that sample), bit for bit.
     /// Only for scenes where [`Self::shades_first_hits_in_lanes`] holds.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn li_first_hits<T: Tracer>(
         &self,
         scene: &Scene,
         rays: &RayLanes,
+        diffs: Option<&[RayDifferential; LANES]>,
         closest: &ClosestLanes,
         used: usize,
         first: PixelSample,
@@ -79,7 +80,8 @@ impl DirectIntegrator {
         let mut shaded = ShadedLanes::default();
         let hit_lanes = closest.hits & ((1 << used) - 1);
         if !shaded.set_common(scene, rays, closest, hit_lanes, &mut radiance, ctx) {
-            shaded.set_one_by_one(scene, rays, closest, hit_lanes, &mut radiance, ctx);
+            let hits = (rays, diffs, closest);
+            shaded.set_one_by_one(scene, hits, hit_lanes, &mut radiance, ctx);
         }
         if shaded.lanes == 0 {
             return radiance;
@@ -211,11 +213,13 @@ impl ShadowOrigins {
 impl<'a> ShadedLanes<'a> {
     /// The lanes of `hit_lanes` set one by one: each lane's surface point,
     /// its emitted light or ambient term in `radiance`, and its shading point.
+    /// A material that filters its textures over a footprint is looked up
+    /// over the lane's ray differentials (`diffs`; none without), from the
+    /// hit's full surface record, as `li_at` looks it up.
     fn set_one_by_one<T: Tracer>(
         &mut self,
         scene: &'a Scene,
-        rays: &RayLanes,
-        closest: &ClosestLanes,
+        (rays, diffs, closest): (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
         hit_lanes: u32,
         radiance: &mut Vec3Lanes,
         ctx: &mut SampleContext<T>,
@@ -229,6 +233,20 @@ impl<'a> ShadedLanes<'a> {
             match scene.surface_of(&hit) {
                 SurfaceKind::Emitter(Light::Area(area)) => radiance.set_lane(k, area.color),
                 SurfaceKind::Emitter(_) => {}
+                SurfaceKind::Material(material) if material.uses_footprint() => {
+                    let Some(hit) = scene.shapes.surface_record(&ray, found) else {
+                        continue;
+                    };
+                    ctx.counters.footprints += 1;
+                    let diff = diffs.map_or_else(|| RayDifferential::none(&ray), |d| d[k]);
+                    let tc = texture_footprint(material, &hit, &diff);
+                    if ctx.detailed {
+                        ctx.textures.record(material, &tc);
+                    }
+                    let point = ShadingPoint::new(&hit, material, &ray, &tc);
+                    radiance.set_lane(k, scene.ambient * point.kd);
+                    self.set(k, &point, material);
+                }
                 SurfaceKind::Material(material) => {
                     if ctx.detailed {
                         ctx.textures.record(material, &TexCoord::point(hit.uv));
@@ -278,6 +296,8 @@ impl<'a> ShadedLanes<'a> {
             _ => return false,
         };
         let material = match scene.surface_of_primitive(object, 0) {
+            // Its footprints need each lane's surface record: one by one.
+            SurfaceKind::Material(material) if material.uses_footprint() => return false,
             SurfaceKind::Material(material) => material,
             SurfaceKind::Emitter(light) => {
                 if let Light::Area(area) = light {
@@ -528,19 +548,28 @@ mod tests {
     /// and the shading counts bit for bit, for every light pattern.
     #[test]
     fn lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
-        let scene = room();
         let mut total = ShadingCounters::default();
         // Chunks whose lanes hit several objects, one shape, one light.
         let mut common = [0; 3];
-        for (pattern, light_samples) in [
-            (SamplePattern::Random, 1),
-            (SamplePattern::Stratified, 1),
-            (SamplePattern::Sobol, 1),
-            (SamplePattern::Grid, 1),
-            (SamplePattern::Random, 3),
-            (SamplePattern::Sobol, 5),
-            (SamplePattern::Grid, 4),
+        for (pattern, light_samples, footprints) in [
+            (SamplePattern::Random, 1, false),
+            (SamplePattern::Stratified, 1, false),
+            (SamplePattern::Sobol, 1, false),
+            (SamplePattern::Grid, 1, false),
+            (SamplePattern::Random, 3, false),
+            (SamplePattern::Sobol, 5, false),
+            (SamplePattern::Grid, 4, false),
+            (SamplePattern::Sobol, 1, true),
+            (SamplePattern::Random, 4, true),
         ] {
+            let mut scene = room();
+            if footprints {
+                // A checkerboard filtered over each ray's footprint.
+                scene.materials[0].diffuse = Texture::Checkerboard(Checkerboard {
+                    analytic: true,
+                    ..Checkerboard::new(Vec3::new(0.9, 0.2, 0.1), Vec3::new(0.1, 0.3, 0.8), 4)
+                });
+            }
             let integrator = DirectIntegrator {
                 light_samples,
                 light_pattern: pattern,
@@ -556,14 +585,20 @@ mod tests {
             for pixel in 0..(resolution.x * resolution.y) as u64 {
                 let (x, y) = (pixel % resolution.x as u64, pixel / resolution.x as u64);
                 for (chunk, used) in [(0u64, LANES), (1, 3), (2, 1)] {
-                    let rays: [Ray; LANES] = std::array::from_fn(|k| {
+                    let cameras: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
                         let n = LANES as f32;
                         let jitter = ((k as f32 + 0.5) / n, ((k * 5 % LANES) as f32 + 0.5) / n);
-                        let c = scene
-                            .camera
-                            .generate_ray(x as f32 + jitter.0, y as f32 + jitter.1);
-                        Ray::new(c.origin, c.direction)
+                        let raster = glam::Vec2::new(x as f32 + jitter.0, y as f32 + jitter.1);
+                        if footprints {
+                            crate::camera_ray(&scene.camera, raster, 0.25)
+                        } else {
+                            let c = scene.camera.generate_ray(raster.x, raster.y);
+                            let ray = Ray::new(c.origin, c.direction);
+                            (ray, RayDifferential::none(&ray))
+                        }
                     });
+                    let rays = cameras.map(|(ray, _)| ray);
+                    let diffs = cameras.map(|(_, diff)| diff);
                     let ray_lanes = RayLanes::new(rays);
                     let closest = scene
                         .shapes
@@ -581,20 +616,21 @@ mod tests {
                         sample: chunk * LANES as u64,
                     };
                     let mut lanes = SampleContext::new(light_samples, 4);
-                    let values = integrator
-                        .li_first_hits(&scene, &ray_lanes, &closest, used, first, &mut lanes);
+                    let values = integrator.li_first_hits(
+                        &scene,
+                        &ray_lanes,
+                        footprints.then_some(&diffs),
+                        &closest,
+                        used,
+                        first,
+                        &mut lanes,
+                    );
                     let mut scalar = SampleContext::new(light_samples, 4);
                     for (k, ray) in rays.iter().enumerate().take(used) {
                         scalar.begin_sample(first.seed, pixel, first.sample + k as u64);
                         let hit = scene.shapes.closest_hit(ray, f32::INFINITY);
-                        let expected = integrator.li_at(
-                            &scene,
-                            ray,
-                            &RayDifferential::none(ray),
-                            hit,
-                            0,
-                            &mut scalar,
-                        );
+                        let expected =
+                            integrator.li_at(&scene, ray, &diffs[k], hit, 0, &mut scalar);
                         assert_eq!(
                             values.lane(k).to_array().map(f32::to_bits),
                             expected.to_array().map(f32::to_bits),
@@ -623,6 +659,7 @@ mod tests {
         assert!(total.light_skips.zero_brdf > 0, "{total:?}");
         assert!(total.light_shadow_rays > 0, "{total:?}");
         assert!(total.specular_lobes > 0, "{total:?}");
+        assert!(total.footprints > 0, "{total:?}");
     }
 
     #[test]
@@ -652,7 +689,8 @@ mod tests {
             integrator(1).shades_first_hits_in_lanes(&scene)
         };
         assert!(!with(|s| s.materials[1].reflectivity = 0.5));
-        assert!(!with(|s| {
+        // Footprints are looked up lane by lane.
+        assert!(with(|s| {
             s.materials[0].diffuse = Texture::Checkerboard(Checkerboard {
                 analytic: true,
                 ..Checkerboard::new(Vec3::ZERO, Vec3::ONE, 4)

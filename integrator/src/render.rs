@@ -369,7 +369,7 @@ impl<'a> PixelRenderer<'a> {
         let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
         let closest = closest.expect("has_closest_lanes");
         self.integrator
-            .li_first_hits(scene, &rays, &closest, used, first, ctx)
+            .li_first_hits(scene, &rays, None, &closest, used, first, ctx)
     }
 
     /// The radiance (or AOV) of up to [`LANES`] camera samples of pixel (x, y),
@@ -402,9 +402,18 @@ impl<'a> PixelRenderer<'a> {
             .flatten();
         match &closest {
             // One sample per light: the chunk's samples shaded together.
-            Some(closest) if first_hits_in_lanes => self
-                .integrator
-                .li_first_hits(scene, &ray_lanes, closest, used, first, ctx),
+            Some(closest) if first_hits_in_lanes => {
+                let diffs = rays.map(|(_, diff)| diff);
+                (self.integrator).li_first_hits(
+                    scene,
+                    &ray_lanes,
+                    Some(&diffs),
+                    closest,
+                    used,
+                    first,
+                    ctx,
+                )
+            }
             _ => Vec3Lanes::from_lanes(std::array::from_fn(|k| {
                 let Some((ray, diff)) = rays.get(k).filter(|_| k < used) else {
                     return Vec3::ZERO;

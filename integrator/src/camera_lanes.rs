@@ -13,9 +13,11 @@
 //! this is the wavefront form of the same sums.
 //!
 //! This is only done where a scene needs nothing else at a first hit
-//! ([`DirectIntegrator::shades_first_hits_in_lanes`]): area lights only, no
-//! environment, no mirrors, no texture footprints, and light points that each
-//! sample can draw alone (not a stratified pattern of several). Every lane
+//! ([`DirectIntegrator::shades_first_hits_in_lanes`]): the course's model,
+//! area and point lights, no environment, no mirrors, and light points that
+//! each sample can draw alone (not a stratified pattern of several). Textures
+//! filtered over a footprint are looked up lane by lane, from each lane's ray
+//! differentials. Every lane
 //! repeats the scalar path's operations in its order, and its random numbers
 //! come from its own camera sample's stream or its own points of the pixel's
 //! Sobol sequence, so each sample's radiance and the shading counts are those
@@ -35,19 +37,22 @@ use glint_geometry::{
     offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayDifferential, RayLanes, Shape,
     SurfaceLanes,
 };
-use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial, ShadingModel};
+use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial, PointLight, ShadingModel};
 use glint_texture::{TexCoord, Texture};
 
 impl DirectIntegrator {
     /// Whether the first hits of `scene`'s camera samples can be shaded [`LANES`] at
-    /// a time (`li_first_hits`): one sample per area light, only area
-    /// lights, no environment, and materials without mirrors or texture
-    /// footprints.
+    /// a time (`li_first_hits`): the course's shading model, area and point
+    /// lights, no environment, materials without mirrors, and light points
+    /// each sample can draw alone.
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
         self.light_samples_in_lanes()
             && scene.shading == ShadingModel::Phong
             && scene.environment.is_none()
-            && scene.lights.iter().all(|l| matches!(l, Light::Area(_)))
+            && scene
+                .lights
+                .iter()
+                .all(|l| matches!(l, Light::Area(_) | Light::Point(_)))
             && scene.materials.iter().all(|m| m.reflectivity == 0.0)
     }
 
@@ -99,8 +104,18 @@ impl DirectIntegrator {
         .then(|| Pcg32Lanes::for_streams(pixel_key(first.seed, first.pixel), first.sample));
         let mut pairs = PairAllocation::new(0);
         for (index, light) in scene.lights.iter().enumerate() {
-            let Light::Area(area) = light else {
-                unreachable!("shades_first_hits_in_lanes admits area lights only")
+            let area = match light {
+                Light::Area(area) => area,
+                Light::Point(point) => {
+                    ctx.counters.point_light_samples += u64::from(shaded.lanes.count_ones());
+                    let reflected = shaded.point_light(scene, point, ctx);
+                    let term = Vec3Lanes::scaled_splat_lanes(point.color, &reflected);
+                    radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
+                    continue;
+                }
+                Light::Sphere(_) => {
+                    unreachable!("shades_first_hits_in_lanes admits no sphere lights")
+                }
             };
             let own = DimensionPair::Light {
                 light: index as u32,
@@ -364,6 +379,34 @@ impl<'a> ShadedLanes<'a> {
     ) -> Vec3Lanes {
         let reflect = |l: &Vec3Lanes| self.phong.reflect(l);
         let s = LightSampleLanes::new(light, (ux, uy), &self.point, &self.ng, self.lanes, reflect);
+        self.unoccluded(scene, &s, &light.shadow_ends(&s.position), occluders, ctx)
+    }
+
+    /// Per lane, the Phong reflection of point light `light`, or zero where it
+    /// is below the surface, reflects nothing or is blocked: the scalar path's
+    /// `unoccluded_reflection` towards the exact point, with its counts.
+    fn point_light<T: Tracer>(
+        &self,
+        scene: &Scene,
+        light: &PointLight,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let reflect = |l: &Vec3Lanes| self.phong.reflect(l);
+        let position = Vec3Lanes::splat(light.position);
+        let s = LightSampleLanes::at(position, &self.point, &self.ng, self.lanes, reflect);
+        self.unoccluded(scene, &s, &position, &Occluders::ALL, ctx)
+    }
+
+    /// The reflections of light samples `s` where their shadow rays, ending at
+    /// `ends`, are not blocked by `occluders` (zero elsewhere), counted.
+    fn unoccluded<T: Tracer>(
+        &self,
+        scene: &Scene,
+        s: &LightSampleLanes,
+        ends: &Vec3Lanes,
+        occluders: &Occluders,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
         let specular = self.phong.specular_lanes();
         count_lanes(
             &mut ctx.counters,
@@ -373,8 +416,7 @@ impl<'a> ShadedLanes<'a> {
             s.traced,
             specular,
         );
-        let ends = light.shadow_ends(&s.position);
-        let visible = s.traced & !self.blocked(scene, occluders, &ends, &s.towards, s.traced);
+        let visible = s.traced & !self.blocked(scene, occluders, ends, &s.towards, s.traced);
         Vec3Lanes::select(
             lanes::from_bits(visible),
             &s.reflected,
@@ -563,6 +605,17 @@ mod tests {
             (SamplePattern::Random, 4, true),
         ] {
             let mut scene = room();
+            if light_samples > 1 {
+                // Two point lights too, after the area light.
+                let point = |position| {
+                    Light::Point(glint_lighting::PointLight {
+                        position,
+                        color: Vec3::new(0.5, 0.4, 0.3),
+                    })
+                };
+                scene.lights.push(point(Vec3::new(-2.0, 3.0, -3.0)));
+                scene.lights.push(point(Vec3::new(2.5, 0.0, -1.0)));
+            }
             if footprints {
                 // A checkerboard filtered over each ray's footprint.
                 scene.materials[0].diffuse = Texture::Checkerboard(Checkerboard {
@@ -660,6 +713,7 @@ mod tests {
         assert!(total.light_shadow_rays > 0, "{total:?}");
         assert!(total.specular_lobes > 0, "{total:?}");
         assert!(total.footprints > 0, "{total:?}");
+        assert!(total.point_light_samples > 0, "{total:?}");
     }
 
     #[test]
@@ -696,7 +750,7 @@ mod tests {
                 ..Checkerboard::new(Vec3::ZERO, Vec3::ONE, 4)
             })
         }));
-        assert!(!with(|s| s.lights.push(Light::Point(
+        assert!(with(|s| s.lights.push(Light::Point(
             glint_lighting::PointLight {
                 position: Vec3::Y,
                 color: Vec3::ONE

@@ -51,10 +51,23 @@ impl LightSampleLanes {
         reflect: impl FnOnce(&Vec3Lanes) -> Vec3Lanes,
     ) -> Self {
         let position = light.sample_points(ux, uy);
+        let lit = used & lanes::bits(light.illuminates_lanes(&position, receiver));
+        Self::at(position, receiver, ng, lit, reflect)
+    }
+
+    /// Lane k: the light point `position_k`, which shines on `receiver_k` in
+    /// the lanes `lit` (a point light's position, on all it is asked about).
+    #[inline(always)]
+    pub(crate) fn at(
+        position: Vec3Lanes,
+        receiver: &Vec3Lanes,
+        ng: &Vec3Lanes,
+        lit: u32,
+        reflect: impl FnOnce(&Vec3Lanes) -> Vec3Lanes,
+    ) -> Self {
         let towards = position - *receiver;
         let (l, normalized) = towards.try_normalize();
         let reflected = reflect(&l);
-        let lit = used & lanes::bits(light.illuminates_lanes(&position, receiver));
         let above = lanes::bits(lanes::gt(l.dot(ng), F32Lanes::ZERO));
         let shaded = lit & lanes::bits(normalized) & above;
         let traced = shaded & !lanes::bits(reflected.is_zero());

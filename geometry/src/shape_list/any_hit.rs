@@ -4,7 +4,7 @@
 use super::{LinearShapes, Object, ShapeList};
 use crate::bvh::{Bvh, RayStream};
 use crate::triangle::WatertightRay;
-use crate::Ray;
+use crate::{Occluders, Ray};
 use glam::Vec3;
 use std::ops::ControlFlow;
 
@@ -71,7 +71,7 @@ impl ShapeList {
         let Some(linear) = &self.linear else {
             return false;
         };
-        self.packets_hit(linear, ray, t_max) || self.others_hit(linear, ray, t_max)
+        self.packets_hit(linear, ray, t_max) || self.others_hit(linear, &Occluders::ALL, ray, t_max)
     }
 
     /// Whether a shape of the linear layout's packets lies on the ray.
@@ -104,23 +104,48 @@ impl ShapeList {
     /// Whether an object outside the linear layout's packets lies on the ray:
     /// one tested one by one, or one in the BVH beside the packets.
     #[inline]
-    pub(super) fn rest_hit(&self, linear: &LinearShapes, ray: &Ray, t_max: f32) -> bool {
-        self.others_hit(linear, ray, t_max)
+    pub(super) fn rest_hit(
+        &self,
+        linear: &LinearShapes,
+        occluders: &Occluders,
+        ray: &Ray,
+        t_max: f32,
+    ) -> bool {
+        self.others_hit(linear, occluders, ray, t_max)
             || self
                 .bvh
                 .as_ref()
                 .is_some_and(|bvh| self.bvh_hit(bvh, ray, t_max))
     }
 
-    /// Whether an object of the linear loop outside its packets lies on the ray.
+    /// Whether an object of the linear loop outside its packets, and kept by
+    /// `occluders`, lies on the ray.
     #[inline]
-    pub(super) fn others_hit(&self, linear: &LinearShapes, ray: &Ray, t_max: f32) -> bool {
-        !linear.others.is_empty() && self.others_hit_one_by_one(linear, ray, t_max)
+    pub(super) fn others_hit(
+        &self,
+        linear: &LinearShapes,
+        occluders: &Occluders,
+        ray: &Ray,
+        t_max: f32,
+    ) -> bool {
+        !linear.others.is_empty() && self.others_hit_one_by_one(linear, occluders, ray, t_max)
     }
 
-    fn others_hit_one_by_one(&self, linear: &LinearShapes, ray: &Ray, t_max: f32) -> bool {
-        linear.others.iter().any(|&object| {
-            let watertight = WatertightRay::new(ray);
+    fn others_hit_one_by_one(
+        &self,
+        linear: &LinearShapes,
+        occluders: &Occluders,
+        ray: &Ray,
+        t_max: f32,
+    ) -> bool {
+        let mut kept = (linear.others.iter().enumerate())
+            .filter(|&(i, _)| occluders.keeps_other(i))
+            .peekable();
+        if kept.peek().is_none() {
+            return false;
+        }
+        let watertight = WatertightRay::new(ray);
+        kept.any(|(_, &object)| {
             self.primitives_of(object).any(|p| {
                 self.primitive_distance(p, ray, &watertight, t_max)
                     .is_some()

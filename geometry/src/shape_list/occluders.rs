@@ -11,7 +11,7 @@
 //! are skipped. (In the Cornell box a floor point's 16 shadow rays to the light
 //! then test one or two spheres instead of ten shapes.)
 
-use super::{ObjectRef, ShapeList};
+use super::{LinearShapes, ObjectRef, ShapeList};
 use crate::bvh::Bounds3;
 use crate::counters::count;
 use crate::lanes::{self, F32Lanes, LANES};
@@ -23,16 +23,29 @@ use wide::f32x4;
 
 /// The shapes of a [`ShapeList`] that may block shadow rays from one point to one
 /// light: bit `4k + lane` for lane `lane` of the linear loop's packet `k` (sphere
-/// packets, then parallelogram packets). Objects outside the packets (planes,
-/// boxes, meshes, whatever a BVH holds) are always tested.
+/// packets, then parallelogram packets), and bit `i` of `others` for the linear
+/// loop's other object `i` (planes can be culled; boxes and meshes, and
+/// whatever a BVH holds, are always tested).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Occluders {
     lanes: u64,
+    others: u32,
 }
 
 impl Occluders {
     /// Every shape (no culling).
-    pub const ALL: Occluders = Occluders { lanes: u64::MAX };
+    pub const ALL: Occluders = Occluders {
+        lanes: u64::MAX,
+        others: u32::MAX,
+    };
+
+    /// Whether the linear loop's other object `i` is kept (past 32, always).
+    #[inline]
+    pub(super) fn keeps_other(&self, i: usize) -> bool {
+        self.others
+            .checked_shr(i as u32)
+            .is_none_or(|bits| bits & 1 == 1)
+    }
 
     /// How many packed shapes may block the rays (64 meaning "all").
     pub fn count(&self) -> u32 {
@@ -131,7 +144,35 @@ impl ShapeList {
                 lanes &= !(1u64 << flat);
             }
         }
-        Occluders { lanes }
+        let others = self.planes_kept(linear, from, light, planes[0].margin, exclude);
+        Occluders { lanes, others }
+    }
+
+    /// The linear loop's other objects that may block the segments of
+    /// [`Self::occluders_towards`] (bit i for object i): all but the planes
+    /// `exclude` names (flat) and those with the light and every point within
+    /// `margin` of `from` strictly on one side, which no such segment crosses.
+    fn planes_kept(
+        &self,
+        linear: &LinearShapes,
+        from: Vec3,
+        light: &[Vec3; 4],
+        margin: f32,
+        exclude: [u32; 2],
+    ) -> u32 {
+        let mut kept = u32::MAX;
+        for (i, &object) in linear.others.iter().enumerate().take(32) {
+            let ObjectRef::Shape(Shape::Plane(plane)) = self.object(object) else {
+                continue;
+            };
+            // The margin (far past the segments' offsets and the rounding of
+            // the distances) grows with the plane's point, as their error does.
+            let margin = margin + 1e-3 * plane.point().abs().max_element();
+            if exclude.contains(&object) || plane.separates_none(from, light, margin) {
+                kept &= !(1 << i);
+            }
+        }
+        kept
     }
 
     /// [`ShapeList::any_hit`] for a shadow ray from the point and towards the light
@@ -156,7 +197,7 @@ impl ShapeList {
                 let lanes = occluders.packet(spheres + k);
                 lanes != 0 && packet.hit4(ray, t_max).0 & lanes != 0
             })
-            || self.rest_hit(linear, ray, t_max)
+            || self.rest_hit(linear, occluders, ray, t_max)
     }
 }
 
@@ -218,9 +259,9 @@ impl ShapeList {
                 }
             }
         }
-        if !linear.others.is_empty() {
+        if (0..linear.others.len()).any(|i| occluders.keeps_other(i)) {
             blocked |= self.lane_by_lane(active & !blocked, |lane| {
-                self.others_hit(linear, &rays.lane(lane), t_max)
+                self.others_hit(linear, occluders, &rays.lane(lane), t_max)
             });
         }
         blocked | self.bvh_hits_lanes(rays, t_max, active & !blocked)
@@ -439,7 +480,99 @@ mod tests {
         assert_eq!(open.count(), 0, "{open:?}");
         // Under the small sphere at (2, −3.2, −5): that sphere alone.
         let under = list.occluders_towards(Vec3::new(1.9, -6.0, -5.0), 0.0, &light, [3, 9]);
-        assert_eq!(under, Occluders { lanes: 1 << 1 });
+        assert_eq!(
+            under,
+            Occluders {
+                lanes: 1 << 1,
+                others: u32::MAX
+            }
+        );
+    }
+
+    /// A ground plane, a wall plane, a two-sided plane tilted across the space
+    /// between the ground and the light, a sphere, and a light above them.
+    fn planes() -> (ShapeList, [Vec3; 4]) {
+        let mut list = ShapeList::new();
+        let plane =
+            |p: [f32; 3], n: [f32; 3]| crate::Plane::new(p.into(), n.into(), false).unwrap();
+        list.push(plane([0.0, 0.0, 0.0], [0.0, 1.0, 0.0]));
+        list.push(plane([5.0, 0.0, 0.0], [-1.0, 0.0, 0.0]));
+        list.push(
+            crate::Plane::new(Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.3, 1.0, 0.0), true).unwrap(),
+        );
+        list.push(Sphere::new(Vec3::new(1.0, 1.0, 0.0), 0.5).unwrap());
+        let light = Parallelogram::new(
+            Vec3::new(-1.0, 4.0, -1.0),
+            Vec3::X * 2.0,
+            Vec3::Z * 2.0,
+            false,
+        )
+        .unwrap()
+        .facing(-Vec3::Y);
+        list.push(light);
+        list.build_acceleration();
+        (list, light.corners())
+    }
+
+    #[test]
+    fn planes_no_shadow_segment_crosses_are_culled() {
+        let (list, light) = planes();
+        let kept = |o: Occluders| (0..3).map(|i| o.keeps_other(i)).collect::<Vec<_>>();
+        // On the ground: its own plane and the wall beside are culled; the
+        // tilted plane, between the point and the light, is kept.
+        let ground = list.occluders_towards(Vec3::new(2.0, 0.0, 0.0), 0.0, &light, [0, 4]);
+        assert_eq!(kept(ground), [false, false, true]);
+        // Beyond the tilted plane's reach, above the ground: none of the three.
+        let clear = list.occluders_towards(Vec3::new(2.0, 3.0, 0.0), 0.0, &light, [3, 4]);
+        assert_eq!(kept(clear), [false, false, false]);
+        // Under the ground, the light above it: the ground is kept.
+        let under = list.occluders_towards(Vec3::new(2.0, -1.0, 0.0), 0.0, &light, [3, 4]);
+        assert!(under.keeps_other(0));
+        // Past the wall: the wall is kept.
+        let past = list.occluders_towards(Vec3::new(6.0, 1.0, 0.0), 0.0, &light, [3, 4]);
+        assert!(past.keeps_other(1));
+        assert!(Occluders::ALL.keeps_other(0) && Occluders::ALL.keeps_other(40));
+    }
+
+    /// Culled planes never change an answer: shadow rays from points on every
+    /// surface and in between get the full loop's answer, one by one and in lanes.
+    #[test]
+    fn culled_planes_leave_every_shadow_answer_as_it_was() {
+        let (list, light) = planes();
+        let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
+        let mut next = move || rng.unit();
+        let (mut blocked, mut culled) = (0, 0);
+        for _ in 0..3000 {
+            let aim = Vec3::new(next() * 12.0 - 6.0, next() * 6.0 - 2.0, next() * 8.0 - 4.0);
+            // Below the tilted plane: the ground, the sphere, the plane's underside.
+            let eye = Vec3::new(0.5, 1.0, 8.0);
+            let ray = Ray::new(eye, aim - eye);
+            let Some(hit) = list.closest_hit(&ray, f32::INFINITY) else {
+                continue;
+            };
+            let reach = 0.2 * next();
+            let occluders = list.occluders_towards(hit.point, reach, &light, [hit.shape, 4]);
+            culled += (0..3).filter(|&i| !occluders.keeps_other(i)).count();
+            let targets: [Vec3; LANES] = std::array::from_fn(|_| {
+                let (a, b) = (next(), next());
+                light[0] + a * (light[1] - light[0]) + b * (light[3] - light[0])
+            });
+            let shadows = targets.map(|t| crate::spawn_ray_to(&hit, &crate::RayTarget::exact(t)));
+            let mut expected = 0u32;
+            for (k, shadow) in shadows.iter().enumerate() {
+                let full = list.any_hit(shadow, 1.0);
+                assert_eq!(list.any_hit_among(&occluders, shadow, 1.0), full);
+                expected |= (full as u32) << k;
+                blocked += full as u32;
+            }
+            let lanes = RayLanes::new(shadows);
+            let all = lanes::all_bits();
+            assert_eq!(list.any_hits_among(&occluders, &lanes, 1.0, all), expected);
+        }
+        assert!(
+            blocked > 500 && culled > 2000,
+            "{blocked} blocked, {culled} culled"
+        );
     }
 
     /// Culling never changes an answer: shadow rays from points all over the box's

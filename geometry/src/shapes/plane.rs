@@ -51,6 +51,19 @@ impl Plane {
         self.normal
     }
 
+    /// Whether `from` and the four `corners` lie strictly on one side of the
+    /// plane, each more than `margin` from it: then no segment from within
+    /// `margin` of `from` to a point of their convex hull crosses it.
+    pub fn separates_none(&self, from: Vec3, corners: &[Vec3; 4], margin: f32) -> bool {
+        let distance = |x: Vec3| self.normal.dot(x - self.point);
+        let d = distance(from);
+        let same_side = |c: &Vec3| {
+            let dc = distance(*c);
+            (d > 0.0 && dc > margin) || (d < 0.0 && dc < -margin)
+        };
+        d.abs() > margin && corners.iter().all(same_side)
+    }
+
     pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
         let denom = self.normal.dot(ray.direction);
         if denom == 0.0 || (!self.two_sided && denom > 0.0) {

@@ -158,15 +158,17 @@ impl ShapeList {
     }
 
     /// Whether [`ShapeList::closest_lanes`] answers (the linear loop holds every
-    /// object in its packets).
+    /// object in its packets, but for planes).
     pub fn has_closest_lanes(&self) -> bool {
         self.lanes_layout().is_some()
     }
 
     pub(super) fn lanes_layout(&self) -> Option<&LinearShapes> {
-        self.linear
-            .as_ref()
-            .filter(|linear| linear.others.is_empty() && self.bvh.is_none())
+        self.linear.as_ref().filter(|linear| {
+            self.bvh.is_none()
+                && (linear.others.iter())
+                    .all(|&o| matches!(self.object(o), ObjectRef::Shape(Shape::Plane(_))))
+        })
     }
 
     /// [`ShapeList::closest_primitives_lanes`] with the answers left in lanes.
@@ -194,7 +196,8 @@ impl ShapeList {
             .chain(parallelograms)
             .flatten()
             .filter(|&&o| o != u32::MAX && (o >= 64 || candidates >> o & 1 == 1));
-        for &object in used {
+        // Planes, unbounded, are in every pixel's view: always tested.
+        for &object in used.chain(&linear.others) {
             let (hits, t) = match self.object(object) {
                 ObjectRef::Shape(Shape::Sphere(s)) => {
                     count(|c| c.sphere_tests += tested);
@@ -204,7 +207,11 @@ impl ShapeList {
                     count(|c| c.parallelogram_tests += tested);
                     p.hit_distance_lanes(rays, f32::INFINITY)
                 }
-                _ => unreachable!("packets hold spheres and parallelograms"),
+                ObjectRef::Shape(Shape::Plane(p)) => {
+                    count(|c| c.plane_tests += tested);
+                    p.hit_distance_lanes(rays, f32::INFINITY)
+                }
+                _ => unreachable!("the lanes layout holds spheres, parallelograms and planes"),
             };
             if hits == 0 {
                 continue;

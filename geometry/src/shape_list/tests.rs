@@ -376,7 +376,7 @@ mod lanes {
         // and with them the hits are each ray's own. Rays on the frustum's
         // edges and corners are included.
         let mut rng = XorShift(0x7a11_c0de_5eed_0001);
-        let (mut hits, mut culled) = (0, 0);
+        let (mut hits, mut culled, mut plane_hits) = (0, 0, 0);
         for scene in 0..80 {
             let mut list = ShapeList::new();
             let scale = [1.0, 1e-3, 1e3][scene % 3];
@@ -396,7 +396,15 @@ mod lanes {
                     list.push(Parallelogram::new(c, e1, e2, k % 4 == 1).unwrap());
                 }
             }
+            if scene % 4 == 1 {
+                // Unbounded planes, one-sided and two-sided: tested in every frustum.
+                for two_sided in [false, true] {
+                    let (p, n) = (rng.vec3(-4.0, 4.0) * scale, rng.vec3(-1.0, 1.0));
+                    list.push(crate::Plane::new(p, n, two_sided).unwrap());
+                }
+            }
             list.build_acceleration();
+            assert!(list.has_closest_lanes());
             for _ in 0..100 {
                 let apex = rng.vec3(-6.0, 6.0) * scale;
                 let axis = (rng.vec3(-4.0, 4.0) * scale - apex).normalize();
@@ -423,10 +431,12 @@ mod lanes {
                 for (k, ray) in rays.iter().enumerate() {
                     assert_eq!(found.hit(k), list.closest_primitive(ray, f32::INFINITY));
                     hits += found.hit(k).is_some() as u32;
+                    plane_hits += found.hit(k).is_some_and(|h| h.object >= 12) as u32;
                 }
             }
         }
         assert!(hits > 2000, "only {hits} hits");
+        assert!(plane_hits > 200, "only {plane_hits} plane hits");
         assert!(culled > 40_000, "the frusta leave out objects ({culled})");
     }
 
@@ -536,9 +546,14 @@ mod lanes {
             }
         }
         assert!(hits > 3000, "only {hits} hits");
-        // Layouts it does not serve: a plane outside the packets, and a BVH.
+        // Planes are served beside the packets; a box outside them is not, nor
+        // is a BVH.
         let rays = RayLanes::new([Ray::new(Vec3::ZERO, Vec3::X); LANES]);
         let mut list = scene();
+        list.build_acceleration();
+        assert!(list.closest_primitives_lanes(&rays, LANES).is_some());
+        let mut list = scene();
+        list.push(crate::AaBox::new(Vec3::splat(2.0), Vec3::splat(3.0)).unwrap());
         list.build_acceleration();
         assert!(list.closest_primitives_lanes(&rays, LANES).is_none());
         assert_eq!(

@@ -2,7 +2,8 @@
 //! texture to the horizon.
 
 use crate::error_bounds::gamma;
-use crate::{Hit, Ray};
+use crate::lanes::{F32Lanes, Float, Mask, Vector3};
+use crate::{Hit, Ray, RayLanes};
 use glam::{Vec2, Vec3};
 
 /// An infinite plane through `point` with unit `normal` (its front side).
@@ -65,12 +66,40 @@ impl Plane {
     }
 
     pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
-        let denom = self.normal.dot(ray.direction);
-        if denom == 0.0 || (!self.two_sided && denom > 0.0) {
-            return None;
+        let (hit, t) = self.hits(&ray.origin.into(), &ray.direction.into(), t_max);
+        hit.then_some(t)
+    }
+
+    /// [`Self::hit_distance`] for each lane's ray: the lanes that hit (bit k
+    /// for lane k) and their distances.
+    #[inline]
+    pub fn hit_distance_lanes(&self, rays: &RayLanes, t_max: f32) -> (u32, F32Lanes) {
+        let (hit, t) = self.hits(&rays.origin, &rays.direction, F32Lanes::splat(t_max));
+        (hit.bits(), t)
+    }
+
+    /// The one kernel of both, for one ray or lanes of them: `t = n·(p − o) /
+    /// n·d` where the ray meets the plane's front (either side if two-sided)
+    /// in (0, `t_max`).
+    #[inline(always)]
+    fn hits<F: Float>(
+        &self,
+        origin: &Vector3<F>,
+        direction: &Vector3<F>,
+        t_max: F,
+    ) -> (F::Mask, F) {
+        let denom = direction.dot_splat(self.normal);
+        let facing = if self.two_sided {
+            F::Mask::TRUE
+        } else {
+            !denom.gt(F::ZERO)
+        };
+        let valid = !denom.eq(F::ZERO) & facing;
+        if !valid.any() {
+            return (F::Mask::FALSE, F::ZERO);
         }
-        let t = self.normal.dot(self.point - ray.origin) / denom;
-        (t > 0.0 && t < t_max).then_some(t)
+        let t = Vector3::splat_sub(self.point, origin).dot_splat(self.normal) / denom;
+        (valid & t.in_ray_range(t_max), t)
     }
 
     pub fn surface_at(&self, ray: &Ray, t: f32) -> Hit {

@@ -104,55 +104,67 @@ impl DirectIntegrator {
         .then(|| Pcg32Lanes::for_streams(pixel_key(first.seed, first.pixel), first.sample));
         let mut pairs = PairAllocation::new(0);
         for (index, light) in scene.lights.iter().enumerate() {
-            let area = match light {
-                Light::Area(area) => area,
+            let term = match light {
+                Light::Area(area) => {
+                    let own = DimensionPair::Light {
+                        light: index as u32,
+                        depth: 0,
+                    };
+                    let pair = pairs.take(own, self.light_samples);
+                    let samples = (first, pair, &mut rngs);
+                    self.area_light_term(scene, &shaded, (index, area), samples, ctx)
+                }
                 Light::Point(point) => {
                     ctx.counters.point_light_samples += u64::from(shaded.lanes.count_ones());
                     let reflected = shaded.point_light(scene, point, ctx);
-                    let term = Vec3Lanes::scaled_splat_lanes(point.color, &reflected);
-                    radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
-                    continue;
+                    Vec3Lanes::scaled_splat_lanes(point.color, &reflected)
                 }
                 Light::Sphere(_) => {
                     unreachable!("shades_first_hits_in_lanes admits no sphere lights")
                 }
             };
-            let own = DimensionPair::Light {
-                light: index as u32,
-                depth: 0,
-            };
-            let pair = pairs.take(own, self.light_samples);
-            let grid = self.grid_points(pair, ctx);
-            let occluders = match self.light_samples >= CULL_FROM_SAMPLES {
-                true => shaded.occluders(scene, index, area),
-                false => Occluders::ALL,
-            };
-            // `li_at`'s `L · (0 + Σ reflected) / n`, each lane summing its own
-            // samples in order. A sample a lane's point does not see adds +0
-            // where `li_at` adds nothing: the same, as the sum is never −0.
-            let mut sum = Vec3Lanes::default();
-            for j in 0..self.light_samples {
-                let u = match (&mut rngs, &grid) {
-                    (Some(rngs), _) => rngs.uniform2(),
-                    (None, Some(grid)) => {
-                        let p = grid.get(j as usize);
-                        (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
-                    }
-                    (None, None) => self.sobol_points(first, pair, j, ctx),
-                };
-                ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
-                sum = sum + shaded.area_light(scene, area, &occluders, u, ctx);
-            }
-            if let Some(grid) = grid {
-                ctx.light_points = grid;
-            }
-            let term = Vec3Lanes::scaled_splat_lanes(area.color, &sum)
-                .div_splat(self.light_samples as f32);
             radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
         }
         // `li_at` adds the absent environment and mirror terms, zeros: a −0
         // component becomes +0 there, so it must here too.
         Vec3Lanes::select(shaded_mask, &(radiance + Vec3Lanes::default()), &radiance)
+    }
+
+    /// `li_at`'s `L · (0 + Σ reflected) / n` for area light `index`, each lane
+    /// summing its own `n` samples in order, their points those of `pair` for
+    /// the camera samples from `first` (drawn from `rngs` where the pattern
+    /// draws). A sample a lane's point does not see adds +0 where `li_at` adds
+    /// nothing: the same, as the sum is never −0.
+    fn area_light_term<T: Tracer>(
+        &self,
+        scene: &Scene,
+        shaded: &ShadedLanes,
+        (index, area): (usize, &AreaLight),
+        (first, pair, rngs): (PixelSample, DimensionPair, &mut Option<Pcg32Lanes>),
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let grid = self.grid_points(pair, ctx);
+        let occluders = match self.light_samples >= CULL_FROM_SAMPLES {
+            true => shaded.occluders(scene, index, area),
+            false => Occluders::ALL,
+        };
+        let mut sum = Vec3Lanes::default();
+        for j in 0..self.light_samples {
+            let u = match (&mut *rngs, &grid) {
+                (Some(rngs), _) => rngs.uniform2(),
+                (None, Some(grid)) => {
+                    let p = grid.get(j as usize);
+                    (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
+                }
+                (None, None) => self.sobol_points(first, pair, j, ctx),
+            };
+            ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
+            sum = sum + shaded.area_light(scene, area, &occluders, u, ctx);
+        }
+        if let Some(grid) = grid {
+            ctx.light_points = grid;
+        }
+        Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(self.light_samples as f32)
     }
 
     /// Light sample `j` of pair `pair` of each lane's camera sample (lane k:

@@ -128,16 +128,6 @@ impl ShapeList {
         ray: &Ray,
         t_max: f32,
     ) -> bool {
-        !linear.others.is_empty() && self.others_hit_one_by_one(linear, occluders, ray, t_max)
-    }
-
-    fn others_hit_one_by_one(
-        &self,
-        linear: &LinearShapes,
-        occluders: &Occluders,
-        ray: &Ray,
-        t_max: f32,
-    ) -> bool {
         let mut kept = (linear.others.iter().enumerate())
             .filter(|&(i, _)| occluders.keeps_other(i))
             .peekable();

@@ -144,19 +144,31 @@ impl DirectIntegrator {
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let grid = self.grid_points(pair, ctx);
+        // Lane k's sample j is point `(first.sample + k)·n + j` of the pixel's
+        // sequence for `pair`: the points each sample alone takes of it.
+        let n = self.light_samples;
+        let sobol = first.sobol_points(pair, n);
+        let sequence =
+            (self.light_pattern == SamplePattern::Sobol).then(|| ctx.sequences.sequence(sobol));
         let occluders = match self.light_samples >= CULL_FROM_SAMPLES {
             true => shaded.occluders(scene, index, area),
             false => Occluders::ALL,
         };
         let mut sum = Vec3Lanes::default();
         for j in 0..self.light_samples {
-            let u = match (&mut *rngs, &grid) {
-                (Some(rngs), _) => rngs.uniform2(),
-                (None, Some(grid)) => {
+            let u = match (&mut *rngs, &grid, sequence) {
+                (Some(rngs), _, _) => rngs.uniform2(),
+                (None, Some(grid), _) => {
                     let p = grid.get(j as usize);
                     (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
                 }
-                (None, None) => self.sobol_points(first, pair, j, ctx),
+                (None, None, Some(sequence)) => {
+                    let u = sequence.lanes_strided(sobol.first + u64::from(j), u64::from(n));
+                    (u.x, u.y)
+                }
+                (None, None, None) => {
+                    unreachable!("the patterns in lanes draw, share or are Sobol")
+                }
             };
             ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
             sum = sum + shaded.area_light(scene, area, &occluders, u, ctx);
@@ -165,23 +177,6 @@ impl DirectIntegrator {
             ctx.light_points = grid;
         }
         Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(self.light_samples as f32)
-    }
-
-    /// Light sample `j` of pair `pair` of each lane's camera sample (lane k:
-    /// sample `first.sample + k`), from the pixel's Sobol sequence for the
-    /// pair: points `(first.sample + k)·n + j` for `n` samples per light, the
-    /// points [`SampleContext::fill_points`] gives each sample alone.
-    fn sobol_points<T: Tracer>(
-        &self,
-        first: PixelSample,
-        pair: DimensionPair,
-        j: u32,
-        ctx: &mut SampleContext<T>,
-    ) -> (F32Lanes, F32Lanes) {
-        let n = u64::from(self.light_samples);
-        let sobol = first.sobol_points(pair, self.light_samples);
-        let u = (ctx.sequences.sequence(sobol)).lanes_strided(sobol.first + u64::from(j), n);
-        (u.x, u.y)
     }
 
     /// The grid pattern's points for `pair` (the same for every camera sample),

@@ -522,7 +522,7 @@ mod tests {
         // tilted plane, between the point and the light, is kept.
         let ground = list.occluders_towards(Vec3::new(2.0, 0.0, 0.0), 0.0, &light, [0, 4]);
         assert_eq!(kept(ground), [false, false, true]);
-        // Beyond the tilted plane's reach, above the ground: none of the three.
+        // Above the tilted plane, on the light's side of all three: none.
         let clear = list.occluders_towards(Vec3::new(2.0, 3.0, 0.0), 0.0, &light, [3, 4]);
         assert_eq!(kept(clear), [false, false, false]);
         // Under the ground, the light above it: the ground is kept.

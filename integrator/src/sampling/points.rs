@@ -22,11 +22,7 @@ impl PointLanes {
     /// `points` in the first lanes, the others 0.
     pub fn from_points(points: &[Vec2]) -> Self {
         debug_assert!(points.len() <= LANES);
-        let coordinate = |axis: usize| {
-            F32Lanes::new(std::array::from_fn(|k| {
-                points.get(k).map_or(0.0, |u| u[axis])
-            }))
-        };
+        let coordinate = |axis: usize| lanes::from_fn(|k| points.get(k).map_or(0.0, |u| u[axis]));
         Self {
             x: coordinate(0),
             y: coordinate(1),

@@ -186,7 +186,8 @@ impl SobolSequence {
         let last = first + (LANES as u64 - 1) * stride;
         if first >> BLOCK_BITS == last >> BLOCK_BITS {
             let i = first as u32 & BLOCK_MASK;
-            let index = U32Lanes::new(std::array::from_fn(|k| i + k as u32 * stride as u32));
+            let lane = U32Lanes::new(std::array::from_fn(|k| k as u32));
+            let index = U32Lanes::splat(i) + lane * U32Lanes::splat(stride as u32);
             self.scrambles(first).points(index)
         } else {
             let points: [Vec2; LANES] =

@@ -694,12 +694,16 @@ fn baseline_name(config: &BenchConfig) -> String {
         .name()
 }
 
+/// The baseline's target: its largest budget, by samples and then by time.
+/// Samples come first because the times of a small scene's cheapest budgets
+/// can swap places on a busy machine, and the target must not move with them.
 fn baseline(config: &BenchConfig, rows: &[Row]) -> Option<Baseline> {
     let name = baseline_name(config);
-    let last = rows
-        .iter()
-        .filter(|r| r.strategy == name)
-        .max_by(|a, b| a.time_median_s.total_cmp(&b.time_median_s))?;
+    let last = rows.iter().filter(|r| r.strategy == name).max_by(|a, b| {
+        a.total_samples
+            .cmp(&b.total_samples)
+            .then(a.time_median_s.total_cmp(&b.time_median_s))
+    })?;
     Some(Baseline {
         strategy: name,
         target_rel_mse: last.rel_mse,

@@ -8,7 +8,7 @@ use crate::settings::RenderSettings;
 use crate::texture_lookup::texture_footprint;
 use crate::trace::{Event, Shadow, Skip, Tracer};
 use crate::{Scene, SurfaceKind};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{
     offset_ray_origin, reflect_differential, spawn_ray, spawn_ray_to, Hit, Occluders, Ray,
@@ -579,9 +579,13 @@ impl ShadingPoint<'_> {
             let mut values = [Vec3::ZERO; LANES];
             let mut directions = [self.hit.geometric_normal; LANES];
             let mut traced = 0u32;
-            for (k, u) in chunk.iter().enumerate() {
-                let s = env.sample(self.n, u);
-                if let Some((_, value)) = self.environment_sample_unshadowed(&s, ctx) {
+            let mut points = [Vec2::ZERO; LANES];
+            for (k, point) in points.iter_mut().enumerate().take(chunk.len) {
+                *point = chunk.lanes.lane(k);
+            }
+            let drawn = env.sample_each(self.n, &points, chunk.len);
+            for (k, s) in drawn.iter().enumerate().take(chunk.len) {
+                if let Some((_, value)) = self.environment_sample_unshadowed(s, ctx) {
                     (values[k], directions[k]) = (value, s.direction);
                     traced |= 1 << k;
                 }

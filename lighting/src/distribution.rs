@@ -149,6 +149,26 @@ impl PiecewiseConstant2D {
         (Vec2::new(x, v), pdf_v * pdf_u)
     }
 
+    /// [`Self::sample`] at each of the first `len` points of `u`, bit for bit,
+    /// stage by stage: every point's row, then every point's column. The
+    /// searches of different points are independent, so their loads overlap
+    /// where one point's would each wait for the one before.
+    #[inline]
+    pub fn sample_each<const N: usize>(&self, u: &[Vec2; N], len: usize) -> [(Vec2, f32); N] {
+        let mut out = [(Vec2::ZERO, 0.0); N];
+        let mut rows = [0usize; N];
+        for k in 0..len.min(N) {
+            let (v, pdf_v, row) = self.marginal.sample(u[k].y);
+            (out[k], rows[k]) = ((Vec2::new(0.0, v), pdf_v), row);
+        }
+        for k in 0..len.min(N) {
+            let (x, pdf_u, _) = self.rows[rows[k]].sample(u[k].x);
+            out[k].0.x = x;
+            out[k].1 *= pdf_u;
+        }
+        out
+    }
+
     /// The density at `uv` ∈ [0, 1]².
     #[inline]
     pub fn pdf(&self, uv: Vec2) -> f32 {

@@ -94,21 +94,9 @@ impl EnvironmentLight {
                     pdf: local.z * FRAC_1_PI,
                 };
             }
-            (Environment::LatLong(_), Some(dist)) => {
+            (_, Some(dist)) => {
                 let (uv, p) = dist.sample(u);
-                let sin_theta = (uv.y * PI).sin();
-                let pdf = if sin_theta > 0.0 {
-                    p / (2.0 * PI * PI * sin_theta)
-                } else {
-                    0.0
-                };
-                (latlong_direction(uv), pdf)
-            }
-            (Environment::CubeMap(_), Some(dist)) => {
-                let (uv, p) = dist.sample(u);
-                let (face, st) = unpack_cube_uv(uv);
-                let d = cube_direction(face, st);
-                (d.normalize(), p / cube_jacobian(st))
+                self.map_direction(uv, p)
             }
         };
         let direction = self.to_world(map_dir);
@@ -117,6 +105,60 @@ impl EnvironmentLight {
             radiance: self.radiance(direction, 0.0),
             pdf,
         }
+    }
+
+    /// [`Self::sample`] at each of the first `len` points of `u`, bit for bit,
+    /// stage by stage over all the points (the map's searches, the
+    /// directions, the radiance), so that the loads of different samples
+    /// overlap.
+    pub fn sample_each<const N: usize>(
+        &self,
+        normal: Vec3,
+        u: &[Vec2; N],
+        len: usize,
+    ) -> [EnvironmentSample; N] {
+        let mut out = [EnvironmentSample {
+            direction: normal,
+            radiance: Vec3::ZERO,
+            pdf: 0.0,
+        }; N];
+        let len = len.min(N);
+        let dist = match (&self.environment, &self.distribution) {
+            (Environment::Constant(_), _) | (_, None) => {
+                for k in 0..len {
+                    out[k] = self.sample(normal, u[k]);
+                }
+                return out;
+            }
+            (_, Some(dist)) => dist,
+        };
+        let uv = dist.sample_each(u, len);
+        for k in 0..len {
+            let (map_dir, pdf) = self.map_direction(uv[k].0, uv[k].1);
+            (out[k].direction, out[k].pdf) = (self.to_world(map_dir), pdf);
+        }
+        for sample in &mut out[..len] {
+            sample.radiance = self.radiance(sample.direction, 0.0);
+        }
+        out
+    }
+
+    /// The map's direction at `uv`, sampled with density `p` per unit area of
+    /// [0, 1]², and its density in solid angle.
+    #[inline]
+    fn map_direction(&self, uv: Vec2, p: f32) -> (Vec3, f32) {
+        if let Environment::CubeMap(_) = self.environment {
+            let (face, st) = unpack_cube_uv(uv);
+            let d = cube_direction(face, st);
+            return (d.normalize(), p / cube_jacobian(st));
+        }
+        let sin_theta = (uv.y * PI).sin();
+        let pdf = if sin_theta > 0.0 {
+            p / (2.0 * PI * PI * sin_theta)
+        } else {
+            0.0
+        };
+        (latlong_direction(uv), pdf)
     }
 
     /// The solid-angle density with which [`Self::sample`] picks world direction
@@ -352,6 +394,24 @@ mod tests {
                 bright > n / 4,
                 "only {bright} of {n} samples hit the hot spot"
             );
+        }
+    }
+
+    #[test]
+    fn samples_drawn_together_are_those_drawn_one_by_one() {
+        let constant = Environment::Constant(Vec3::splat(0.5));
+        for env in [hot_spot_latlong(), hot_spot_cube(), constant] {
+            let light = EnvironmentLight::new(env, 0.4, 2.0);
+            let normal = Vec3::new(0.3, 0.8, -0.2).normalize();
+            let points: [Vec2; 16] = std::array::from_fn(|k| {
+                Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 + 0.5) / 16.0)
+            });
+            for len in [16, 5, 0] {
+                let together = light.sample_each(normal, &points, len);
+                for (k, s) in together.iter().enumerate().take(len) {
+                    assert_eq!(*s, light.sample(normal, points[k]), "sample {k} of {len}");
+                }
+            }
         }
     }
 

@@ -137,6 +137,11 @@ impl CubeMap {
     /// so the level is `log2(width·N/2) + ¾·log2(1 + s² + t²)`.
     pub fn radiance(&self, d: Vec3, width: f32) -> Vec3 {
         let (face, st) = cube_face_st(d);
+        // A cone of no width (or NaN) reads level 0: the level below would
+        // come out −∞ (or NaN), which the clamp turns into 0 anyway.
+        if width.is_nan() || width <= 0.0 {
+            return self.bilinear(face, 0, st);
+        }
         let (s, t) = (2.0 * st.x - 1.0, 2.0 * st.y - 1.0);
         let level = (width * self.size() as f32 / 2.0).log2() + 0.75 * (1.0 + s * s + t * t).log2();
         let last = (self.level_count() - 1) as f32;
@@ -222,6 +227,9 @@ impl LatLongMap {
     pub fn radiance(&self, d: Vec3, width: f32) -> Vec3 {
         let uv = latlong_uv(d);
         let image = self.image.image();
+        if width.is_nan() || width <= 0.0 {
+            return latlong_bilinear(image, uv);
+        }
         let level = (width * image.height() as f32 / PI).log2();
         if level.is_nan() || level <= 0.0 {
             return latlong_bilinear(self.image.image(), uv);
@@ -257,7 +265,13 @@ pub fn latlong_texel(image: &Image, x: i64, y: i64) -> Vec3 {
     } else {
         (x, y)
     };
-    image.texel(x.rem_euclid(w) as u32, y.clamp(0, h - 1) as u32)
+    // Most reads are inside: skip the division there.
+    let x = if (0..w).contains(&x) {
+        x
+    } else {
+        x.rem_euclid(w)
+    };
+    image.texel(x as u32, y.clamp(0, h - 1) as u32)
 }
 
 /// Radiance arriving from every direction: a constant, a cube map or a lat-long map.

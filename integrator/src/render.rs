@@ -386,8 +386,8 @@ impl<'a> PixelRenderer<'a> {
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let (scene, settings, used) = (self.scene, self.settings, jitters.len());
-        let rays: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
-            let raster = Vec2::new(x as f32, y as f32) + jitters[k.min(used - 1)];
+        let ray_at = |jitter: Vec2| {
+            let raster = Vec2::new(x as f32, y as f32) + jitter;
             if self.differentials {
                 camera_ray(&scene.camera, raster, self.footprint_scale)
             } else {
@@ -395,7 +395,15 @@ impl<'a> PixelRenderer<'a> {
                 let ray = Ray::new(c.origin, c.direction);
                 (ray, RayDifferential::none(&ray))
             }
-        });
+        };
+        // The unused lanes repeat the last sample's ray, made once.
+        let mut rays = [ray_at(jitters[0]); LANES];
+        for (k, &jitter) in jitters.iter().enumerate().skip(1) {
+            rays[k] = ray_at(jitter);
+        }
+        for k in used..LANES {
+            rays[k] = rays[used - 1];
+        }
         let ray_lanes = RayLanes::new(rays.map(|(ray, _)| ray));
         let closest = (settings.aov.is_none() && used > 1 && !T::ON)
             .then(|| scene.shapes.closest_lanes(&ray_lanes, used))

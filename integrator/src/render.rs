@@ -352,19 +352,11 @@ impl<'a> PixelRenderer<'a> {
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let (scene, used) = (self.scene, jitters.len());
-        let jitter = |axis: usize| lanes::from_fn(|k| jitters[k.min(used - 1)][axis]);
-        let c = scene.camera.generate_rays_lanes(
-            F32Lanes::splat(x as f32) + jitter(0),
-            F32Lanes::splat(y as f32) + jitter(1),
-        );
-        let [dx, dy, dz] = c.direction;
+        let (px, py) = raster_lanes(x, y, jitters);
+        let c = scene.camera.generate_rays_lanes(px, py);
         let rays = RayLanes {
             origin: Vec3Lanes::splat(c.origin),
-            direction: Vec3Lanes {
-                x: dx,
-                y: dy,
-                z: dz,
-            },
+            direction: vec3_lanes(c.direction),
         };
         let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
         let closest = closest.expect("has_closest_lanes");
@@ -386,46 +378,38 @@ impl<'a> PixelRenderer<'a> {
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let (scene, settings, used) = (self.scene, self.settings, jitters.len());
-        let ray_at = |jitter: Vec2| {
-            let raster = Vec2::new(x as f32, y as f32) + jitter;
-            if self.differentials {
-                camera_ray(&scene.camera, raster, self.footprint_scale)
-            } else {
-                let c = scene.camera.generate_ray(raster.x, raster.y);
-                let ray = Ray::new(c.origin, c.direction);
-                (ray, RayDifferential::none(&ray))
+        let (px, py) = raster_lanes(x, y, jitters);
+        let (ray_lanes, diffs) = match self.differentials {
+            true => camera_rays_lanes(&scene.camera, px, py, self.footprint_scale),
+            false => {
+                let c = scene.camera.generate_rays_lanes(px, py);
+                let rays = RayLanes {
+                    origin: Vec3Lanes::splat(c.origin),
+                    direction: vec3_lanes(c.direction),
+                };
+                let diffs = lanes::array_from_fn(|k| RayDifferential::none(&rays.lane(k)));
+                (rays, diffs)
             }
         };
-        // The unused lanes repeat the last sample's ray, made once.
-        let mut rays = [ray_at(jitters[0]); LANES];
-        for (k, &jitter) in jitters.iter().enumerate().skip(1) {
-            rays[k] = ray_at(jitter);
-        }
-        for k in used..LANES {
-            rays[k] = rays[used - 1];
-        }
-        let ray_lanes = RayLanes::new(rays.map(|(ray, _)| ray));
         let closest = (settings.aov.is_none() && used > 1 && !T::ON)
             .then(|| scene.shapes.closest_lanes(&ray_lanes, used))
             .flatten();
         match &closest {
             // One sample per light: the chunk's samples shaded together.
-            Some(closest) if first_hits_in_lanes => {
-                let diffs = rays.map(|(_, diff)| diff);
-                (self.integrator).li_first_hits(
-                    scene,
-                    &ray_lanes,
-                    Some(&diffs),
-                    closest,
-                    used,
-                    first,
-                    ctx,
-                )
-            }
+            Some(closest) if first_hits_in_lanes => (self.integrator).li_first_hits(
+                scene,
+                &ray_lanes,
+                Some(&diffs),
+                closest,
+                used,
+                first,
+                ctx,
+            ),
             _ => Vec3Lanes::from_lanes(std::array::from_fn(|k| {
-                let Some((ray, diff)) = rays.get(k).filter(|_| k < used) else {
+                if k >= used {
                     return Vec3::ZERO;
-                };
+                }
+                let (ray, diff) = (&ray_lanes.lane(k), &diffs[k]);
                 let hit = closest.as_ref().map(|closest| {
                     closest
                         .hit(k)
@@ -539,6 +523,47 @@ fn accumulate<T: Tracer>(
     }
 }
 
+/// The raster positions of a chunk of a pixel's camera samples, at `jitters`
+/// in pixel (x, y); the lanes past them repeat the last.
+fn raster_lanes(x: u32, y: u32, jitters: &[Vec2]) -> (F32Lanes, F32Lanes) {
+    let last = jitters.len() - 1;
+    let jitter = |axis: usize| lanes::from_fn(|k| jitters[k.min(last)][axis]);
+    (
+        F32Lanes::splat(x as f32) + jitter(0),
+        F32Lanes::splat(y as f32) + jitter(1),
+    )
+}
+
+fn vec3_lanes([x, y, z]: [F32Lanes; 3]) -> Vec3Lanes {
+    Vec3Lanes { x, y, z }
+}
+
+/// [`camera_ray`] in every lane, at raster positions `(x[k], y[k])`: each
+/// lane's ray and differentials bit for bit the scalar ones.
+pub fn camera_rays_lanes(
+    camera: &Camera,
+    x: F32Lanes,
+    y: F32Lanes,
+    scale: f32,
+) -> (RayLanes, [RayDifferential; LANES]) {
+    let c = camera.generate_rays_lanes(x, y);
+    let d = vec3_lanes(c.direction);
+    let shrunk = |offset: [F32Lanes; 3]| d + (vec3_lanes(offset) - d).scale(F32Lanes::splat(scale));
+    let rx = shrunk(camera.generate_rays_lanes(x + F32Lanes::ONE, y).direction);
+    let ry = shrunk(camera.generate_rays_lanes(x, y + F32Lanes::ONE).direction);
+    let diffs = lanes::array_from_fn(|k| RayDifferential {
+        rx_origin: c.origin,
+        rx_direction: rx.lane(k),
+        ry_origin: c.origin,
+        ry_direction: ry.lane(k),
+    });
+    let rays = RayLanes {
+        origin: Vec3Lanes::splat(c.origin),
+        direction: d,
+    };
+    (rays, diffs)
+}
+
 /// The camera ray through `raster`, with its differentials shrunk to `scale`
 /// pixels (a render uses `max(1/8, 1/√spp)`).
 pub fn camera_ray(camera: &Camera, raster: Vec2, scale: f32) -> (Ray, RayDifferential) {
@@ -551,4 +576,38 @@ pub fn camera_ray(camera: &Camera, raster: Vec2, scale: f32) -> (Ray, RayDiffere
         ry_direction: d + scale * (c.dy_direction - d),
     };
     (Ray::new(c.ray.origin, d), diff)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every lane's ray and differentials are the scalar `camera_ray`'s, bit
+    /// for bit, for cameras looking along and across the axes.
+    #[test]
+    fn camera_rays_in_lanes_are_the_scalar_ones() {
+        let cameras = [
+            (Vec3::new(0.0, 1.0, 6.0), Vec3::new(0.0, 0.55, -10.0), 45.0),
+            (Vec3::new(-2.5, 3.1, 0.7), Vec3::new(1.0, -0.2, -3.0), 71.0),
+            (Vec3::ZERO, -Vec3::Z, 12.0),
+        ];
+        for (position, look_at, fov) in cameras {
+            let resolution = UVec2::new(640, 360);
+            let camera = Camera::new(position, look_at, Vec3::Y, fov, 1.0, resolution).unwrap();
+            let raster = |k: usize| Vec2::new(17.0 + 39.3 * k as f32, 3.0 + 22.1 * k as f32);
+            let (x, y) = (
+                lanes::from_fn(|k| raster(k).x),
+                lanes::from_fn(|k| raster(k).y),
+            );
+            for scale in [1.0, 0.25, 0.125] {
+                let (rays, diffs) = camera_rays_lanes(&camera, x, y, scale);
+                for (k, diff) in diffs.iter().enumerate() {
+                    let (ray, expected) = camera_ray(&camera, raster(k), scale);
+                    assert_eq!(rays.lane(k).origin, ray.origin);
+                    assert_eq!(rays.lane(k).direction, ray.direction, "lane {k}");
+                    assert_eq!(*diff, expected, "lane {k} at scale {scale}");
+                }
+            }
+        }
+    }
 }

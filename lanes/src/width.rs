@@ -105,6 +105,16 @@ pub fn from_fn(mut f: impl FnMut(usize) -> f32) -> F32Lanes {
     F32Lanes::new(lanes)
 }
 
+/// `[f(0), …, f(LANES − 1)]` by a loop, for the reason [`from_fn`] gives.
+#[inline(always)]
+pub fn array_from_fn<T: Copy>(mut f: impl FnMut(usize) -> T) -> [T; LANES] {
+    let mut out = [f(0); LANES];
+    for (k, lane) in out.iter_mut().enumerate().skip(1) {
+        *lane = f(k);
+    }
+    out
+}
+
 /// The mask of the lanes whose bit is set in `bits` (lane k as bit k): the
 /// inverse of [`bits`].
 #[inline]

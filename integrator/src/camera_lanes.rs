@@ -26,13 +26,13 @@
 use crate::direct::{PairAllocation, SampleContext, ShadingPoint, CULL_FROM_SAMPLES};
 use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::sampling::{
-    pixel_key, DimensionPair, Pcg32Lanes, PixelSample, SamplePattern, SamplePoints,
+    DimensionPair, LaneSamples, Pcg32Lanes, SamplePattern, SamplePoints, SobolSequence,
 };
 use crate::texture_lookup::texture_footprint;
 use crate::trace::Tracer;
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::Vec2;
-use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
+use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, LANES};
 use glint_geometry::{
     offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayDifferential, RayLanes, Shape,
     SurfaceLanes,
@@ -64,10 +64,10 @@ impl DirectIntegrator {
         self.light_samples == 1 || self.light_pattern != SamplePattern::Stratified
     }
 
-    /// The radiance of the first `used` of [`LANES`] camera samples of one pixel,
-    /// samples `first.sample..first.sample + used`, whose camera rays `rays`
-    /// have the closest hits `closest`: for each, what [`Self::li_at`] gives it
-    /// alone (with [`SampleContext::begin_sample`] for that sample), bit for bit.
+    /// The radiance of the first `used` of [`LANES`] camera samples, lane k
+    /// sample `samples.lane(k)`, whose camera rays `rays` have the closest
+    /// hits `closest`: for each, what [`Self::li_at`] gives it alone (with
+    /// [`SampleContext::begin_sample`] for that sample), bit for bit.
     /// Only for scenes where [`Self::shades_first_hits_in_lanes`] holds.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn li_first_hits<T: Tracer>(
@@ -77,7 +77,7 @@ impl DirectIntegrator {
         diffs: Option<&[RayDifferential; LANES]>,
         closest: &ClosestLanes,
         used: usize,
-        first: PixelSample,
+        samples: &LaneSamples,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         debug_assert!(self.shades_first_hits_in_lanes(scene));
@@ -101,7 +101,7 @@ impl DirectIntegrator {
             self.light_pattern,
             SamplePattern::Random | SamplePattern::Stratified
         )
-        .then(|| Pcg32Lanes::for_streams(pixel_key(first.seed, first.pixel), first.sample));
+        .then(|| Pcg32Lanes::new(samples.stream_seeds()));
         let mut pairs = PairAllocation::new(0);
         for (index, light) in scene.lights.iter().enumerate() {
             let term = match light {
@@ -111,8 +111,8 @@ impl DirectIntegrator {
                         depth: 0,
                     };
                     let pair = pairs.take(own, self.light_samples);
-                    let samples = (first, pair, &mut rngs);
-                    self.area_light_term(scene, &shaded, (index, area), samples, ctx)
+                    let points = (samples, pair, &mut rngs);
+                    self.area_light_term(scene, &shaded, (index, area), points, ctx)
                 }
                 Light::Point(point) => {
                     ctx.counters.point_light_samples += u64::from(shaded.lanes.count_ones());
@@ -132,7 +132,7 @@ impl DirectIntegrator {
 
     /// `li_at`'s `L · (0 + Σ reflected) / n` for area light `index`, each lane
     /// summing its own `n` samples in order, their points those of `pair` for
-    /// the camera samples from `first` (drawn from `rngs` where the pattern
+    /// the lanes' camera samples `samples` (drawn from `rngs` where the pattern
     /// draws). A sample a lane's point does not see adds +0 where `li_at` adds
     /// nothing: the same, as the sum is never −0.
     fn area_light_term<T: Tracer>(
@@ -140,32 +140,26 @@ impl DirectIntegrator {
         scene: &Scene,
         shaded: &ShadedLanes,
         (index, area): (usize, &AreaLight),
-        (first, pair, rngs): (PixelSample, DimensionPair, &mut Option<Pcg32Lanes>),
+        (samples, pair, rngs): (&LaneSamples, DimensionPair, &mut Option<Pcg32Lanes>),
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let grid = self.grid_points(pair, ctx);
-        // Lane k's sample j is point `(first.sample + k)·n + j` of the pixel's
-        // sequence for `pair`: the points each sample alone takes of it.
         let n = self.light_samples;
-        let sobol = first.sobol_points(pair, n);
-        let sequence =
-            (self.light_pattern == SamplePattern::Sobol).then(|| ctx.sequences.sequence(sobol));
+        let sequences = (self.light_pattern == SamplePattern::Sobol)
+            .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
         let occluders = match self.light_samples >= CULL_FROM_SAMPLES {
             true => shaded.occluders(scene, index, area),
             false => Occluders::ALL,
         };
         let mut sum = Vec3Lanes::default();
         for j in 0..self.light_samples {
-            let u = match (&mut *rngs, &grid, sequence) {
+            let u = match (&mut *rngs, &grid, &sequences) {
                 (Some(rngs), _, _) => rngs.uniform2(),
                 (None, Some(grid), _) => {
                     let p = grid.get(j as usize);
                     (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
                 }
-                (None, None, Some(sequence)) => {
-                    let u = sequence.lanes_strided(sobol.first + u64::from(j), u64::from(n));
-                    (u.x, u.y)
-                }
+                (None, None, Some(sequences)) => sequences.points(j, n),
                 (None, None, None) => {
                     unreachable!("the patterns in lanes draw, share or are Sobol")
                 }
@@ -192,6 +186,53 @@ impl DirectIntegrator {
             ctx.fill_points(self.light_pattern, pair, &mut points);
             points
         })
+    }
+}
+
+/// The Sobol sequences of a chunk's runs of camera samples for one pair:
+/// lane k's sample j is point `(sample + k')·n + j` of its pixel's sequence,
+/// `k'` its place in its run, the points each sample alone takes of it.
+struct RunSequences {
+    /// Each run's sequence, its first point, and its first lane.
+    runs: [(SobolSequence, u64, usize); LANES],
+    count: usize,
+}
+
+impl RunSequences {
+    /// The sequences of the runs holding a lane of `lanes`.
+    fn new<T: Tracer>(
+        samples: &LaneSamples,
+        lanes: u32,
+        pair: DimensionPair,
+        n: u32,
+        ctx: &mut SampleContext<T>,
+    ) -> Self {
+        let used = (u32::BITS - lanes.leading_zeros()) as usize;
+        let count = samples.runs(used);
+        let mut start = |run: usize| {
+            let sobol = samples.run_start(run).sobol_points(pair, n);
+            let sequence = ctx.sequences.sequence(sobol);
+            (sequence, sobol.first, run * samples.per_pixel)
+        };
+        let mut runs = [start(0); LANES];
+        for (run, entry) in runs.iter_mut().enumerate().take(count).skip(1) {
+            *entry = start(run);
+        }
+        Self { runs, count }
+    }
+
+    /// Every lane's light point `j` of `n`.
+    #[inline]
+    fn points(&self, j: u32, n: u32) -> (F32Lanes, F32Lanes) {
+        let (sequence, first, _) = self.runs[0];
+        let mut u = sequence.lanes_strided(first + u64::from(j), u64::from(n));
+        for &(sequence, first, lane) in &self.runs[1..self.count] {
+            let run = sequence.lanes_strided_from(first + u64::from(j), u64::from(n), lane);
+            let from_run = lanes::from_bits(u32::MAX << lane);
+            u.x = Float::select(from_run, run.x, u.x);
+            u.y = Float::select(from_run, run.y, u.y);
+        }
+        (u.x, u.y)
     }
 }
 
@@ -644,7 +685,17 @@ mod tests {
             let mut compared = 0;
             for pixel in 0..(resolution.x * resolution.y) as u64 {
                 let (x, y) = (pixel % resolution.x as u64, pixel / resolution.x as u64);
-                for (chunk, used) in [(0u64, LANES), (1, 3), (2, 1)] {
+                // One pixel's chunks (full, three lanes, one), then runs of
+                // several pixels' samples: four of four, sixteen of one, and
+                // three of four partly used.
+                for (chunk, used, per_pixel) in [
+                    (0u64, LANES, LANES),
+                    (1, 3, LANES),
+                    (2, 1, LANES),
+                    (0, LANES, 4),
+                    (0, LANES, 1),
+                    (1, 11, 4),
+                ] {
                     let cameras: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
                         let n = LANES as f32;
                         let jitter = ((k as f32 + 0.5) / n, ((k * 5 % LANES) as f32 + 0.5) / n);
@@ -670,10 +721,11 @@ mod tests {
                         Some(_) => common[1] += 1,
                         None => common[0] += 1,
                     }
-                    let first = PixelSample {
+                    let samples = LaneSamples {
                         seed: 11,
-                        pixel,
-                        sample: chunk * LANES as u64,
+                        first: chunk * per_pixel as u64,
+                        per_pixel,
+                        pixels: std::array::from_fn(|run| pixel + 1000 * run as u64),
                     };
                     let mut lanes = SampleContext::new(light_samples, 4);
                     let values = integrator.li_first_hits(
@@ -682,20 +734,20 @@ mod tests {
                         footprints.then_some(&diffs),
                         &closest,
                         used,
-                        first,
+                        &samples,
                         &mut lanes,
                     );
                     let mut scalar = SampleContext::new(light_samples, 4);
                     for (k, ray) in rays.iter().enumerate().take(used) {
-                        scalar.begin_sample(first.seed, pixel, first.sample + k as u64);
+                        let sample = samples.lane(k);
+                        scalar.begin_sample(sample.seed, sample.pixel, sample.sample);
                         let hit = scene.shapes.closest_hit(ray, f32::INFINITY);
                         let expected =
                             integrator.li_at(&scene, ray, &diffs[k], hit, 0, &mut scalar);
                         assert_eq!(
                             values.lane(k).to_array().map(f32::to_bits),
                             expected.to_array().map(f32::to_bits),
-                            "{pattern:?} × {light_samples}, pixel ({x}, {y}), sample {}: {} against {expected}",
-                            first.sample + k as u64,
+                            "{pattern:?} × {light_samples}, pixel ({x}, {y}), {sample:?}: {} against {expected}",
                             values.lane(k)
                         );
                         compared += 1;
@@ -707,7 +759,7 @@ mod tests {
                     total += scalar.counters;
                 }
             }
-            assert_eq!(compared, 12 * 10 * (LANES + 3 + 1));
+            assert_eq!(compared, 12 * 10 * (3 * LANES + 3 + 1 + 11));
         }
         // Both ways of gathering the points were taken, and lanes that all see a light.
         assert!(common.iter().all(|&n| n > 0), "{common:?}");

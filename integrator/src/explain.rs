@@ -38,7 +38,8 @@ pub enum ExplainError {
 
 /// Pixel `(x, y)` of `scene` rendered with `settings`, with the steps of the
 /// samples `selection` names. Its radiance is what [`crate::render`] writes
-/// for that pixel (the same code, on one pixel): the trace is taken on the
+/// for that pixel (the same code, on one pixel; a render may shade several
+/// pixels' samples in one chunk's lanes, to the same bits): the trace is taken on the
 /// integrator's scalar path, checked against the render's own path bit for
 /// bit ([`ExplainError::Diverged`] otherwise).
 pub fn explain_pixel(

@@ -1,6 +1,6 @@
 use crate::counters::{ShadingCounters, TextureCounters};
 use crate::direct::SampleContext;
-use crate::sampling::{pixel_rng, PixelSample, SobolPoints, PIXEL_STREAM};
+use crate::sampling::{pixel_rng, LaneSamples, PixelSample, SobolPoints, PIXEL_STREAM};
 use crate::settings::{Crop, RenderSettings, SettingsError};
 use crate::trace::{Event, Tracer};
 use crate::{DirectIntegrator, Scene};
@@ -233,20 +233,35 @@ fn render_rows(
     let mut ctx = SampleContext::new(settings.light_samples, settings.environment_samples);
     ctx.detailed = settings.stats;
     let pixels_of = PixelRenderer::new(scene, settings, integrator);
-    for (offset, (radiance, finished)) in pixels.iter_mut().zip(finished).enumerate() {
-        if *finished {
+    let run = pixels_of.run_length();
+    let mut run_samples = [Vec2::ZERO; LANES];
+    let mut offset = 0;
+    while offset < pixels.len() {
+        if finished[offset] {
+            offset += 1;
             continue;
         }
         if stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
             break;
         }
-        let (x, y) = (
-            x0 + offset as u32 % width,
-            first_row + offset as u32 / width,
-        );
-        *radiance = pixels_of.pixel(x, y, &mut pixel_samples, &mut ctx);
-        *finished = true;
-        rendered += 1;
+        let column = offset as u32 % width;
+        let (x, y) = (x0 + column, first_row + offset as u32 / width);
+        // A run of pixels shares one chunk's lanes where it fits in the row
+        // and none of it is finished; else the pixel goes alone.
+        let whole_run = offset..offset + run;
+        if run > 1
+            && column as usize + run <= width as usize
+            && !finished[whole_run.clone()].contains(&true)
+        {
+            let values = pixels_of.pixel_run(x, y, &mut run_samples, &mut ctx);
+            pixels[whole_run.clone()].copy_from_slice(&values[..run]);
+            finished[whole_run].fill(true);
+            (offset, rendered) = (offset + run, rendered + run as u64);
+        } else {
+            pixels[offset] = pixels_of.pixel(x, y, &mut pixel_samples, &mut ctx);
+            finished[offset] = true;
+            (offset, rendered) = (offset + 1, rendered + 1);
+        }
     }
     TileCounts {
         pixels: rendered,
@@ -309,50 +324,123 @@ impl<'a> PixelRenderer<'a> {
         pixel_samples: &mut [Vec2],
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let (scene, settings) = (self.scene, self.settings);
-        let width = scene.camera.resolution().x;
-        let pixel = y as u64 * width as u64 + x as u64;
-        let mut rng = pixel_rng(settings.seed, pixel, PIXEL_STREAM);
-        let sobol = SobolPoints::pixel_positions(settings.seed, pixel);
-        settings.pixel_pattern.fill(&mut rng, sobol, pixel_samples);
-        let all_in_lanes = self.all_in_lanes && !T::ON;
-        let first_hits_in_lanes = self.first_hits_in_lanes && !T::ON;
+        let pixel = self.pixel_index(x, y);
+        self.fill_jitters(pixel, pixel_samples);
+        let candidates = self.candidates::<T>(x, 1, y);
         let mut sum = Vec3::ZERO;
-        let candidates = if all_in_lanes {
-            objects_seen_by_pixel(scene, x, y)
-        } else {
-            u64::MAX
-        };
         for (chunk, jitters) in pixel_samples.chunks(LANES).enumerate() {
             let first = PixelSample {
-                seed: settings.seed,
+                seed: self.settings.seed,
                 pixel,
                 sample: (chunk * LANES) as u64,
             };
-            let values = if all_in_lanes && jitters.len() > 1 {
-                self.samples_in_lanes(x, y, jitters, candidates, first, ctx)
-            } else {
-                self.samples_by_rays(x, y, jitters, first_hits_in_lanes, first, ctx)
+            let chunk = SampleChunk {
+                x0: x,
+                y,
+                jitters,
+                samples: LaneSamples::of_pixel(first),
             };
-            accumulate(&mut sum, &values, jitters.len(), ctx);
+            let values = self.chunk_values(&chunk, candidates, ctx);
+            accumulate(&mut sum, &values, 0..jitters.len(), ctx);
         }
-        sum / settings.spp as f32
+        sum / self.settings.spp as f32
     }
 
-    /// The radiance of up to [`LANES`] camera samples of pixel (x, y), at
-    /// `jitters` in it: camera rays, closest hits among the objects
-    /// `candidates` names, and shading, all in lanes.
-    fn samples_in_lanes<T: Tracer>(
+    /// Pixels rendered together, each the same as [`Self::pixel`]: where a
+    /// pixel has fewer samples than a chunk has lanes, this many pixels of a
+    /// row fill the lanes (1 where they do not divide evenly).
+    pub(crate) fn run_length(&self) -> usize {
+        let spp = self.settings.spp as usize;
+        if spp < LANES && LANES % spp == 0 {
+            LANES / spp
+        } else {
+            1
+        }
+    }
+
+    /// Pixels `(x0 + i, y)` for `i < run_length()`, [`Self::pixel`] each,
+    /// bit for bit, their camera samples in the lanes of one chunk (`jitters`
+    /// is a buffer of [`LANES`] positions).
+    pub(crate) fn pixel_run<T: Tracer>(
         &self,
-        x: u32,
+        x0: u32,
         y: u32,
-        jitters: &[Vec2],
+        jitters: &mut [Vec2; LANES],
+        ctx: &mut SampleContext<T>,
+    ) -> [Vec3; LANES] {
+        let (run, spp) = (self.run_length(), self.settings.spp as usize);
+        let mut samples = LaneSamples {
+            seed: self.settings.seed,
+            first: 0,
+            per_pixel: spp,
+            pixels: [0; LANES],
+        };
+        for (i, own) in jitters.chunks_mut(spp).take(run).enumerate() {
+            samples.pixels[i] = self.pixel_index(x0 + i as u32, y);
+            self.fill_jitters(samples.pixels[i], own);
+        }
+        let chunk = SampleChunk {
+            x0,
+            y,
+            jitters: &jitters[..run * spp],
+            samples,
+        };
+        let values = self.chunk_values(&chunk, self.candidates::<T>(x0, run, y), ctx);
+        let mut sums = [Vec3::ZERO; LANES];
+        for (i, sum) in sums.iter_mut().enumerate().take(run) {
+            accumulate(sum, &values, i * spp..(i + 1) * spp, ctx);
+            *sum /= spp as f32;
+        }
+        sums
+    }
+
+    /// The index `y · width + x` that names pixel (x, y)'s samples.
+    fn pixel_index(&self, x: u32, y: u32) -> u64 {
+        y as u64 * self.scene.camera.resolution().x as u64 + x as u64
+    }
+
+    /// The positions in pixel `pixel` of its camera samples, from its pattern.
+    fn fill_jitters(&self, pixel: u64, out: &mut [Vec2]) {
+        let settings = self.settings;
+        let mut rng = pixel_rng(settings.seed, pixel, PIXEL_STREAM);
+        let sobol = SobolPoints::pixel_positions(settings.seed, pixel);
+        settings.pixel_pattern.fill(&mut rng, sobol, out);
+    }
+
+    /// The objects the camera rays through pixels `(x0..x0 + count, y)` may
+    /// hit, where the whole sample is taken in lanes (else all).
+    fn candidates<T: Tracer>(&self, x0: u32, count: usize, y: u32) -> u64 {
+        match self.all_in_lanes && !T::ON {
+            true => objects_seen_by_pixels(self.scene, x0, count, y),
+            false => u64::MAX,
+        }
+    }
+
+    /// The radiance of a chunk's camera samples, by the route the scene
+    /// allows: all in lanes, first hits in lanes, or one by one.
+    fn chunk_values<T: Tracer>(
+        &self,
+        chunk: &SampleChunk,
         candidates: u64,
-        first: PixelSample,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        let (scene, used) = (self.scene, jitters.len());
-        let (px, py) = raster_lanes(x, y, jitters);
+        if self.all_in_lanes && !T::ON && chunk.jitters.len() > 1 {
+            self.samples_in_lanes(chunk, candidates, ctx)
+        } else {
+            self.samples_by_rays(chunk, self.first_hits_in_lanes && !T::ON, ctx)
+        }
+    }
+
+    /// The radiance of a chunk's camera samples: camera rays, closest hits
+    /// among the objects `candidates` names, and shading, all in lanes.
+    fn samples_in_lanes<T: Tracer>(
+        &self,
+        chunk: &SampleChunk,
+        candidates: u64,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let (scene, used) = (self.scene, chunk.jitters.len());
+        let (px, py) = chunk.raster_lanes();
         let c = scene.camera.generate_rays_lanes(px, py);
         let rays = RayLanes {
             origin: Vec3Lanes::splat(c.origin),
@@ -360,25 +448,21 @@ impl<'a> PixelRenderer<'a> {
         };
         let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
         let closest = closest.expect("has_closest_lanes");
-        self.integrator
-            .li_first_hits(scene, &rays, None, &closest, used, first, ctx)
+        (self.integrator).li_first_hits(scene, &rays, None, &closest, used, &chunk.samples, ctx)
     }
 
-    /// The radiance (or AOV) of up to [`LANES`] camera samples of pixel (x, y),
-    /// each camera ray made with its differentials: their closest hits found
-    /// together where the scene's layout allows it (the same hits), then shaded
-    /// together if `first_hits_in_lanes`, else one by one.
+    /// The radiance (or AOV) of a chunk's camera samples, each camera ray made
+    /// with its differentials: their closest hits found together where the
+    /// scene's layout allows it (the same hits), then shaded together if
+    /// `first_hits_in_lanes`, else one by one.
     fn samples_by_rays<T: Tracer>(
         &self,
-        x: u32,
-        y: u32,
-        jitters: &[Vec2],
+        chunk: &SampleChunk,
         first_hits_in_lanes: bool,
-        first: PixelSample,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        let (scene, settings, used) = (self.scene, self.settings, jitters.len());
-        let (px, py) = raster_lanes(x, y, jitters);
+        let (scene, settings, used) = (self.scene, self.settings, chunk.jitters.len());
+        let (px, py) = chunk.raster_lanes();
         let (ray_lanes, diffs) = match self.differentials {
             true => camera_rays_lanes(&scene.camera, px, py, self.footprint_scale),
             false => {
@@ -402,7 +486,7 @@ impl<'a> PixelRenderer<'a> {
                 Some(&diffs),
                 closest,
                 used,
-                first,
+                &chunk.samples,
                 ctx,
             ),
             _ => Vec3Lanes::from_lanes(std::array::from_fn(|k| {
@@ -415,8 +499,17 @@ impl<'a> PixelRenderer<'a> {
                         .hit(k)
                         .and_then(|found| scene.shapes.surface_record(ray, found))
                 });
-                let sample = first.sample + k as u64;
-                self.sample(x, y, jitters[k], sample, ray, diff, hit, ctx)
+                let sample = chunk.samples.lane(k).sample;
+                self.sample(
+                    chunk.x(k),
+                    chunk.y,
+                    chunk.jitters[k],
+                    sample,
+                    ray,
+                    diff,
+                    hit,
+                    ctx,
+                )
             })),
         }
     }
@@ -481,17 +574,17 @@ fn full_image(size: UVec2) -> Crop {
     }
 }
 
-/// The objects a camera ray through pixel `(x, y)` may hit
+/// The objects a camera ray through pixels `(x0..x0 + count, y)` may hit
 /// ([`ShapeList::objects_in_frustum`](glint_geometry::ShapeList::objects_in_frustum)):
-/// those meeting the frustum of the rays through the pixel's four corners.
-fn objects_seen_by_pixel(scene: &Scene, x: u32, y: u32) -> u64 {
+/// those meeting the frustum of the rays through the run's four corners.
+fn objects_seen_by_pixels(scene: &Scene, x0: u32, count: usize, y: u32) -> u64 {
     let camera = &scene.camera;
-    let (x, y) = (x as f32, y as f32);
+    let (x, y, w) = (x0 as f32, y as f32, count as f32);
     let corner = |dx: f32, dy: f32| camera.generate_ray(x + dx, y + dy);
     let corners = [
         corner(0.0, 0.0),
-        corner(1.0, 0.0),
-        corner(1.0, 1.0),
+        corner(w, 0.0),
+        corner(w, 1.0),
         corner(0.0, 1.0),
     ];
     scene
@@ -499,13 +592,13 @@ fn objects_seen_by_pixel(scene: &Scene, x: u32, y: u32) -> u64 {
         .objects_in_frustum(corners[0].origin, corners.map(|c| c.direction))
 }
 
-/// Adds the first `used` of a chunk's radiance `values` to `sum`, leaving out
-/// (and counting) those that are NaN or infinite.
+/// Adds a chunk's radiance `values` in `lanes` to `sum`, in order, leaving
+/// out (and counting) those that are NaN or infinite.
 #[inline]
 fn accumulate<T: Tracer>(
     sum: &mut Vec3,
     values: &Vec3Lanes,
-    used: usize,
+    lanes: std::ops::Range<usize>,
     ctx: &mut SampleContext<T>,
 ) {
     let finite = lanes::bits(values.x.is_finite() & values.y.is_finite() & values.z.is_finite());
@@ -514,7 +607,7 @@ fn accumulate<T: Tracer>(
         values.y.to_array(),
         values.z.to_array(),
     );
-    for k in 0..used {
+    for k in lanes {
         if finite >> k & 1 == 1 {
             *sum += Vec3::new(x[k], y[k], z[k]);
         } else {
@@ -523,15 +616,33 @@ fn accumulate<T: Tracer>(
     }
 }
 
-/// The raster positions of a chunk of a pixel's camera samples, at `jitters`
-/// in pixel (x, y); the lanes past them repeat the last.
-fn raster_lanes(x: u32, y: u32, jitters: &[Vec2]) -> (F32Lanes, F32Lanes) {
-    let last = jitters.len() - 1;
-    let jitter = |axis: usize| lanes::from_fn(|k| jitters[k.min(last)][axis]);
-    (
-        F32Lanes::splat(x as f32) + jitter(0),
-        F32Lanes::splat(y as f32) + jitter(1),
-    )
+/// A chunk of camera samples in lanes: runs of `samples.per_pixel` samples
+/// of pixels `(x0, y), (x0 + 1, y), …`, lane k at `jitters[k]` in its pixel
+/// (the lanes past `jitters` repeat the last).
+struct SampleChunk<'j> {
+    x0: u32,
+    y: u32,
+    jitters: &'j [Vec2],
+    samples: LaneSamples,
+}
+
+impl SampleChunk<'_> {
+    /// Lane k's pixel column.
+    #[inline]
+    fn x(&self, k: usize) -> u32 {
+        self.x0 + (k / self.samples.per_pixel) as u32
+    }
+
+    /// Every lane's raster position.
+    #[inline]
+    fn raster_lanes(&self) -> (F32Lanes, F32Lanes) {
+        let last = self.jitters.len() - 1;
+        let lane = |k: usize| k.min(last);
+        (
+            lanes::from_fn(|k| self.x(lane(k)) as f32 + self.jitters[lane(k)].x),
+            F32Lanes::splat(self.y as f32) + lanes::from_fn(|k| self.jitters[lane(k)].y),
+        )
+    }
 }
 
 fn vec3_lanes([x, y, z]: [F32Lanes; 3]) -> Vec3Lanes {

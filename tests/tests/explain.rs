@@ -29,7 +29,8 @@ fn bits(v: Vec3) -> [u32; 3] {
 }
 
 /// Each case takes another of the render loop's paths: whole samples in
-/// lanes (one light sample), first hits in lanes with light samples in lanes,
+/// lanes (one light sample), several pixels' samples in one chunk's lanes,
+/// first hits in lanes with light samples in lanes,
 /// the scalar path with footprints, mirrors and environment samples, the BVH,
 /// and physical shading with MIS and without (its light samples' shadow rays
 /// in lanes when rendered, one by one when explained).
@@ -52,6 +53,19 @@ fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
             "cornell-set1, 4 light samples",
             scene("cornell-set1", size, few),
         ),
+        // Pixels of one or two samples: runs of 16 and 8 pixels share a chunk.
+        ("cornell-set1, 1 spp", {
+            scene("cornell-set1", size, |s| {
+                few(s);
+                s.spp = 1;
+            })
+        }),
+        ("ground-mipmap, 2 spp", {
+            scene("ground-mipmap", size, |s| {
+                few(s);
+                s.spp = 2;
+            })
+        }),
         ("cornell-set3", scene("cornell-set3", size, few)),
         ("environment", scene("environment", size, few)),
         ("ground-mipmap", scene("ground-mipmap", size, few)),

@@ -183,15 +183,24 @@ impl SobolSequence {
     /// block, else point by point.
     #[inline]
     pub fn lanes_strided(self, first: u64, stride: u64) -> PointLanes {
-        let last = first + (LANES as u64 - 1) * stride;
+        self.lanes_strided_from(first, stride, 0)
+    }
+
+    /// Points `first + (k − lane)·stride` in the lanes k from `lane` on (the
+    /// lanes before it repeat point `first`): a run of a pixel's samples that
+    /// starts at lane `lane` of a chunk holding several pixels.
+    #[inline]
+    pub fn lanes_strided_from(self, first: u64, stride: u64, lane: usize) -> PointLanes {
+        let last = first + (LANES - 1).saturating_sub(lane) as u64 * stride;
+        let step = |k: usize| k.saturating_sub(lane) as u64;
         if first >> BLOCK_BITS == last >> BLOCK_BITS {
             let i = first as u32 & BLOCK_MASK;
-            let lane = U32Lanes::new(std::array::from_fn(|k| k as u32));
-            let index = U32Lanes::splat(i) + lane * U32Lanes::splat(stride as u32);
+            let steps = U32Lanes::new(std::array::from_fn(|k| step(k) as u32));
+            let index = U32Lanes::splat(i) + steps * U32Lanes::splat(stride as u32);
             self.scrambles(first).points(index)
         } else {
             let points: [Vec2; LANES] =
-                std::array::from_fn(|k| self.point(first + k as u64 * stride));
+                std::array::from_fn(|k| self.point(first + step(k) * stride));
             PointLanes::from_points(&points)
         }
     }

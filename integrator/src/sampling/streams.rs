@@ -4,6 +4,7 @@
 use super::mix::mix64;
 use super::pcg::Pcg32;
 use super::sobol::{DimensionPair, SobolPoints};
+use glint_geometry::lanes::LANES;
 
 /// The sample index that names a pixel's own stream (its pixel-sample pattern),
 /// distinct from the streams of its individual samples `0..spp`.
@@ -46,6 +47,72 @@ pub struct PixelSample {
     pub pixel: u64,
     /// The camera sample, `0..spp`.
     pub sample: u64,
+}
+
+/// The camera samples in a chunk's [`LANES`] lanes: runs of `per_pixel`
+/// samples of consecutive pixels. Run g, lanes `g·per_pixel` up to
+/// `(g + 1)·per_pixel`, holds samples `first..first + per_pixel` of pixel
+/// `pixels[g]`. One pixel's chunk of sixteen samples is one run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LaneSamples {
+    /// The render's seed.
+    pub seed: u64,
+    /// The first sample of every run.
+    pub first: u64,
+    /// The lanes of a run.
+    pub per_pixel: usize,
+    /// The pixel of each run (the first `runs()` entries).
+    pub pixels: [u64; LANES],
+}
+
+impl LaneSamples {
+    /// Samples `first.sample..` of one pixel in all the lanes.
+    pub fn of_pixel(first: PixelSample) -> Self {
+        Self {
+            seed: first.seed,
+            first: first.sample,
+            per_pixel: LANES,
+            pixels: [first.pixel; LANES],
+        }
+    }
+
+    /// The runs in a chunk of `used` lanes.
+    #[inline]
+    pub fn runs(&self, used: usize) -> usize {
+        used.div_ceil(self.per_pixel)
+    }
+
+    /// The first sample of run `run`.
+    #[inline]
+    pub fn run_start(&self, run: usize) -> PixelSample {
+        PixelSample {
+            seed: self.seed,
+            pixel: self.pixels[run],
+            sample: self.first,
+        }
+    }
+
+    /// The sample in lane `k`.
+    #[inline]
+    pub fn lane(&self, k: usize) -> PixelSample {
+        PixelSample {
+            sample: self.first + (k % self.per_pixel) as u64,
+            ..self.run_start(k / self.per_pixel)
+        }
+    }
+
+    /// Each lane's own PCG stream's seed ([`stream_seed`]).
+    #[inline]
+    pub fn stream_seeds(&self) -> [u64; LANES] {
+        let mut seeds = [0; LANES];
+        for (run, lanes) in seeds.chunks_mut(self.per_pixel).enumerate() {
+            let key = pixel_key(self.seed, self.pixels[run]);
+            for (k, seed) in lanes.iter_mut().enumerate() {
+                *seed = mix64(key ^ (self.first + k as u64));
+            }
+        }
+        seeds
+    }
 }
 
 impl PixelSample {

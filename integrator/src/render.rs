@@ -441,11 +441,7 @@ impl<'a> PixelRenderer<'a> {
     ) -> Vec3Lanes {
         let (scene, used) = (self.scene, chunk.jitters.len());
         let (px, py) = chunk.raster_lanes();
-        let c = scene.camera.generate_rays_lanes(px, py);
-        let rays = RayLanes {
-            origin: Vec3Lanes::splat(c.origin),
-            direction: vec3_lanes(c.direction),
-        };
+        let rays = centre_rays(&scene.camera, px, py);
         let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
         let closest = closest.expect("has_closest_lanes");
         (self.integrator).li_first_hits(scene, &rays, None, &closest, used, &chunk.samples, ctx)
@@ -466,11 +462,7 @@ impl<'a> PixelRenderer<'a> {
         let (ray_lanes, diffs) = match self.differentials {
             true => camera_rays_lanes(&scene.camera, px, py, self.footprint_scale),
             false => {
-                let c = scene.camera.generate_rays_lanes(px, py);
-                let rays = RayLanes {
-                    origin: Vec3Lanes::splat(c.origin),
-                    direction: vec3_lanes(c.direction),
-                };
+                let rays = centre_rays(&scene.camera, px, py);
                 let diffs = lanes::array_from_fn(|k| RayDifferential::none(&rays.lane(k)));
                 (rays, diffs)
             }
@@ -649,6 +641,17 @@ fn vec3_lanes([x, y, z]: [F32Lanes; 3]) -> Vec3Lanes {
     Vec3Lanes { x, y, z }
 }
 
+/// The camera rays through raster positions `(x[k], y[k])`, without
+/// differentials.
+#[inline]
+fn centre_rays(camera: &Camera, x: F32Lanes, y: F32Lanes) -> RayLanes {
+    let c = camera.generate_rays_lanes(x, y);
+    RayLanes {
+        origin: Vec3Lanes::splat(c.origin),
+        direction: vec3_lanes(c.direction),
+    }
+}
+
 /// [`camera_ray`] in every lane, at raster positions `(x[k], y[k])`: each
 /// lane's ray and differentials bit for bit the scalar ones.
 pub fn camera_rays_lanes(
@@ -657,21 +660,17 @@ pub fn camera_rays_lanes(
     y: F32Lanes,
     scale: f32,
 ) -> (RayLanes, [RayDifferential; LANES]) {
-    let c = camera.generate_rays_lanes(x, y);
-    let d = vec3_lanes(c.direction);
+    let rays = centre_rays(camera, x, y);
+    let (origin, d) = (camera.position(), rays.direction);
     let shrunk = |offset: [F32Lanes; 3]| d + (vec3_lanes(offset) - d).scale(F32Lanes::splat(scale));
     let rx = shrunk(camera.generate_rays_lanes(x + F32Lanes::ONE, y).direction);
     let ry = shrunk(camera.generate_rays_lanes(x, y + F32Lanes::ONE).direction);
     let diffs = lanes::array_from_fn(|k| RayDifferential {
-        rx_origin: c.origin,
+        rx_origin: origin,
         rx_direction: rx.lane(k),
-        ry_origin: c.origin,
+        ry_origin: origin,
         ry_direction: ry.lane(k),
     });
-    let rays = RayLanes {
-        origin: Vec3Lanes::splat(c.origin),
-        direction: d,
-    };
     (rays, diffs)
 }
 

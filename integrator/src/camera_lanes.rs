@@ -351,14 +351,19 @@ impl<'a> ShadedLanes<'a> {
         let Some(object) = closest.common_object(hit_lanes) else {
             return false;
         };
+        let kind = scene.surface_of_primitive(object, 0);
+        // A sphere's texture coordinates cost an `acos` and an `atan2` a lane:
+        // only where the material reads them.
+        let uv_lanes = match kind {
+            SurfaceKind::Material(material) if material.reads_uv() => hit_lanes,
+            _ => 0,
+        };
         let surface = match scene.shapes.object(object) {
-            ObjectRef::Shape(Shape::Sphere(s)) => {
-                s.surface_points_lanes(rays, closest.t, hit_lanes)
-            }
+            ObjectRef::Shape(Shape::Sphere(s)) => s.surface_points_lanes(rays, closest.t, uv_lanes),
             ObjectRef::Shape(Shape::Parallelogram(p)) => p.surface_points_lanes(rays, closest.t),
             _ => return false,
         };
-        let material = match scene.surface_of_primitive(object, 0) {
+        let material = match kind {
             // Its footprints need each lane's surface record: one by one.
             SurfaceKind::Material(material) if material.uses_footprint() => return false,
             SurfaceKind::Material(material) => material,

@@ -2,7 +2,7 @@ use crate::counters::{ShadingCounters, TextureCounters};
 use crate::light_samples::LANES_FROM_SAMPLES;
 use crate::sampling::Pcg32;
 use crate::sampling::{
-    DimensionPair, PixelSample, SamplePattern, SamplePoints, SequenceCache, MAX_JOINT,
+    DimensionPair, PixelSample, PointChunk, SamplePattern, SamplePoints, SequenceCache, MAX_JOINT,
 };
 use crate::settings::RenderSettings;
 use crate::texture_lookup::texture_footprint;
@@ -495,19 +495,20 @@ impl DirectIntegrator {
         ctx.counters.environment_samples += samples.len() as u64;
         let sum = if T::ON || samples.len() < LANES_FROM_SAMPLES {
             let mut sum = Vec3::ZERO;
-            for u in samples.iter() {
-                let s = env.sample(point.n, u);
-                let Some((f, value)) = point.environment_sample_unshadowed(&s, ctx) else {
-                    continue;
-                };
-                let shadow_ray = spawn_ray(point.hit, s.direction);
-                if !scene.shapes.any_hit(&shadow_ray, f32::INFINITY) {
-                    record_environment_sample(ctx, &s, f, Shadow::Unoccluded, value);
-                    sum += value;
-                } else if T::ON {
-                    // Finding the blocker costs a query: only when tracing.
-                    let shadow = blocker(scene, &shadow_ray, f32::INFINITY);
-                    record_environment_sample(ctx, &s, f, shadow, Vec3::ZERO);
+            for chunk in samples.chunks() {
+                for s in drawn_together(env, point.n, &chunk).iter().take(chunk.len) {
+                    let Some((f, value)) = point.environment_sample_unshadowed(s, ctx) else {
+                        continue;
+                    };
+                    let shadow_ray = spawn_ray(point.hit, s.direction);
+                    if !scene.shapes.any_hit(&shadow_ray, f32::INFINITY) {
+                        record_environment_sample(ctx, s, f, Shadow::Unoccluded, value);
+                        sum += value;
+                    } else if T::ON {
+                        // Finding the blocker costs a query: only when tracing.
+                        let shadow = blocker(scene, &shadow_ray, f32::INFINITY);
+                        record_environment_sample(ctx, s, f, shadow, Vec3::ZERO);
+                    }
                 }
             }
             sum
@@ -579,11 +580,7 @@ impl ShadingPoint<'_> {
             let mut values = [Vec3::ZERO; LANES];
             let mut directions = [self.hit.geometric_normal; LANES];
             let mut traced = 0u32;
-            let mut points = [Vec2::ZERO; LANES];
-            for (k, point) in points.iter_mut().enumerate().take(chunk.len) {
-                *point = chunk.lanes.lane(k);
-            }
-            let drawn = env.sample_each(self.n, &points, chunk.len);
+            let drawn = drawn_together(env, self.n, &chunk);
             for (k, s) in drawn.iter().enumerate().take(chunk.len) {
                 if let Some((_, value)) = self.environment_sample_unshadowed(s, ctx) {
                     (values[k], directions[k]) = (value, s.direction);
@@ -624,6 +621,21 @@ impl ShadowOrigins {
         let from_back = lanes::lt(towards.dot_splat(self.normal), F32Lanes::ZERO);
         Vec3Lanes::select(from_back, &self.back, &self.front)
     }
+}
+
+/// The environment's samples at a chunk of points, about `normal`: drawn
+/// together ([`EnvironmentLight::sample_each`]), each as it is drawn alone.
+#[inline]
+fn drawn_together(
+    env: &EnvironmentLight,
+    normal: Vec3,
+    chunk: &PointChunk,
+) -> [EnvironmentSample; LANES] {
+    let mut points = [Vec2::ZERO; LANES];
+    for (k, point) in points.iter_mut().enumerate().take(chunk.len) {
+        *point = chunk.lanes.lane(k);
+    }
+    env.sample_each(normal, &points, chunk.len)
 }
 
 /// Tells the tracer of environment sample `s`: its `f · cos θ`, its shadow

@@ -149,6 +149,17 @@ impl PhongMaterial {
         (kd, ks)
     }
 
+    /// Whether its reflectances vary over the surface (a diffuse or specular
+    /// texture that is not a constant), so that shading needs each hit's
+    /// texture coordinates.
+    pub fn reads_uv(&self) -> bool {
+        self.diffuse.as_constant().is_none()
+            || self
+                .specular
+                .as_ref()
+                .is_some_and(|t| t.as_constant().is_none())
+    }
+
     /// Whether any of the material's textures filter over a footprint, so the
     /// integrator only computes ray differentials at hits that need them.
     pub fn uses_footprint(&self) -> bool {

@@ -72,11 +72,17 @@ pub struct SurfaceLanes {
 }
 
 impl Sphere {
-    /// [`Self::surface_point`] of each lane of `lanes` (bit k for lane k) at its
-    /// distance `t`; the other lanes are left undefined. The polar angles are
-    /// taken one lane at a time, by the same `acos` and `atan2` as the scalar path.
+    /// [`Self::surface_point`] of each lane at its distance `t`, with the
+    /// texture coordinates of the lanes `uv_lanes` (bit k for lane k; the
+    /// others' are 0). The polar angles are taken one lane at a time, by the
+    /// same `acos` and `atan2` as the scalar path.
     #[inline]
-    pub fn surface_points_lanes(&self, rays: &RayLanes, t: F32Lanes, lanes: u32) -> SurfaceLanes {
+    pub fn surface_points_lanes(
+        &self,
+        rays: &RayLanes,
+        t: F32Lanes,
+        uv_lanes: u32,
+    ) -> SurfaceLanes {
         let n = rays.at(t).sub_splat(self.center).normalize();
         let point = Vec3Lanes::splat_add(self.center, &n.scale(F32Lanes::splat(self.radius)));
         // As `point_error`: γ₂|c| + |n|·(γ₆·r).
@@ -87,7 +93,7 @@ impl Sphere {
         let (ny, nz, nx) = (n.y.to_array(), n.z.to_array(), n.x.to_array());
         let mut u = [0.0; LANES];
         let mut v = [0.0; LANES];
-        for k in (0..LANES).filter(|k| lanes >> k & 1 == 1) {
+        for k in (0..LANES).filter(|k| uv_lanes >> k & 1 == 1) {
             let (uv, _, _) = Sphere::uv_of_normal(Vec3::new(nx[k], ny[k], nz[k]));
             (u[k], v[k]) = (uv.x, uv.y);
         }

@@ -11,6 +11,7 @@ use glint_geometry::{
     take_counters, CountingGuard, Hit, QueryCounters, Ray, RayDifferential, RayLanes,
 };
 use rayon::prelude::*;
+use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use std::time::{Duration, Instant};
@@ -288,7 +289,23 @@ pub(crate) struct PixelRenderer<'a> {
     first_hits_in_lanes: bool,
     /// The whole of a camera sample in lanes, from its ray to its radiance.
     all_in_lanes: bool,
+    /// The objects the last span of pixels may see, for its next pixels.
+    span: Cell<Option<CandidateSpan>>,
 }
+
+/// The objects the camera rays through pixels `x0..x1` of row `y` may hit.
+#[derive(Clone, Copy, Debug)]
+struct CandidateSpan {
+    y: u32,
+    x0: u32,
+    x1: u32,
+    objects: u64,
+}
+
+/// The pixels of a row whose camera rays' candidates are found together:
+/// one frustum test instead of eight. The span's objects are a superset of
+/// each pixel's, so every closest hit is the same.
+const CANDIDATE_SPAN: u32 = 8;
 
 impl<'a> PixelRenderer<'a> {
     pub(crate) fn new(
@@ -309,6 +326,7 @@ impl<'a> PixelRenderer<'a> {
                 && settings.aov.is_none()
                 && !differentials
                 && scene.shapes.has_closest_lanes(),
+            span: Cell::new(None),
         }
     }
 
@@ -408,12 +426,28 @@ impl<'a> PixelRenderer<'a> {
     }
 
     /// The objects the camera rays through pixels `(x0..x0 + count, y)` may
-    /// hit, where the whole sample is taken in lanes (else all).
+    /// hit, where the whole sample is taken in lanes (else all): those of the
+    /// span of [`CANDIDATE_SPAN`] pixels or more that holds them.
     fn candidates<T: Tracer>(&self, x0: u32, count: usize, y: u32) -> u64 {
-        match self.all_in_lanes && !T::ON {
-            true => objects_seen_by_pixels(self.scene, x0, count, y),
-            false => u64::MAX,
+        if !self.all_in_lanes || T::ON {
+            return u64::MAX;
         }
+        let x1 = x0 + count as u32;
+        if let Some(span) = self.span.get() {
+            if span.y == y && span.x0 <= x0 && x1 <= span.x1 {
+                return span.objects;
+            }
+        }
+        let width = self.scene.camera.resolution().x;
+        let end = x1.max(x0 + CANDIDATE_SPAN).min(width).max(x1);
+        let objects = objects_seen_by_pixels(self.scene, x0, (end - x0) as usize, y);
+        self.span.set(Some(CandidateSpan {
+            y,
+            x0,
+            x1: end,
+            objects,
+        }));
+        objects
     }
 
     /// The radiance of a chunk's camera samples, by the route the scene
@@ -619,21 +653,24 @@ struct SampleChunk<'j> {
 }
 
 impl SampleChunk<'_> {
-    /// Lane k's pixel column.
+    /// Lane k's pixel column (a run's length divides [`LANES`]: a shift).
     #[inline]
     fn x(&self, k: usize) -> u32 {
-        self.x0 + (k / self.samples.per_pixel) as u32
+        debug_assert!(self.samples.per_pixel.is_power_of_two());
+        self.x0 + (k >> self.samples.per_pixel.trailing_zeros()) as u32
     }
 
     /// Every lane's raster position.
     #[inline]
     fn raster_lanes(&self) -> (F32Lanes, F32Lanes) {
         let last = self.jitters.len() - 1;
-        let lane = |k: usize| k.min(last);
-        (
-            lanes::from_fn(|k| self.x(lane(k)) as f32 + self.jitters[lane(k)].x),
-            F32Lanes::splat(self.y as f32) + lanes::from_fn(|k| self.jitters[lane(k)].y),
-        )
+        let (mut x, mut y) = ([0.0; LANES], [0.0; LANES]);
+        for k in 0..LANES {
+            let jitter = self.jitters[k.min(last)];
+            x[k] = self.x(k.min(last)) as f32 + jitter.x;
+            y[k] = self.y as f32 + jitter.y;
+        }
+        (F32Lanes::new(x), F32Lanes::new(y))
     }
 }
 

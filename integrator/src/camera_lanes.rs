@@ -1,6 +1,8 @@
-//! The first hits of a pixel's camera samples shaded [`LANES`] at once.
+//! The first hits of a chunk of camera samples shaded [`LANES`] at once.
 //!
-//! The lanes are the camera samples: the [`LANES`] samples of a pixel that
+//! The lanes are the camera samples: the [`LANES`] samples of a pixel (or,
+//! for pixels of fewer samples, the runs of samples of consecutive pixels a
+//! [`LaneSamples`] names) that
 //! [`glint_geometry::ShapeList::closest_primitives_lanes`] found the hits of
 //! together are shaded together too. Their surface points, reflectances and
 //! shadow-ray origins are set up once; then, for each of a light's N samples in
@@ -19,7 +21,7 @@
 //! filtered over a footprint are looked up lane by lane, from each lane's ray
 //! differentials. Every lane
 //! repeats the scalar path's operations in its order, and its random numbers
-//! come from its own camera sample's stream or its own points of the pixel's
+//! come from its own camera sample's stream or its own points of its pixel's
 //! Sobol sequence, so each sample's radiance and the shading counts are those
 //! of [`DirectIntegrator::li_at`], bit for bit (the tests compare).
 

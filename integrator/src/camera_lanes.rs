@@ -25,7 +25,7 @@
 //! Sobol sequence, so each sample's radiance and the shading counts are those
 //! of [`DirectIntegrator::li_at`], bit for bit (the tests compare).
 
-use crate::direct::{PairAllocation, SampleContext, ShadingPoint, CULL_FROM_SAMPLES};
+use crate::direct::{PairAllocation, SampleContext, ShadingPoint, CULL_REACH};
 use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::sampling::{
     DimensionPair, LaneSamples, Pcg32Lanes, SamplePattern, SamplePoints, SobolSequence,
@@ -33,7 +33,7 @@ use crate::sampling::{
 use crate::texture_lookup::texture_footprint;
 use crate::trace::Tracer;
 use crate::{DirectIntegrator, Scene, SurfaceKind};
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, LANES};
 use glint_geometry::{
     offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayDifferential, RayLanes, Shape,
@@ -149,10 +149,7 @@ impl DirectIntegrator {
         let n = self.light_samples;
         let sequences = (self.light_pattern == SamplePattern::Sobol)
             .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
-        let occluders = match self.light_samples >= CULL_FROM_SAMPLES {
-            true => shaded.occluders(scene, index, area),
-            false => Occluders::ALL,
-        };
+        let occluders = shaded.occluders(scene, index, area, ctx);
         let mut sum = Vec3Lanes::default();
         for j in 0..self.light_samples {
             let u = match (&mut *rngs, &grid, &sequences) {
@@ -189,6 +186,18 @@ impl DirectIntegrator {
             points
         })
     }
+}
+
+/// The last culling of shadow-ray occluders in the lanes: the shapes that
+/// may block rays to light `light` from any point of `object` within `reach`
+/// of `center`, kept for the chunks of the pixels around.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LaneOccluders {
+    light: usize,
+    object: u32,
+    center: Vec3,
+    reach: f32,
+    occluders: Occluders,
 }
 
 /// The Sobol sequences of a chunk's runs of camera samples for one pair:
@@ -403,22 +412,47 @@ impl<'a> ShadedLanes<'a> {
     /// as [`DirectIntegrator::occluders`] culls them for one point: from a
     /// centre, widened by a reach that holds every lane's point, where the
     /// lanes lie on one object; every shape otherwise.
-    fn occluders(&self, scene: &Scene, index: usize, light: &AreaLight) -> Occluders {
+    fn occluders<T: Tracer>(
+        &self,
+        scene: &Scene,
+        index: usize,
+        light: &AreaLight,
+        ctx: &mut SampleContext<T>,
+    ) -> Occluders {
         let Some(object) = self.object else {
             return Occluders::ALL;
         };
+        let farthest_from = |center: Vec3| {
+            let offsets = self.point.sub_splat(center);
+            lanes::max_lane(offsets.dot(&offsets).sqrt(), lanes::from_bits(self.lanes))
+        };
+        if let Some(cached) = ctx.lane_occluders {
+            let same = (cached.light, cached.object) == (index, object);
+            if same && farthest_from(cached.center) <= cached.reach {
+                return cached.occluders;
+            }
+        }
         let center = self.point.lane(self.lanes.trailing_zeros() as usize);
-        let offsets = self.point.sub_splat(center);
-        let distances = offsets.dot(&offsets).sqrt();
-        // A tenth wider than the farthest lane: far past the rounding of the
-        // distances, which the reach must not fall short of.
-        let reach = lanes::max_lane(distances, lanes::from_bits(self.lanes)) * 1.1;
-        scene.shapes.occluders_towards(
+        // A tenth wider than the farthest lane (far past the rounding of the
+        // distances, which the reach must not fall short of), and at least
+        // the one-point culling's reach, so that the chunks of the pixels
+        // around reuse it.
+        let reach = (farthest_from(center) * 1.1)
+            .max(CULL_REACH * center.distance(light.surface().center()));
+        let occluders = scene.shapes.occluders_towards(
             center,
             reach,
             &light.surface().corners(),
             [object, scene.light_objects[index]],
-        )
+        );
+        ctx.lane_occluders = Some(LaneOccluders {
+            light: index,
+            object,
+            center,
+            reach,
+            occluders,
+        });
+        occluders
     }
 
     /// Per lane, the Phong reflection of the light point at `(ux, uy)` on `light`, or
@@ -690,6 +724,9 @@ mod tests {
             assert!(integrator.shades_first_hits_in_lanes(&scene));
             let resolution = scene.camera.resolution();
             let mut compared = 0;
+            // One context for every chunk, as a render's thread keeps it: the
+            // lanes' culling of occluders serves the chunks near it.
+            let mut lanes = SampleContext::new(light_samples, 4);
             for pixel in 0..(resolution.x * resolution.y) as u64 {
                 let (x, y) = (pixel % resolution.x as u64, pixel / resolution.x as u64);
                 // One pixel's chunks (full, three lanes, one), then runs of
@@ -734,7 +771,7 @@ mod tests {
                         per_pixel,
                         pixels: std::array::from_fn(|run| pixel + 1000 * run as u64),
                     };
-                    let mut lanes = SampleContext::new(light_samples, 4);
+                    lanes.counters = ShadingCounters::default();
                     let values = integrator.li_first_hits(
                         &scene,
                         &ray_lanes,

@@ -1,3 +1,4 @@
+use crate::camera_lanes::LaneOccluders;
 use crate::counters::{ShadingCounters, TextureCounters};
 use crate::light_samples::LANES_FROM_SAMPLES;
 use crate::sampling::Pcg32;
@@ -30,7 +31,7 @@ pub(crate) const CULL_FROM_SAMPLES: u32 = 4;
 /// share one (a pixel spans about a thousandth of its distance from the camera
 /// at 512², so a hundredth covers it with room), at the price of faces
 /// widened by that much.
-const CULL_REACH: f32 = 0.01;
+pub(crate) const CULL_REACH: f32 = 0.01;
 
 /// The direct-lighting integrator of the course report (section 2.5), with the
 /// environment and mirror reflections of section 2.7.
@@ -75,6 +76,8 @@ pub struct SampleContext<T: Tracer = ()> {
     pub tracer: T,
     /// The last culling of shadow-ray occluders, for the next points near it.
     occluders: Option<CachedOccluders>,
+    /// The last culling in the camera-sample lanes, for the next chunks near it.
+    pub(crate) lane_occluders: Option<LaneOccluders>,
     /// The Sobol sequences of the pixel's pairs, hashed once for its samples.
     pub(crate) sequences: SequenceCache,
 }
@@ -110,6 +113,7 @@ impl<T: Tracer> SampleContext<T> {
             detailed: false,
             tracer,
             occluders: None,
+            lane_occluders: None,
             sequences: SequenceCache::default(),
         }
     }

@@ -298,7 +298,7 @@ impl<'a> ShadedLanes<'a> {
         radiance: &mut Vec3Lanes,
         ctx: &mut SampleContext<T>,
     ) {
-        for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
+        for k in lanes::each_set(hit_lanes) {
             let ray = rays.lane(k);
             let found = closest.hit(k).expect("a hit lane");
             let Some(hit) = scene.shapes.surface_point(&ray, found) else {
@@ -545,7 +545,7 @@ fn reflectances_lanes<T: Tracer>(
     let (u, v) = (surface.u.to_array(), surface.v.to_array());
     let uv = |k: usize| Vec2::new(u[k], v[k]);
     if ctx.detailed {
-        for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
+        for k in lanes::each_set(hit_lanes) {
             ctx.textures.record(material, &TexCoord::point(uv(k)));
         }
     }
@@ -555,7 +555,7 @@ fn reflectances_lanes<T: Tracer>(
         (Some(kd), Some(Some(ks))) => (Vec3Lanes::splat(kd), Vec3Lanes::splat(ks)),
         _ => {
             let (mut kd, mut ks) = (Vec3Lanes::default(), Vec3Lanes::default());
-            for k in (0..LANES).filter(|k| hit_lanes >> k & 1 == 1) {
+            for k in lanes::each_set(hit_lanes) {
                 let (d, s) = material.reflectances_at(uv(k));
                 kd.set_lane(k, d);
                 ks.set_lane(k, s);

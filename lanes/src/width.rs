@@ -115,6 +115,21 @@ pub fn array_from_fn<T: Copy>(mut f: impl FnMut(usize) -> T) -> [T; LANES] {
     out
 }
 
+/// The lanes whose bit is set in `bits` (lane k as bit k), in order: one
+/// step per set bit, where a filter over every lane takes a branch per lane
+/// that a random mask mispredicts.
+#[inline(always)]
+pub fn each_set(bits: u32) -> impl Iterator<Item = usize> {
+    let mut rest = bits;
+    std::iter::from_fn(move || {
+        (rest != 0).then(|| {
+            let k = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            k
+        })
+    })
+}
+
 /// The mask of the lanes whose bit is set in `bits` (lane k as bit k): the
 /// inverse of [`bits`].
 #[inline]
@@ -169,6 +184,18 @@ pub fn first_lanes(n: usize) -> F32Lanes {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn each_set_names_the_set_lanes_in_order() {
+        assert_eq!(each_set(0).count(), 0);
+        assert_eq!(each_set(0b1010_0001).collect::<Vec<_>>(), [0, 5, 7]);
+        let all = (1u32 << LANES) - 1;
+        assert!(each_set(all).eq(0..LANES));
+        for bits in [0x8000_0001u32, 0x1234_5678] {
+            let filtered = (0..32).filter(|k| bits >> k & 1 == 1);
+            assert!(each_set(bits).eq(filtered), "{bits:#x}");
+        }
+    }
 
     fn lanes(f: impl Fn(usize) -> Vec3) -> Vec3Lanes {
         Vec3Lanes::from_lanes(std::array::from_fn(f))

@@ -92,7 +92,7 @@ impl<'a> PhongLanes<'a> {
         } else {
             0
         };
-        for k in (0..LANES).filter(|k| lanes >> k & 1 == 1) {
+        for k in lanes::each_set(lanes) {
             self.materials[k] = Some(material);
         }
         self.set_exponent(lanes, exponent);
@@ -259,7 +259,7 @@ mod tests {
         together.set_lanes(lanes, &shiny, &x(kd), &x(ks), &x(n), &x(v), specular | 1);
         let mut one_by_one = PhongLanes::default();
         one_by_one.set(0, &other, Vec3::ONE, Vec3::ONE, Vec3::Y, Vec3::Y, true);
-        for k in (0..LANES).filter(|k| lanes >> k & 1 == 1) {
+        for k in lanes::each_set(lanes) {
             one_by_one.set(k, &shiny, kd[k], ks[k], n[k], v[k], specular >> k & 1 == 1);
         }
         assert_eq!(together.specular_lanes(), one_by_one.specular_lanes());

@@ -14,7 +14,7 @@ use super::bounds::EXIT_SCALE;
 use super::wide::{Link, WIDTH};
 use super::Bvh;
 use crate::counters::count;
-use crate::lanes::{self, F32Lanes, LANES};
+use crate::lanes::{self, F32Lanes};
 use crate::RayLanes;
 use std::cell::RefCell;
 
@@ -61,7 +61,7 @@ impl Bvh {
                 if link.is_leaf() {
                     count(|c| c.bvh_leaves += u64::from(reach.count_ones()));
                     let (first, n) = link.leaf_range();
-                    for lane in (0..LANES).filter(|&k| reach >> k & 1 == 1) {
+                    for lane in lanes::each_set(reach) {
                         if blocked(first, n, lane) {
                             found |= 1 << lane;
                         }
@@ -148,6 +148,7 @@ mod tests {
     use crate::bvh::prepared_ray::PreparedRay;
     use crate::bvh::test_support::{awkward_ray, node_boxes, some_t_max, XorShift};
     use crate::bvh::wide::tests::node_of;
+    use crate::lanes::LANES;
     use crate::Ray;
 
     /// Each (ray, child) verdict in lanes is the scalar node test's, on random

@@ -9,7 +9,7 @@
 
 use super::{Parallelogram, Sphere};
 use crate::error_bounds::gamma;
-use crate::lanes::{F32Lanes, Mask, Vec3Lanes, LANES};
+use crate::lanes::{self, F32Lanes, Mask, Vec3Lanes, LANES};
 use crate::RayLanes;
 use glam::{Vec2, Vec3};
 
@@ -93,7 +93,7 @@ impl Sphere {
         let (ny, nz, nx) = (n.y.to_array(), n.z.to_array(), n.x.to_array());
         let mut u = [0.0; LANES];
         let mut v = [0.0; LANES];
-        for k in (0..LANES).filter(|k| uv_lanes >> k & 1 == 1) {
+        for k in lanes::each_set(uv_lanes) {
             let (uv, _, _) = Sphere::uv_of_normal(Vec3::new(nx[k], ny[k], nz[k]));
             (u[k], v[k]) = (uv.x, uv.y);
         }

@@ -11,7 +11,6 @@
 //! Arbitrary Strides", 1994), which is how the lanes take consecutive draws
 //! of one stream.
 
-use super::mix::mix64;
 use glint_geometry::lanes::{self, F32Lanes, LANES};
 
 /// The LCG's multiplier (Knuth's MMIX constant, PCG's default).
@@ -184,15 +183,6 @@ impl Pcg32Lanes {
         self.state = each(first, |s| jumped(TWO_DRAWS, s));
         let uniforms = |states: [u64; LANES]| lanes::from_fn(|k| unit(output(states[k])));
         (uniforms(first), uniforms(second))
-    }
-
-    /// The generators of `key`'s streams `first..first + LANES`, lane k seeded
-    /// with [`mix64`]`(key ^ (first + k))`: with a pixel's
-    /// [`pixel_key`](super::pixel_key), the streams of [`LANES`] consecutive samples
-    /// as [`stream_seed`](super::stream_seed) names them.
-    #[inline(always)]
-    pub fn for_streams(key: u64, first: u64) -> Self {
-        Self::new(std::array::from_fn(|k| mix64(key ^ (first + k as u64))))
     }
 }
 

@@ -151,13 +151,31 @@ mod tests {
         assert!((mean - 0.5).abs() < 0.005, "mean {mean}");
     }
 
+    /// Each lane's stream is its own camera sample's, for one pixel's chunk
+    /// and for runs of several pixels' samples.
     #[test]
-    fn lanes_for_streams_are_the_samples_streams() {
-        for (seed, pixel, first) in [(0, 0, 0), (7, 512 * 300 + 11, 24), (u64::MAX, 3, 56)] {
-            let mut lanes = Pcg32Lanes::for_streams(pixel_key(seed, pixel), first);
-            let (x, y) = lanes.uniform2();
+    fn lanes_streams_are_their_samples_streams() {
+        let mut chunks: Vec<LaneSamples> = [(0, 0, 0), (7, 512 * 300 + 11, 32), (u64::MAX, 3, 48)]
+            .map(|(seed, pixel, sample)| {
+                LaneSamples::of_pixel(PixelSample {
+                    seed,
+                    pixel,
+                    sample,
+                })
+            })
+            .to_vec();
+        for per_pixel in [1, 4] {
+            chunks.push(LaneSamples {
+                seed: 5,
+                first: 2 * per_pixel as u64,
+                per_pixel,
+                pixels: std::array::from_fn(|run| 40 + 3 * run as u64),
+            });
+        }
+        for samples in chunks {
+            let (x, y) = Pcg32Lanes::new(samples.stream_seeds()).uniform2();
             for k in 0..LANES {
-                let mut rng = Pcg32::new(stream_seed(seed, pixel, first + k as u64));
+                let mut rng = samples.lane(k).rng();
                 assert_eq!(x.to_array()[k].to_bits(), rng.uniform().to_bits());
                 assert_eq!(y.to_array()[k].to_bits(), rng.uniform().to_bits());
             }

@@ -3,12 +3,14 @@
 //! Reading images back ([`Film::load`]) is in the `read` submodule; a partly
 //! rendered film with its coverage ([`PartialFilm`]) in `partial`.
 
+mod checks;
 mod partial;
 mod ppm;
 mod read;
 
+pub use checks::{MAX_EXPANSION, MAX_LOAD_SIDE};
 pub use partial::PartialFilm;
-pub use read::{srgb_to_linear, SampleEncoding, MAX_EXPANSION, MAX_LOAD_SIDE};
+pub use read::SampleEncoding;
 
 use glam::{UVec2, Vec3};
 use std::io::{Seek, Write};
@@ -169,6 +171,17 @@ impl Film {
             }
         }
         Ok(())
+    }
+}
+
+/// The sRGB electro-optical transfer function (IEC 61966-2-1): an encoded value
+/// in [0, 1] to linear. The inverse of the curve in [`linear_to_srgb8`](crate::linear_to_srgb8):
+/// every 8-bit code survives `linear_to_srgb8(srgb_to_linear(code / 255))`.
+pub fn srgb_to_linear(encoded: f32) -> f32 {
+    if encoded <= 0.040_45 {
+        encoded / 12.92
+    } else {
+        ((encoded + 0.055) / 1.055).powf(2.4)
     }
 }
 

@@ -6,8 +6,8 @@
 //! raw codes instead of scaling by `maxval`, so a file with `maxval` 1000 would
 //! read as the wrong colours.
 
-use super::read::{check_size, srgb_to_linear};
-use super::Film;
+use super::checks::{check_size, regular_file};
+use super::{srgb_to_linear, Film};
 use glam::{UVec2, Vec3};
 use std::io::Read;
 use std::path::Path;
@@ -28,7 +28,7 @@ struct Header {
 /// The largest code of the file at `path`, from its header: what an 8-bit
 /// PPM's quantisation step is relative to.
 pub(super) fn maxval(path: &Path) -> Result<u32, String> {
-    super::read::regular_file(path)?;
+    regular_file(path)?;
     let mut head = Vec::with_capacity(HEADER_LIMIT);
     std::fs::File::open(path)
         .map_err(|e| e.to_string())?
@@ -104,7 +104,7 @@ fn skip_space_and_comments(bytes: &[u8], mut pos: usize) -> Option<usize> {
 }
 
 pub(super) fn read_ppm(path: &Path) -> Result<Film, String> {
-    super::read::regular_file(path)?;
+    regular_file(path)?;
     let mut file = std::fs::File::open(path).map_err(|e| e.to_string())?;
     let file_len = file.metadata().map_err(|e| e.to_string())?.len();
     let mut head = Vec::with_capacity(HEADER_LIMIT);

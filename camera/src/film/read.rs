@@ -4,15 +4,12 @@
 //! Unlike texture loading, nothing is cleaned up: NaN, infinite and negative
 //! values stay as they are, so that a comparison sees them.
 
-use super::{Film, FilmError};
+use super::checks::{check_expansion, check_size, regular_file, MAX_LOAD_SIDE};
+use super::{srgb_to_linear, Film, FilmError};
 use glam::{UVec2, Vec3};
 use std::io::{BufReader, Read};
 use std::path::Path;
 use std::sync::OnceLock;
-
-/// The largest image side [`Film::load`] accepts, in pixels (the largest film
-/// Glint renders).
-pub const MAX_LOAD_SIDE: u32 = 16384;
 
 /// The formats [`Film::load`] reads, chosen by file extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -132,68 +129,11 @@ fn integer_max_code(path: &Path, format: InputFormat) -> u32 {
     }
 }
 
-/// The sRGB electro-optical transfer function (IEC 61966-2-1): an encoded value
-/// in [0, 1] to linear. The inverse of the curve in [`linear_to_srgb8`](crate::linear_to_srgb8):
-/// every 8-bit code survives `linear_to_srgb8(srgb_to_linear(code / 255))`.
-pub fn srgb_to_linear(encoded: f32) -> f32 {
-    if encoded <= 0.040_45 {
-        encoded / 12.92
-    } else {
-        ((encoded + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// The most an image's pixels may take over its file's size. Deflate (PNG,
-/// OpenEXR's ZIP) expands data at most about 1032 times, and the other
-/// codecs less: a header that claims more pixels than its file could hold is
-/// refused before any pixel memory is taken.
-pub const MAX_EXPANSION: u64 = 2048;
-
-/// Refuses a `width × height` image whose `decoded` bytes are more than
-/// [`MAX_EXPANSION`] times the file's `file_len`.
-pub(super) fn check_expansion(
-    width: u32,
-    height: u32,
-    decoded: u64,
-    file_len: u64,
-) -> Result<(), String> {
-    if decoded > MAX_EXPANSION.saturating_mul(file_len.max(1)) {
-        return Err(format!(
-            "the header says {width}x{height} pixels ({decoded} bytes decoded), more than a file of {file_len} bytes can hold"
-        ));
-    }
-    Ok(())
-}
-
-pub(super) fn check_size(width: u64, height: u64) -> Result<(), String> {
-    if width == 0 || height == 0 {
-        return Err(format!("the image is {width}x{height}: it has no pixels"));
-    }
-    let max = MAX_LOAD_SIDE as u64;
-    if width > max || height > max {
-        return Err(format!(
-            "the image is {width}x{height}, larger than the limit of {MAX_LOAD_SIDE} pixels a side"
-        ));
-    }
-    Ok(())
-}
-
 fn open(path: &Path) -> Result<BufReader<std::fs::File>, String> {
     regular_file(path)?;
     std::fs::File::open(path)
         .map(BufReader::new)
         .map_err(|e| e.to_string())
-}
-
-/// Refuses what is not a regular file: a FIFO or a device would never end.
-pub(super) fn regular_file(path: &Path) -> Result<(), String> {
-    match std::fs::metadata(path) {
-        Ok(meta) if !meta.is_file() => {
-            Err("not a regular file (a folder, FIFO or device); an image must be a file".into())
-        }
-        Ok(_) => Ok(()),
-        Err(e) => Err(e.to_string()),
-    }
 }
 
 /// PNG, JPEG and OpenEXR through the `image` crate: the header first (size

@@ -8,7 +8,7 @@ use crate::{named, progress_bar, Failure};
 use clap::{Args, ValueEnum};
 use glint_grade::class::{self, ClassGrades, Entry, Progress};
 use glint_grade::course::{Course, Scenes};
-use glint_grade::{Cache, GradeError, StatedSettings, TestOptions};
+use glint_grade::{text, Cache, GradeError, StatedSettings, TestOptions};
 use glint_integrator::SamplePattern;
 use indicatif::ProgressBar;
 use std::path::{Path, PathBuf};
@@ -170,7 +170,7 @@ fn parse_alpha(text: &str) -> Result<f64, String> {
         Ok(a) if a > 0.0 && a < 1.0 => Ok(a),
         _ => Err(format!(
             "expected a probability between 0 and 1 (exclusive), got \"{}\"",
-            class::shorten(text)
+            text::shorten(text)
         )),
     }
 }

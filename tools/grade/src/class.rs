@@ -7,6 +7,7 @@ use crate::hypothesis::{ReferencePlan, StatedSettings};
 use crate::reference::{references, Cache, GradeScene, References};
 use crate::submission::Submission;
 use crate::test::TestOptions;
+use crate::text::shorten;
 use crate::{grade_image, GradeError, ImageGrade};
 use glam::UVec2;
 use glint_integrator::SamplePattern;
@@ -138,16 +139,6 @@ fn csv_problem(e: &csv::Error) -> String {
             shorten(&e.to_string())
         ),
         None => format!("not valid CSV: {}", shorten(&e.to_string())),
-    }
-}
-
-/// At most 60 characters of `text`, with "…" where it was cut.
-pub fn shorten(text: &str) -> String {
-    const LIMIT: usize = 60;
-    if text.chars().count() <= LIMIT {
-        text.to_owned()
-    } else {
-        text.chars().take(LIMIT).collect::<String>() + "…"
     }
 }
 

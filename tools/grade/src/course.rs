@@ -54,7 +54,7 @@ impl Scenes {
                     let known: Vec<&str> = course.scenes.keys().map(String::as_str).collect();
                     format!(
                         "no scene \"{}\" in {} (it has {})",
-                        crate::class::shorten(name),
+                        crate::text::shorten(name),
                         course.path.display(),
                         known.join(", ")
                     )
@@ -106,7 +106,7 @@ impl Course {
                             input(format!(
                                 "{}: \"{}\" is not a pattern; expected one of {}",
                                 field(key),
-                                crate::class::shorten(v),
+                                crate::text::shorten(v),
                                 SamplePattern::NAMES.join(", ")
                             ))
                         })

@@ -36,6 +36,7 @@ pub mod report;
 pub mod stages;
 pub mod submission;
 pub mod test;
+pub mod text;
 
 pub use hypothesis::{ReferencePlan, StatedSettings};
 pub use reference::{references, Cache, GradeScene, References};

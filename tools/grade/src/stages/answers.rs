@@ -10,7 +10,7 @@
 
 use super::table::{Kind, Layout};
 use super::Stage;
-use crate::class::shorten;
+use crate::text::shorten;
 use crate::GradeError;
 use serde_json::Value as Json;
 use std::collections::{BTreeMap, BTreeSet};

@@ -72,7 +72,8 @@ impl RenderStats {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RenderControl<'a> {
     /// Once set (say by a signal handler), each worker stops after the pixel it
-    /// is on and starts no other: the pixels not reached stay unfinished.
+    /// is on (or the run of pixels sharing its chunk) and starts no other: the
+    /// pixels not reached stay unfinished.
     pub stop: Option<&'a AtomicBool>,
     /// A partial render to continue: its finished pixels are kept as they are
     /// and only the others rendered. Every pixel depends only on the scene, the

@@ -183,6 +183,45 @@ fn a_crop_renders_the_same_pixels_as_the_whole_image() {
     }
 }
 
+/// A resumed render keeps the finished pixels and renders the rest, each the
+/// whole render's pixel, where the finished ones break up the runs of
+/// pixels that share a chunk.
+#[test]
+fn a_resumed_render_is_the_whole_render_where_runs_are_broken() {
+    for (name, scene, settings) in cases().into_iter().take(4) {
+        let whole = render(&scene, &settings, &|_, _| {}).unwrap().film;
+        let size = scene.camera.resolution();
+        let finished: Vec<bool> = (0..size.x * size.y)
+            .map(|i| i % 7 == 3 || i % 11 == 0)
+            .collect();
+        let mut film = glint_camera::Film::new(size);
+        for (i, _) in finished.iter().enumerate().filter(|(_, &f)| f) {
+            let (x, y) = (i as u32 % size.x, i as u32 / size.x);
+            film.set_pixel(x, y, whole.pixel(x, y));
+        }
+        let partial = glint_camera::PartialFilm {
+            film,
+            finished,
+            fingerprint: None,
+        };
+        let control = RenderControl {
+            resume: Some(&partial),
+            ..RenderControl::default()
+        };
+        let resumed = render_with(&scene, &settings, &|_, _| {}, control).unwrap();
+        assert!(resumed.finished.iter().all(|&f| f), "{name}");
+        for y in 0..size.y {
+            for x in 0..size.x {
+                assert_eq!(
+                    bits(resumed.film.pixel(x, y)),
+                    bits(whole.pixel(x, y)),
+                    "{name}: ({x}, {y})"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn pixels_and_samples_outside_the_render_are_refused() {
     let (scene, settings) = scene("cornell-set1", UVec2::new(8, 6), |s| s.spp = 4);

@@ -636,8 +636,8 @@ fn drawn_together(
     chunk: &PointChunk,
 ) -> [EnvironmentSample; LANES] {
     let mut points = [Vec2::ZERO; LANES];
-    for (k, point) in points.iter_mut().enumerate().take(chunk.len) {
-        *point = chunk.lanes.lane(k);
+    for (point, u) in points.iter_mut().zip(chunk.iter()) {
+        *point = u;
     }
     env.sample_each(normal, &points, chunk.len)
 }

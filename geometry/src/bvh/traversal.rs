@@ -184,10 +184,7 @@ impl Bvh {
     /// each child through `black_box`, which had itself gained 6% over nothing.
     #[inline(always)]
     fn prefetch_children(&self, node: &wide::WideNode, hits: u32) {
-        let mut bits = hits;
-        while bits != 0 {
-            let lane = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
+        for lane in crate::lanes::each_set(hits) {
             let link = node.link(lane);
             if !link.is_leaf() {
                 if let Some(child) = self.tree.nodes.get(link.node()) {

@@ -92,10 +92,7 @@ impl TraversalStack {
         let enter = enter.to_array();
         let mut lanes = [0usize; WIDTH];
         let mut n = 0;
-        let mut bits = hits;
-        while bits != 0 {
-            let lane = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
+        for lane in crate::lanes::each_set(hits) {
             // Farthest first.
             let mut j = n;
             while j > 0 && enter[lanes[j - 1]] < enter[lane] {

@@ -146,14 +146,12 @@ impl ShapeList {
         t_max: f32,
     ) -> (u32, Vec4) {
         let leaf = first as usize / LEAF_WIDTH;
-        let mut shapes = self.shape_lanes[leaf];
+        let shapes = self.shape_lanes[leaf];
         if shapes != 0xf {
             count(|c| c.triangle_tests += 4);
         }
         let (mut hits, mut t) = watertight.intersect4(&self.packets[leaf], t_max);
-        while shapes != 0 {
-            let lane = shapes.trailing_zeros() as usize;
-            shapes &= shapes - 1;
+        for lane in crate::lanes::each_set(u32::from(shapes)) {
             let p = self.primitives[first as usize + lane];
             if let Object::Shape(s) = self.objects[p.object as usize] {
                 if let Some(d) = self.shapes[s as usize].hit_distance(ray, t_max) {

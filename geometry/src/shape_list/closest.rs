@@ -361,10 +361,8 @@ impl ClosestSearch {
 
     /// Considers the hit lanes of a packet of shapes, lane k being object `objects[k]`.
     #[inline]
-    fn consider_lanes(&mut self, list: &ShapeList, mut hits: u32, t: Vec4, objects: &[u32; 4]) {
-        while hits != 0 {
-            let lane = hits.trailing_zeros() as usize;
-            hits &= hits - 1;
+    fn consider_lanes(&mut self, list: &ShapeList, hits: u32, t: Vec4, objects: &[u32; 4]) {
+        for lane in crate::lanes::each_set(hits) {
             let p = Primitive {
                 object: objects[lane],
                 triangle: 0,
@@ -391,17 +389,15 @@ impl ClosestSearch {
         let watertight = self
             .watertight
             .get_or_insert_with(|| WatertightRay::new(&ray));
-        let (mut hits, t) = list.leaf_hits(first, &ray, watertight, limit);
+        let (hits, t) = list.leaf_hits(first, &ray, watertight, limit);
         if hits != 0 {
             // What the slot holds is read at the end of the query.
             if let Some(slot) = list.primitives.get(first as usize) {
                 prefetch(slot);
             }
         }
-        while hits != 0 {
-            let lane = hits.trailing_zeros();
-            hits &= hits - 1;
-            self.consider(list, Found::Slot(first + lane), t[lane as usize]);
+        for lane in crate::lanes::each_set(hits) {
+            self.consider(list, Found::Slot(first + lane as u32), t[lane]);
         }
         self.limit()
     }

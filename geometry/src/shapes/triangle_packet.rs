@@ -179,10 +179,7 @@ impl WatertightRay {
         on_edge: u32,
     ) -> (u32, Vec4) {
         hits &= !on_edge;
-        let mut lanes = on_edge;
-        while lanes != 0 {
-            let lane = lanes.trailing_zeros() as usize;
-            lanes &= lanes - 1;
+        for lane in crate::lanes::each_set(on_edge) {
             let [p0, p1, p2] = packet.triangle(lane);
             if let Some((t_hit, _)) = self.intersect(p0, p1, p2, t_max) {
                 hits |= 1 << lane;

@@ -15,9 +15,11 @@ pub struct PiecewiseConstant1D {
     integral: f32,
     /// A guide table (Chen and Asau, "On generating random variates from an
     /// empirical distribution", AIIE Transactions 6(2), 1974): entry `j` is
-    /// the number of CDF values at most `j / n`, so the search for `u` need only
-    /// look between the entries either side of `u·n`. The bin found is the
-    /// full search's.
+    /// the number of CDF values in buckets before `j`, bucket
+    /// [`bucket`]`(c, n)` holding value `c`. The values of `u`'s own bucket
+    /// are the only ones the search compares with `u`; where a bucket holds
+    /// none (a bin wider than a bucket), the guide is the answer. The bucket
+    /// function is monotone, so the count is the full search's.
     guide: Vec<u32>,
 }
 
@@ -48,7 +50,7 @@ impl PiecewiseConstant1D {
             (total / n as f64) as f32
         };
         let guide = (0..=n)
-            .map(|j| cdf.partition_point(|&c| c <= j as f64 / n as f64) as u32)
+            .map(|j| cdf.partition_point(|&c| bucket(c, n) < j) as u32)
             .collect();
         Self {
             weights,
@@ -58,18 +60,23 @@ impl PiecewiseConstant1D {
         }
     }
 
-    /// The number of CDF values at most `u`, searching only between the guide
-    /// entries a bucket either side of `u`'s (a margin for the rounding of `u·n`).
+    /// The number of CDF values at most `u`: those of the buckets before
+    /// `u`'s, plus those of its own bucket at most `u` (most buckets hold none
+    /// or one, counted without a branch).
     #[inline]
     fn values_at_most(&self, u: f64) -> usize {
         let n = self.len();
         if !(0.0..1.0).contains(&u) {
             return self.cdf.partition_point(|&c| c <= u);
         }
-        let bucket = ((u * n as f64) as usize).min(n);
-        let lo = self.guide[bucket.saturating_sub(1)] as usize;
-        let hi = self.guide[(bucket + 2).min(n)] as usize;
-        lo + self.cdf[lo..hi].partition_point(|&c| c <= u)
+        let j = bucket(u, n);
+        let (lo, hi) = (self.guide[j] as usize, self.guide[j + 1] as usize);
+        let own = &self.cdf[lo..hi];
+        lo + if own.len() <= 4 {
+            own.iter().map(|&c| usize::from(c <= u)).sum::<usize>()
+        } else {
+            own.partition_point(|&c| c <= u)
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -115,6 +122,13 @@ impl PiecewiseConstant1D {
     fn pdf_of_bin(&self, bin: usize) -> f32 {
         self.weights[bin].max(0.0) / self.integral
     }
+}
+
+/// The guide bucket of `x` among `n`: `⌊x·n⌋` as rounded, within `0..n`.
+/// Monotone in `x`, which is all the guide table needs of it.
+#[inline]
+fn bucket(x: f64, n: usize) -> usize {
+    ((x * n as f64) as usize).min(n - 1)
 }
 
 /// A piecewise-constant density over [0, 1]² on a `width × height` grid of bins:

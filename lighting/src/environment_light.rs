@@ -1,8 +1,8 @@
 use crate::distribution::PiecewiseConstant2D;
 use glam::{Vec2, Vec3};
 use glint_texture::{
-    cube_direction, cube_face_st, latlong_direction, latlong_texel, latlong_uv, CubeMap,
-    Environment,
+    cube_direction, cube_face_st, latlong_direction_and_sin_theta, latlong_texel, latlong_uv,
+    CubeMap, Environment,
 };
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -166,13 +166,13 @@ impl EnvironmentLight {
             let d = cube_direction(face, st);
             return (d.normalize(), p / cube_jacobian(st));
         }
-        let sin_theta = (uv.y * PI).sin();
+        let (direction, sin_theta) = latlong_direction_and_sin_theta(uv);
         let pdf = if sin_theta > 0.0 {
             p / (2.0 * PI * PI * sin_theta)
         } else {
             0.0
         };
-        (latlong_direction(uv), pdf)
+        (direction, pdf)
     }
 
     /// The solid-angle density with which [`Self::sample`] picks world direction

@@ -74,11 +74,18 @@ pub fn latlong_uv(d: Vec3) -> Vec2 {
 /// The unit direction at lat-long coordinates `(u, v)`; inverse of [`latlong_uv`].
 #[inline]
 pub fn latlong_direction(uv: Vec2) -> Vec3 {
+    latlong_direction_and_sin_theta(uv).0
+}
+
+/// [`latlong_direction`] and `sin θ`, θ = v·π its angle from +y (the
+/// Jacobian of the map's coordinates has it), from the one sine.
+#[inline]
+pub fn latlong_direction_and_sin_theta(uv: Vec2) -> (Vec3, f32) {
     let phi = (uv.x - 0.5) * TAU;
     let theta = uv.y * PI;
     let (sin_t, cos_t) = theta.sin_cos();
     let (sin_p, cos_p) = phi.sin_cos();
-    Vec3::new(sin_t * sin_p, cos_t, -sin_t * cos_p)
+    (Vec3::new(sin_t * sin_p, cos_t, -sin_t * cos_p), sin_t)
 }
 
 /// Six square faces of one size, each with its own lazily built pyramid.

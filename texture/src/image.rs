@@ -84,16 +84,37 @@ impl Image {
 
     /// Bilinear interpolation at `st` with texels read by `fetch(x, y)`, which
     /// decides what lies past the image's edges (a wrap mode, the next cube face,
-    /// the other side of a pole).
+    /// the other side of a pole). Inside the image `fetch` must give the texel
+    /// itself: there it is not asked, the four texels being read directly.
     #[inline]
     pub fn bilinear_with(&self, st: Vec2, fetch: impl Fn(i64, i64) -> Vec3) -> Vec3 {
         let p = st * self.size() - 0.5;
         let p0 = p.floor();
         let f = p - p0;
         let (x, y) = (p0.x as i64, p0.y as i64);
-        let top = lerp(fetch(x, y), fetch(x + 1, y), f.x);
-        let bottom = lerp(fetch(x, y + 1), fetch(x + 1, y + 1), f.x);
-        lerp(top, bottom, f.y)
+        let [t00, t10, t01, t11] = match self.square_at(x, y) {
+            Some(i) => {
+                let w = self.width as usize;
+                let t = &self.texels;
+                [t[i], t[i + 1], t[i + w], t[i + w + 1]]
+            }
+            None => [
+                fetch(x, y),
+                fetch(x + 1, y),
+                fetch(x, y + 1),
+                fetch(x + 1, y + 1),
+            ],
+        };
+        lerp(lerp(t00, t10, f.x), lerp(t01, t11, f.x), f.y)
+    }
+
+    /// The index of texel `(x, y)` where the 2 × 2 texels from it lie inside
+    /// the image.
+    #[inline]
+    fn square_at(&self, x: i64, y: i64) -> Option<usize> {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let inside = x >= 0 && y >= 0 && x + 1 < w && y + 1 < h;
+        inside.then(|| (y * w + x) as usize)
     }
 
     /// `(width, height)` as floats.

@@ -61,6 +61,7 @@ mod hit;
 pub use glint_lanes as lanes;
 mod offset;
 mod prefetch;
+pub use prefetch::prefetch;
 mod ray;
 mod shape_list;
 mod shapes;

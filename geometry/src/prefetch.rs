@@ -6,9 +6,9 @@
 /// 1.6× the rays per second of the same interleaving without it (8 lanes, 1M triangles,
 /// incoherent rays, one core: 360 vs 590 ns per ray). A no-op off x86_64.
 #[inline(always)]
-pub(crate) fn prefetch<T>(item: &T) {
+pub fn prefetch<T: ?Sized>(item: &T) {
     let start = (item as *const T).cast::<u8>();
-    let size = std::mem::size_of::<T>();
+    let size = std::mem::size_of_val(item);
     prefetch_lines(start, size.div_ceil(64));
     // The last line, which an unaligned `item` reaches past the ones above.
     prefetch_line(start.wrapping_add(size.saturating_sub(1)));

@@ -2,6 +2,7 @@
 //! A.5 and 12.5): sample a bin in proportion to its weight, then uniformly inside it.
 
 use glam::Vec2;
+use glint_geometry::prefetch;
 
 /// A piecewise-constant density over [0, 1] with `n` equal bins.
 #[derive(Clone, Debug)]
@@ -81,6 +82,17 @@ impl PiecewiseConstant1D {
 
     pub fn len(&self) -> usize {
         self.weights.len()
+    }
+
+    /// Asks for the memory a [`Self::sample`] at `u` reads: the guide entry
+    /// of `u`'s bucket and, as a guess that holds for an even density, the
+    /// CDF values and weights at the same index.
+    #[inline]
+    fn prefetch_around(&self, u: f32) {
+        let j = bucket(u as f64, self.len());
+        prefetch(&self.guide[j]);
+        prefetch(&self.cdf[j]);
+        prefetch(&self.weights[j]);
     }
 
     pub fn is_empty(&self) -> bool {
@@ -174,6 +186,11 @@ impl PiecewiseConstant2D {
         for k in 0..len.min(N) {
             let (v, pdf_v, row) = self.marginal.sample(u[k].y);
             (out[k], rows[k]) = ((Vec2::new(0.0, v), pdf_v), row);
+        }
+        // Each row's guide entry, CDF values and weights around the bucket of
+        // its point: the searches below find them in the cache.
+        for k in 0..len.min(N) {
+            self.rows[rows[k]].prefetch_around(u[k].x);
         }
         for k in 0..len.min(N) {
             let (x, pdf_u, _) = self.rows[rows[k]].sample(u[k].x);

@@ -1,5 +1,6 @@
 use crate::distribution::PiecewiseConstant2D;
 use glam::{Vec2, Vec3};
+use glint_geometry::prefetch;
 use glint_texture::{
     cube_direction, cube_face_st, latlong_direction_and_sin_theta, latlong_texel, latlong_uv,
     CubeMap, Environment,
@@ -130,6 +131,14 @@ impl EnvironmentLight {
             (_, Some(dist)) => dist,
         };
         let uv = dist.sample_each(u, len);
+        // The texels each radiance below reads, asked for all at once.
+        if let Environment::LatLong(map) = &self.environment {
+            for &(uv, _) in &uv[..len] {
+                for texels in map.image().bilinear_texels(uv).into_iter().flatten() {
+                    prefetch(texels);
+                }
+            }
+        }
         for k in 0..len {
             out[k].radiance = self.radiance_at(uv[k].0);
         }

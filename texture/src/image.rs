@@ -88,10 +88,7 @@ impl Image {
     /// itself: there it is not asked, the four texels being read directly.
     #[inline]
     pub fn bilinear_with(&self, st: Vec2, fetch: impl Fn(i64, i64) -> Vec3) -> Vec3 {
-        let p = st * self.size() - 0.5;
-        let p0 = p.floor();
-        let f = p - p0;
-        let (x, y) = (p0.x as i64, p0.y as i64);
+        let (x, y, f) = self.bilinear_corner(st);
         let [t00, t10, t01, t11] = match self.square_at(x, y) {
             Some(i) => {
                 let w = self.width as usize;
@@ -106,6 +103,25 @@ impl Image {
             ],
         };
         lerp(lerp(t00, t10, f.x), lerp(t01, t11, f.x), f.y)
+    }
+
+    /// The first of the 2 × 2 texels bilinear filtering reads at `st`, and
+    /// the weights of the others.
+    #[inline]
+    fn bilinear_corner(&self, st: Vec2) -> (i64, i64, Vec2) {
+        let p = st * self.size() - 0.5;
+        let p0 = p.floor();
+        (p0.x as i64, p0.y as i64, p - p0)
+    }
+
+    /// The texels [`Self::bilinear_with`] reads at `st` where they all lie
+    /// inside the image: the first two, then the two below them.
+    #[inline]
+    pub fn bilinear_texels(&self, st: Vec2) -> Option<[&[Vec3]; 2]> {
+        let (x, y, _) = self.bilinear_corner(st);
+        let i = self.square_at(x, y)?;
+        let w = self.width as usize;
+        Some([&self.texels[i..i + 2], &self.texels[i + w..i + w + 2]])
     }
 
     /// The index of texel `(x, y)` where the 2 × 2 texels from it lie inside

@@ -1,5 +1,6 @@
 use crate::camera_lanes::LaneOccluders;
 use crate::counters::{ShadingCounters, TextureCounters};
+use crate::drawn_ahead::DrawnAhead;
 use crate::light_samples::LANES_FROM_SAMPLES;
 use crate::sampling::Pcg32;
 use crate::sampling::{
@@ -80,6 +81,8 @@ pub struct SampleContext<T: Tracer = ()> {
     pub(crate) lane_occluders: Option<LaneOccluders>,
     /// The Sobol sequences of the pixel's pairs, hashed once for its samples.
     pub(crate) sequences: SequenceCache,
+    /// Environment samples drawn for a chunk's first hits, all together.
+    pub(crate) drawn_ahead: DrawnAhead,
 }
 
 /// The shapes that may block shadow rays to one area light from anywhere
@@ -115,6 +118,7 @@ impl<T: Tracer> SampleContext<T> {
             occluders: None,
             lane_occluders: None,
             sequences: SequenceCache::default(),
+            drawn_ahead: DrawnAhead::default(),
         }
     }
 
@@ -494,32 +498,26 @@ impl DirectIntegrator {
         let Some(env) = &scene.environment else {
             return Vec3::ZERO;
         };
-        let mut samples = std::mem::take(&mut ctx.environment_points);
-        ctx.fill_points(self.environment_pattern, pair, &mut samples);
-        ctx.counters.environment_samples += samples.len() as u64;
-        let sum = if T::ON || samples.len() < LANES_FROM_SAMPLES {
-            let mut sum = Vec3::ZERO;
-            for chunk in samples.chunks() {
-                for s in drawn_together(env, point.n, &chunk).iter().take(chunk.len) {
-                    let Some((f, value)) = point.environment_sample_unshadowed(s, ctx) else {
-                        continue;
-                    };
-                    let shadow_ray = spawn_ray(point.hit, s.direction);
-                    if !scene.shapes.any_hit(&shadow_ray, f32::INFINITY) {
-                        record_environment_sample(ctx, s, f, Shadow::Unoccluded, value);
-                        sum += value;
-                    } else if T::ON {
-                        // Finding the blocker costs a query: only when tracing.
-                        let shadow = blocker(scene, &shadow_ray, f32::INFINITY);
-                        record_environment_sample(ctx, s, f, shadow, Vec3::ZERO);
-                    }
-                }
+        let n = self.environment_samples as usize;
+        ctx.counters.environment_samples += n as u64;
+        let one_by_one = T::ON || n < LANES_FROM_SAMPLES;
+        let mut sum = Vec3::ZERO;
+        if let Some(i) = ctx.drawn_ahead.find(ctx.sample, pair) {
+            let ahead = std::mem::take(&mut ctx.drawn_ahead);
+            for drawn in ahead.samples_of(i, n).chunks(LANES) {
+                point.add_environment_samples(scene, drawn, one_by_one, &mut sum, ctx);
             }
-            sum
+            ctx.drawn_ahead = ahead;
         } else {
-            point.environment_sum_in_lanes(scene, env, &samples, ctx)
-        };
-        ctx.environment_points = samples;
+            let mut samples = std::mem::take(&mut ctx.environment_points);
+            ctx.fill_points(self.environment_pattern, pair, &mut samples);
+            for chunk in samples.chunks() {
+                let drawn = drawn_together(env, point.n, &chunk);
+                let drawn = &drawn[..chunk.len];
+                point.add_environment_samples(scene, drawn, one_by_one, &mut sum, ctx);
+            }
+            ctx.environment_points = samples;
+        }
         sum / self.environment_samples as f32
     }
 }
@@ -567,45 +565,52 @@ impl ShadingPoint<'_> {
         Some((f, s.radiance * f / s.pdf))
     }
 
-    /// The sum of the unblocked environment samples' values over `samples`,
-    /// in order: each sample up to its shadow ray one by one, then the shadow
-    /// rays of [`LANES`] samples tested together (the origins of `spawn_ray`,
-    /// so the same answers and the same sum, bit for bit).
-    fn environment_sum_in_lanes<T: Tracer>(
+    /// Adds to `sum` the values of the environment samples `drawn` (at most
+    /// [`LANES`]) whose shadow rays are unblocked, in order: `one_by_one`,
+    /// or each up to its shadow ray one by one and then their shadow rays
+    /// tested together (the origins of `spawn_ray`, so the same answers and
+    /// the same sum, bit for bit).
+    fn add_environment_samples<T: Tracer>(
         &self,
         scene: &Scene,
-        env: &EnvironmentLight,
-        samples: &SamplePoints,
+        drawn: &[EnvironmentSample],
+        one_by_one: bool,
+        sum: &mut Vec3,
         ctx: &mut SampleContext<T>,
-    ) -> Vec3 {
-        let origins = self.shadow_origins();
-        let mut sum = Vec3::ZERO;
-        for chunk in samples.chunks() {
-            let mut values = [Vec3::ZERO; LANES];
-            let mut directions = [self.hit.geometric_normal; LANES];
-            let mut traced = 0u32;
-            let drawn = drawn_together(env, self.n, &chunk);
-            for (k, s) in drawn.iter().enumerate().take(chunk.len) {
-                if let Some((_, value)) = self.environment_sample_unshadowed(s, ctx) {
-                    (values[k], directions[k]) = (value, s.direction);
-                    traced |= 1 << k;
+    ) {
+        if one_by_one {
+            for s in drawn {
+                let Some((f, value)) = self.environment_sample_unshadowed(s, ctx) else {
+                    continue;
+                };
+                let shadow_ray = spawn_ray(self.hit, s.direction);
+                if !scene.shapes.any_hit(&shadow_ray, f32::INFINITY) {
+                    record_environment_sample(ctx, s, f, Shadow::Unoccluded, value);
+                    *sum += value;
+                } else if T::ON {
+                    // Finding the blocker costs a query: only when tracing.
+                    let shadow = blocker(scene, &shadow_ray, f32::INFINITY);
+                    record_environment_sample(ctx, s, f, shadow, Vec3::ZERO);
                 }
             }
-            let direction = Vec3Lanes::from_lanes(directions);
-            let origin = origins.leaving_towards(&direction);
-            let rays = RayLanes { origin, direction };
-            let blocked =
-                scene
-                    .shapes
-                    .any_hits_among(&Occluders::ALL, &rays, f32::INFINITY, traced);
-            let visible = traced & !blocked;
-            for (k, value) in values.iter().enumerate().take(chunk.len) {
-                if visible >> k & 1 == 1 {
-                    sum += *value;
-                }
+            return;
+        }
+        let mut values = [Vec3::ZERO; LANES];
+        let mut directions = [self.hit.geometric_normal; LANES];
+        let mut traced = 0u32;
+        for (k, s) in drawn.iter().enumerate() {
+            if let Some((_, value)) = self.environment_sample_unshadowed(s, ctx) {
+                (values[k], directions[k]) = (value, s.direction);
+                traced |= 1 << k;
             }
         }
-        sum
+        let direction = Vec3Lanes::from_lanes(directions);
+        let origin = self.shadow_origins().leaving_towards(&direction);
+        let rays = RayLanes { origin, direction };
+        let blocked = (scene.shapes).any_hits_among(&Occluders::ALL, &rays, f32::INFINITY, traced);
+        for k in lanes::each_set(traced & !blocked) {
+            *sum += values[k];
+        }
     }
 }
 

@@ -3,12 +3,12 @@ use crate::direct::SampleContext;
 use crate::sampling::{pixel_rng, LaneSamples, PixelSample, SobolPoints, PIXEL_STREAM};
 use crate::settings::{Crop, RenderSettings, SettingsError};
 use crate::trace::{Event, Tracer};
-use crate::{DirectIntegrator, Scene};
+use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::{UVec2, Vec2, Vec3};
 use glint_camera::{Camera, Film, PartialFilm};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{
-    take_counters, CountingGuard, Hit, QueryCounters, Ray, RayDifferential, RayLanes,
+    take_counters, ClosestLanes, CountingGuard, Hit, QueryCounters, Ray, RayDifferential, RayLanes,
 };
 use rayon::prelude::*;
 use std::cell::Cell;
@@ -516,29 +516,72 @@ impl<'a> PixelRenderer<'a> {
                 &chunk.samples,
                 ctx,
             ),
-            _ => Vec3Lanes::from_lanes(std::array::from_fn(|k| {
-                if k >= used {
-                    return Vec3::ZERO;
+            _ => {
+                if let Some(closest) = &closest {
+                    self.draw_environment_ahead(chunk, closest, used, ctx);
                 }
-                let (ray, diff) = (&ray_lanes.lane(k), &diffs[k]);
-                let hit = closest.as_ref().map(|closest| {
-                    closest
-                        .hit(k)
-                        .and_then(|found| scene.shapes.surface_record(ray, found))
-                });
-                let sample = chunk.samples.lane(k).sample;
-                self.sample(
-                    chunk.x(k),
-                    chunk.y,
-                    chunk.jitters[k],
-                    sample,
-                    ray,
-                    diff,
-                    hit,
-                    ctx,
-                )
-            })),
+                self.samples_one_by_one(chunk, (&ray_lanes, &diffs), closest.as_ref(), ctx)
+            }
         }
+    }
+
+    /// Each of a chunk's camera samples traced alone from its ray and
+    /// differentials (`rays`), from its first hit where found (`closest`).
+    fn samples_one_by_one<T: Tracer>(
+        &self,
+        chunk: &SampleChunk,
+        (ray_lanes, diffs): (&RayLanes, &[RayDifferential; LANES]),
+        closest: Option<&ClosestLanes>,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let (scene, used) = (self.scene, chunk.jitters.len());
+        Vec3Lanes::from_lanes(std::array::from_fn(|k| {
+            if k >= used {
+                return Vec3::ZERO;
+            }
+            let (ray, diff) = (&ray_lanes.lane(k), &diffs[k]);
+            let hit = closest.as_ref().map(|closest| {
+                closest
+                    .hit(k)
+                    .and_then(|found| scene.shapes.surface_record(ray, found))
+            });
+            let sample = chunk.samples.lane(k).sample;
+            self.sample(
+                chunk.x(k),
+                chunk.y,
+                chunk.jitters[k],
+                sample,
+                ray,
+                diff,
+                hit,
+                ctx,
+            )
+        }))
+    }
+
+    /// Draws the environment samples of the chunk's camera samples that hit
+    /// a surface with local shading, all together, where the integrator can
+    /// ([`DirectIntegrator::draws_environment_ahead`]): the samples each
+    /// takes at its first hit.
+    fn draw_environment_ahead<T: Tracer>(
+        &self,
+        chunk: &SampleChunk,
+        closest: &ClosestLanes,
+        used: usize,
+        ctx: &mut SampleContext<T>,
+    ) {
+        let (scene, integrator) = (self.scene, self.integrator);
+        if T::ON || self.settings.aov.is_some() || !integrator.draws_environment_ahead(scene) {
+            return;
+        }
+        let shaded = |k: usize| match scene.surface_of_primitive(closest.object[k], 0) {
+            SurfaceKind::Material(material) => material.has_local_shading(),
+            SurfaceKind::Emitter(_) => false,
+        };
+        let lanes = lanes::each_set(closest.hits & ((1 << used) - 1))
+            .filter(|&k| shaded(k))
+            .fold(0u32, |lanes, k| lanes | 1 << k);
+        integrator.draw_environment_ahead(scene, &chunk.samples, lanes, ctx);
     }
 
     /// The radiance (or AOV) of camera sample `sample` of pixel (x, y), at

@@ -81,6 +81,12 @@ impl EnvironmentLight {
         self.scale * self.environment.radiance(self.to_map(d), width)
     }
 
+    /// Whether samples are drawn from the map (by luminance), not about a
+    /// shading normal: then they do not depend on the normal.
+    pub fn is_sampled_by_map(&self) -> bool {
+        self.distribution.is_some() && !matches!(self.environment, Environment::Constant(_))
+    }
+
     /// A direction chosen in proportion to the environment's radiance (or, for a
     /// constant environment, to the cosine about `normal`), for uniform `u`.
     pub fn sample(&self, normal: Vec3, u: Vec2) -> EnvironmentSample {

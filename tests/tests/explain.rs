@@ -32,8 +32,9 @@ fn bits(v: Vec3) -> [u32; 3] {
 /// lanes (one light sample), several pixels' samples in one chunk's lanes,
 /// first hits in lanes with light samples in lanes,
 /// the scalar path with footprints, mirrors and environment samples, the BVH,
-/// and physical shading with MIS and without (its light samples' shadow rays
-/// in lanes when rendered, one by one when explained).
+/// physical shading with MIS and without (its light samples' shadow rays
+/// in lanes when rendered, one by one when explained), and environment
+/// samples drawn ahead for a chunk's camera samples.
 fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
     let size = UVec2::new(24, 18);
     let few = |s: &mut RenderSettings| {
@@ -71,6 +72,23 @@ fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
         ("ground-mipmap", scene("ground-mipmap", size, few)),
         ("bunny-cornell", scene("bunny-cornell", size, few)),
         ("physical-glossy", scene("physical-glossy", size, few)),
+        // Environment samples drawn ahead for a chunk's first hits, one or
+        // four a point (the first pair joint with the pixel's), and drawn by
+        // each point itself behind a mirror.
+        ("physical-textured-ground, 1 sample", {
+            scene("physical-textured-ground", size, |s| {
+                few(s);
+                (s.light_samples, s.environment_samples) = (1, 1);
+            })
+        }),
+        (
+            "physical-textured-ground",
+            scene("physical-textured-ground", size, few),
+        ),
+        (
+            "physical-environment",
+            scene("physical-environment", size, few),
+        ),
         ("cornell-physical", scene("cornell-physical", size, few)),
     ]
     .into_iter()

@@ -140,8 +140,9 @@ impl EnvironmentLight {
         // The texels each radiance below reads, asked for all at once.
         if let Environment::LatLong(map) = &self.environment {
             for &(uv, _) in &uv[..len] {
-                for texels in map.image().bilinear_texels(uv).into_iter().flatten() {
-                    prefetch(texels);
+                if let Some([top, bottom]) = map.image().bilinear_texels(uv) {
+                    prefetch(top);
+                    prefetch(bottom);
                 }
             }
         }

@@ -78,7 +78,7 @@ pub use shape_list::{
 pub use shapes::{triangle, triangle_packet};
 pub use shapes::{
     AaBox, MeshError, Parallelogram, ParallelogramPacket, Plane, Shape, Sphere, SpherePacket,
-    SurfaceLanes, TriangleMesh, TrianglePacket,
+    SurfaceLanes, TriangleMesh, TrianglePacket, SPHERE_UV_APPROX_ERROR,
 };
 
 #[cfg(doctest)]

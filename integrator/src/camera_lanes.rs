@@ -37,10 +37,12 @@ use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, LANES};
 use glint_geometry::{
     offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayDifferential, RayLanes, Shape,
-    SurfaceLanes,
+    Sphere, SurfaceLanes, SPHERE_UV_APPROX_ERROR,
 };
-use glint_lighting::{AreaLight, Light, PhongLanes, PhongMaterial, PointLight, ShadingModel};
-use glint_texture::{TexCoord, Texture};
+use glint_lighting::{
+    AreaLight, Light, PhongLanes, PhongMaterial, PointLight, ShadingModel, UvTransform,
+};
+use glint_texture::{Checkerboard, TexCoord, Texture};
 
 impl DirectIntegrator {
     /// Whether the first hits of `scene`'s camera samples can be shaded [`LANES`] at
@@ -363,13 +365,20 @@ impl<'a> ShadedLanes<'a> {
             return false;
         };
         let kind = scene.surface_of_primitive(object, 0);
+        let shape = scene.shapes.object(object);
         // A sphere's texture coordinates cost an `acos` and an `atan2` a lane:
-        // only where the material reads them.
+        // only where the material reads them, and not for checks.
+        let checks = match (&kind, shape) {
+            (SurfaceKind::Material(m), ObjectRef::Shape(Shape::Sphere(_))) if !ctx.detailed => {
+                SphereChecks::of(m)
+            }
+            _ => None,
+        };
         let uv_lanes = match kind {
-            SurfaceKind::Material(material) if material.reads_uv() => hit_lanes,
+            SurfaceKind::Material(material) if material.reads_uv() && checks.is_none() => hit_lanes,
             _ => 0,
         };
-        let surface = match scene.shapes.object(object) {
+        let surface = match shape {
             ObjectRef::Shape(Shape::Sphere(s)) => s.surface_points_lanes(rays, closest.t, uv_lanes),
             ObjectRef::Shape(Shape::Parallelogram(p)) => p.surface_points_lanes(rays, closest.t),
             _ => return false,
@@ -386,7 +395,10 @@ impl<'a> ShadedLanes<'a> {
                 return true;
             }
         };
-        let (kd, ks) = reflectances_lanes(material, &surface, hit_lanes, ctx);
+        let (kd, ks) = match &checks {
+            Some(checks) => checks.reflectances_lanes(material, &surface.normal, hit_lanes),
+            None => reflectances_lanes(material, &surface, hit_lanes, ctx),
+        };
         // `ShadingPoint::with_reflectances`: the normal turned to the viewer, the
         // geometric normal to its side, and the unit direction to the viewer.
         let d = &rays.direction;
@@ -562,6 +574,78 @@ fn reflectances_lanes<T: Tracer>(
             }
             (kd, ks)
         }
+    }
+}
+
+/// A sphere's point-sampled checkerboard, read from each lane's normal: its
+/// check found from polar angles in lanes ([`Sphere::uv_of_normals_approx`]),
+/// and from libm's (the scalar path's texture coordinates) only in lanes
+/// within the approximation's error of a check's edge. The check is then
+/// the scalar path's, and so are the reflectances, bit for bit.
+struct SphereChecks<'a> {
+    board: &'a Checkerboard,
+    /// The constant specular color, `None` where it is the diffuse one.
+    ks: Option<Vec3>,
+    /// The checks per unit of the sphere's u and v, at most.
+    density: f32,
+}
+
+impl<'a> SphereChecks<'a> {
+    /// The checks of `material`, if its diffuse color is a point-sampled
+    /// checkerboard, its specular color none or a constant, and its checks
+    /// few enough per unit of uv (at most [`Self::MAX_DENSITY`]) that the
+    /// approximation's error stays far below a check.
+    fn of(material: &'a PhongMaterial) -> Option<Self> {
+        let Texture::Checkerboard(board) = &material.diffuse else {
+            return None;
+        };
+        let ks = match &material.specular {
+            None => None,
+            Some(texture) => Some(texture.as_constant()?),
+        };
+        let density = board.checks as f32 * material.uv_transform.scale.abs().max_element();
+        (!board.analytic && density <= Self::MAX_DENSITY).then_some(Self { board, ks, density })
+    }
+
+    const MAX_DENSITY: f32 = 64.0;
+
+    /// `material.reflectances_at` each lane's uv on a sphere whose unit
+    /// normals are `normal` (lanes of `hit_lanes`; the others zero).
+    fn reflectances_lanes(
+        &self,
+        material: &PhongMaterial,
+        normal: &Vec3Lanes,
+        hit_lanes: u32,
+    ) -> (Vec3Lanes, Vec3Lanes) {
+        let (u, v) = Sphere::uv_of_normals_approx(normal);
+        let UvTransform { scale, offset } = material.uv_transform;
+        let n = F32Lanes::splat(self.board.checks as f32);
+        let cells = |c: F32Lanes, s: f32, o: f32| {
+            ((c * F32Lanes::splat(s) + F32Lanes::splat(o)) * n).to_array()
+        };
+        let (x, y) = (cells(u, scale.x, offset.x), cells(v, scale.y, offset.y));
+        let error = 2.0 * self.density * SPHERE_UV_APPROX_ERROR;
+        // Away from every edge by more than the error (and the rounding of
+        // `c`, a few of its ulps): the exact coordinate is in the same check.
+        let clear = |c: f32| {
+            let margin = error + c.abs() * 1e-6;
+            let f = c - c.floor();
+            f > margin && f < 1.0 - margin
+        };
+        let (mut kd, mut ks) = (Vec3Lanes::default(), Vec3Lanes::default());
+        for k in lanes::each_set(hit_lanes) {
+            let (d, s) = if clear(x[k]) && clear(y[k]) {
+                let odd = (x[k].floor() as i64 ^ y[k].floor() as i64) & 1;
+                let d = self.board.colors[odd as usize];
+                (d, self.ks.unwrap_or(d))
+            } else {
+                let (uv, _, _) = Sphere::uv_of_normal(normal.lane(k));
+                material.reflectances_at(uv)
+            };
+            kd.set_lane(k, d);
+            ks.set_lane(k, s);
+        }
+        (kd, ks)
     }
 }
 
@@ -859,5 +943,68 @@ mod tests {
                 color: Vec3::ONE
             }
         ))));
+    }
+
+    /// Checks read from the normals in lanes are the scalar path's, bit for
+    /// bit: on a dense sweep of directions, including every check's edges
+    /// and their neighbours, the poles and the seam, with the material's uv
+    /// scaled and offset; both ways of finding the check are taken.
+    #[test]
+    fn sphere_checks_from_normals_are_the_scalar_paths() {
+        let mut material = PhongMaterial::new(Vec3::ZERO, 20.0);
+        let board = Checkerboard::new(Vec3::new(0.9, 0.1, 0.2), Vec3::new(0.1, 0.3, 0.8), 8);
+        material.diffuse = Texture::Checkerboard(board);
+        material.specular = Some(Texture::Constant(Vec3::splat(0.25)));
+        material.uv_transform = UvTransform {
+            scale: Vec2::new(3.0, -2.0),
+            offset: Vec2::new(0.125, 0.3),
+        };
+        let checks = SphereChecks::of(&material).expect("point-sampled checks");
+        let direction = |theta: f32, phi: f32| {
+            let (st, ct) = theta.sin_cos();
+            Vec3::new(st * phi.cos(), ct, -st * phi.sin())
+        };
+        let mut normals = vec![Vec3::Y, -Vec3::Y, Vec3::X, -Vec3::Z];
+        let edges = 8 * 3 * 2;
+        for i in 0..=edges {
+            let at = i as f32 / edges as f32;
+            for nudge in [-2e-6f32, -1e-7, 0.0, 1e-7, 2e-6, 0.013] {
+                let a = (at + nudge) * std::f32::consts::PI;
+                for j in 0..7 {
+                    let b = j as f32 * 0.9;
+                    normals.push(direction(a, b));
+                    normals.push(direction(b * 0.5, 2.0 * a));
+                }
+            }
+        }
+        // Normals whose exact check coordinates lie within 1e-4 of an edge
+        // (inside the margin, so read through libm), and the others.
+        let (mut near, mut clear) = (0, 0);
+        for chunk in normals.chunks(LANES) {
+            let mut normal = Vec3Lanes::default();
+            for (k, n) in chunk.iter().enumerate() {
+                normal.set_lane(k, n.normalize());
+            }
+            let used = (1u32 << chunk.len()) - 1;
+            let (kd, ks) = checks.reflectances_lanes(&material, &normal, used);
+            for k in 0..chunk.len() {
+                let (uv, _, _) = Sphere::uv_of_normal(normal.lane(k));
+                let (d, s) = material.reflectances_at(uv);
+                assert_eq!(kd.lane(k), d, "normal {}", normal.lane(k));
+                assert_eq!(ks.lane(k), s, "normal {}", normal.lane(k));
+                let UvTransform { scale, offset } = material.uv_transform;
+                let c = (uv * scale + offset) * 8.0;
+                let edge = |c: f32| (c - c.round()).abs() < 1e-4;
+                if edge(c.x) || edge(c.y) {
+                    near += 1;
+                } else {
+                    clear += 1;
+                }
+            }
+        }
+        assert!(
+            near > 200 && clear > 2000,
+            "{near} near an edge, {clear} clear"
+        );
     }
 }

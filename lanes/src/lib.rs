@@ -7,10 +7,12 @@
 //! the scalar kernel's bits and an image does not depend on the lane width.
 //! Masks of lanes are lanes of all-ones (true) or all-zeros (false) bits.
 
+mod approx;
 mod float;
 mod vector;
 mod width;
 
+pub use approx::{acos_approx, atan2_approx, ACOS_ERROR, ATAN2_ERROR};
 pub use float::{Float, Mask};
 pub use vector::Vector3;
 pub use width::*;

@@ -21,7 +21,7 @@ pub use aabox::AaBox;
 pub use mesh::{MeshError, TriangleMesh};
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
-pub use ray_lanes::SurfaceLanes;
+pub use ray_lanes::{SurfaceLanes, SPHERE_UV_APPROX_ERROR};
 pub use shape_packets::{ParallelogramPacket, SpherePacket};
 pub use sphere::Sphere;
 pub use triangle_packet::TrianglePacket;

@@ -9,7 +9,7 @@
 
 use super::{Parallelogram, Sphere};
 use crate::error_bounds::gamma;
-use crate::lanes::{self, F32Lanes, Mask, Vec3Lanes, LANES};
+use crate::lanes::{self, F32Lanes, Float, Mask, Vec3Lanes, LANES};
 use crate::RayLanes;
 use glam::{Vec2, Vec3};
 
@@ -104,6 +104,29 @@ impl Sphere {
             u: F32Lanes::new(u),
             v: F32Lanes::new(v),
         }
+    }
+}
+
+/// A bound on the error of [`Sphere::uv_of_normals_approx`] in u and in v:
+/// the polynomials' [`lanes::ATAN2_ERROR`] over 2π and [`lanes::ACOS_ERROR`]
+/// over π, with room for the rounding of the divisions.
+pub const SPHERE_UV_APPROX_ERROR: f32 = 1e-5;
+
+impl Sphere {
+    /// Each lane's texture coordinates as [`Sphere::uv_of_normal`] gives
+    /// them from its unit normal `n`, within [`SPHERE_UV_APPROX_ERROR`] in u
+    /// and in v, except across u's seam (a u near 0 may come out near 1, and
+    /// the other way), by polynomial `acos` and `atan2` in lanes. NaN at the
+    /// poles, where `atan2(0, 0)` has no value.
+    #[inline]
+    pub fn uv_of_normals_approx(n: &Vec3Lanes) -> (F32Lanes, F32Lanes) {
+        use std::f32::consts::{PI, TAU};
+        let y = n.y.max(F32Lanes::splat(-1.0)).min(F32Lanes::ONE);
+        let theta = lanes::acos_approx(y);
+        let phi = lanes::atan2_approx(-n.z, n.x);
+        let phi = F32Lanes::select(phi.lt(F32Lanes::ZERO), phi + F32Lanes::splat(TAU), phi);
+        let u = phi / F32Lanes::splat(TAU);
+        (u, F32Lanes::ONE - theta / F32Lanes::splat(PI))
     }
 }
 

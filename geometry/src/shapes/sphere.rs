@@ -148,7 +148,7 @@ impl Sphere {
     /// The uv of the point with unit normal `n`, with its polar angle θ (from
     /// +y) and azimuth φ (from +x towards −z, in [0, 2π)).
     #[inline]
-    pub(crate) fn uv_of_normal(n: Vec3) -> (Vec2, f32, f32) {
+    pub fn uv_of_normal(n: Vec3) -> (Vec2, f32, f32) {
         let theta = n.y.clamp(-1.0, 1.0).acos();
         let mut phi = (-n.z).atan2(n.x);
         if phi < 0.0 {

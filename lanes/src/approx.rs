@@ -1,0 +1,115 @@
+//! Polynomial `acos` and `atan2` over [`Float`], for lanes where libm would
+//! take one lane at a time.
+//!
+//! They round differently from libm, so they serve only where a result within
+//! [`ACOS_ERROR`] or [`ATAN2_ERROR`] decides the same thing as libm's: a
+//! caller compares against its decision boundaries with that margin and takes
+//! libm's value where it falls inside it.
+
+use crate::Float;
+use std::f32::consts::{FRAC_PI_2, PI};
+
+/// A bound on `|acos_approx(x) − acos(x)|` in radians over [−1, 1]: the
+/// polynomial's own 2·10⁻⁸ (Abramowitz and Stegun 4.4.46) plus the rounding
+/// of its f32 evaluation, with room (the tests measure under 10⁻⁶).
+pub const ACOS_ERROR: f32 = 4e-6;
+
+/// A bound on `|atan2_approx(y, x) − atan2(y, x)|` in radians for finite
+/// `(y, x) ≠ (0, 0)`: the polynomial's 10⁻⁵ (Abramowitz and Stegun 4.4.47)
+/// plus rounding, with room (the tests measure under 1.2·10⁻⁵).
+pub const ATAN2_ERROR: f32 = 4e-5;
+
+/// `acos(x)` for `x` in [−1, 1]: `√(1 − |x|)·P(|x|)`, reflected as
+/// `π − acos(|x|)` for negative `x` (Abramowitz and Stegun 4.4.46).
+#[inline(always)]
+pub fn acos_approx<F: Float>(x: F) -> F {
+    const A: [f32; 8] = [
+        FRAC_PI_2,
+        -0.214_598_8,
+        0.088_978_99,
+        -0.050_174_303,
+        0.030_891_88,
+        -0.017_088_126,
+        0.006_670_09,
+        -0.001_262_491_1,
+    ];
+    let a = x.abs().min(F::ONE);
+    let mut p = F::splat(A[7]);
+    for &c in A[..7].iter().rev() {
+        p = p * a + F::splat(c);
+    }
+    let r = (F::ONE - a).sqrt() * p;
+    F::select(x.lt(F::ZERO), F::splat(PI) - r, r)
+}
+
+/// `atan2(y, x)` in (−π, π]: `atan` of the smaller of `|x|, |y|` over the
+/// larger by an odd polynomial (Abramowitz and Stegun 4.4.47, on [0, 1]),
+/// then moved to its octant. NaN where both are 0.
+#[inline(always)]
+pub fn atan2_approx<F: Float>(y: F, x: F) -> F {
+    const A: [f32; 5] = [0.999_866, -0.330_299_5, 0.180_141, -0.085_133, 0.020_835_1];
+    let (ax, ay) = (x.abs(), y.abs());
+    let t = ax.min(ay) / ax.max(ay);
+    let t2 = t * t;
+    let mut p = F::splat(A[4]);
+    for &c in A[..4].iter().rev() {
+        p = p * t2 + F::splat(c);
+    }
+    let r = p * t;
+    let r = F::select(ay.gt(ax), F::splat(FRAC_PI_2) - r, r);
+    let r = F::select(x.lt(F::ZERO), F::splat(PI) - r, r);
+    F::select(y.lt(F::ZERO), -r, r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::F32Lanes;
+
+    #[test]
+    fn acos_is_within_its_bound_of_libm() {
+        let mut worst = 0.0f32;
+        for i in 0..=200_000 {
+            let x = -1.0 + 2.0 * i as f32 / 200_000.0;
+            worst = worst.max((acos_approx(x) - x.acos()).abs());
+        }
+        assert!(worst < 1e-6, "{worst}");
+        assert!(worst < ACOS_ERROR);
+    }
+
+    #[test]
+    fn atan2_is_within_its_bound_of_libm_in_every_octant() {
+        let mut worst = 0.0f32;
+        for i in 0..100_000 {
+            let a = -PI + 2.0 * PI * (i as f32 + 0.5) / 100_000.0;
+            for r in [1e-3f32, 0.7, 1.0, 250.0] {
+                let (y, x) = (r * a.sin(), r * a.cos());
+                worst = worst.max((atan2_approx(y, x) - y.atan2(x)).abs());
+            }
+        }
+        for (y, x) in [
+            (0.0f32, 1.0f32),
+            (1.0, 0.0),
+            (0.0, -1.0),
+            (-1.0, 0.0),
+            (1.0, 1.0),
+        ] {
+            worst = worst.max((atan2_approx(y, x) - y.atan2(x)).abs());
+        }
+        assert!(worst < 1.2e-5, "{worst}");
+        assert!(worst < ATAN2_ERROR);
+        assert!(atan2_approx(0.0f32, 0.0).is_nan());
+    }
+
+    #[test]
+    fn lanes_give_each_lanes_scalar_value() {
+        let x: [f32; crate::LANES] = std::array::from_fn(|k| -0.97 + 0.13 * k as f32);
+        let y: [f32; crate::LANES] = std::array::from_fn(|k| 0.31 - 0.07 * k as f32);
+        let acos = acos_approx(F32Lanes::new(x)).to_array();
+        let atan2 = atan2_approx(F32Lanes::new(y), F32Lanes::new(x)).to_array();
+        for k in 0..crate::LANES {
+            assert_eq!(acos[k].to_bits(), acos_approx(x[k]).to_bits());
+            assert_eq!(atan2[k].to_bits(), atan2_approx(y[k], x[k]).to_bits());
+        }
+    }
+}

@@ -274,7 +274,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         None => String::new(),
     };
     crate::output::say(&format!(
-        "wrote {}: {}x{}, {} spp, {} light samples{environment_samples}, {:.2} s wall ({:.2} s rendering), {} rays ({:.2} M rays/s)\n",
+        "wrote {}: {}x{}, {} spp, {} light samples{environment_samples}, {:.3} s wall ({:.3} s rendering), {} rays ({:.2} M rays/s)\n",
         output.display(),
         resolution.x,
         resolution.y,

@@ -39,7 +39,7 @@ PROG = "compare.py --equal-error"
 DEFAULT_SCENES = ["cornell-physical", "physical-environment", "analytic-area-light", "physical-textured-ground"]
 TARGETS = [1e-3, 1e-4]
 
-# Glint's summary line ends with `T s wall (T s rendering)`, printed to 10 ms; the
+# Glint's summary line ends with `T s wall (T s rendering)`, printed to 1 ms; the
 # --stats-json file has the same phase unrounded, which the cheap rungs need.
 RENDER_S = re.compile(r"\((?P<render>[0-9.]+) s rendering\)")
 

@@ -184,6 +184,54 @@ impl DirectIntegrator {
     }
 }
 
+/// Diffuse points in lanes (one point in every lane, or a point per lane):
+/// their positions, geometric normals and unit shading normals on the
+/// viewer's side, and diffuse reflectances.
+pub(crate) struct DiffusePoints<'a> {
+    pub(crate) point: &'a Vec3Lanes,
+    pub(crate) ng: &'a Vec3Lanes,
+    pub(crate) n: &'a Vec3Lanes,
+    pub(crate) kd: &'a Vec3Lanes,
+}
+
+impl DiffusePoints<'_> {
+    /// The light samples at `position` with solid-angle densities `pdf`, one
+    /// a lane, in the lanes `used`, short of their shadow rays: each lane's
+    /// `kd/π · cos θ / p` ([`ShadingPoint::light_sample_unshadowed`] at a
+    /// diffuse point, bit for bit) and the lanes that need a shadow ray,
+    /// the others counted as skipped.
+    #[inline(always)]
+    pub(crate) fn light_samples(
+        &self,
+        position: &Vec3Lanes,
+        pdf: F32Lanes,
+        used: u32,
+        counters: &mut ShadingCounters,
+    ) -> (Vec3Lanes, u32) {
+        let dense = used & lanes::bits(lanes::gt(pdf, F32Lanes::ZERO) & pdf.is_finite());
+        let (l, normalized) = (*position - *self.point).try_normalize();
+        let above = lanes::bits(normalized & lanes::gt(l.dot(self.ng), F32Lanes::ZERO));
+        // `brdf_cos_diffuse`: kd/π · n·l, zero where n·l ≤ 0.
+        let n_dot_l = l.dot(self.n);
+        let f = self
+            .kd
+            .scale(F32Lanes::splat(std::f32::consts::FRAC_1_PI))
+            .scale(n_dot_l);
+        let f = Vec3Lanes::select(
+            lanes::le(n_dot_l, F32Lanes::ZERO),
+            &Vec3Lanes::default(),
+            &f,
+        );
+        let reflects = dense & above & !lanes::bits(f.is_zero());
+        let skips = &mut counters.light_skips;
+        skips.zero_density += u64::from((used & !dense).count_ones());
+        skips.below_surface += u64::from((dense & !above).count_ones());
+        skips.zero_brdf += u64::from((dense & above & !reflects).count_ones());
+        counters.light_shadow_rays += u64::from(reflects.count_ones());
+        (f.scale(F32Lanes::ONE / pdf), reflects)
+    }
+}
+
 /// Veach's power heuristic (β = 2) for a sample drawn with density `a` where
 /// the other technique has density `b`: `a² / (a² + b²)`, written so that
 /// neither square overflows.
@@ -354,25 +402,13 @@ impl ShadingPoint<'_> {
             (positions[k], pdfs[k]) = (s.point, s.pdf);
         }
         let (position, pdf) = (Vec3Lanes::from_lanes(positions), F32Lanes::new(pdfs));
-        let used = chunk.used();
-        let dense = used & lanes::bits(lanes::gt(pdf, F32Lanes::ZERO) & pdf.is_finite());
-        let (l, normalized) = position.sub_splat(self.hit.point).try_normalize();
-        let above = lanes::bits(normalized & lanes::gt(l.dot_splat(self.ng), F32Lanes::ZERO));
-        // `brdf_cos_diffuse`: kd/π · n·l, zero where n·l ≤ 0.
-        let n_dot_l = l.dot_splat(self.n);
-        let f = Vec3Lanes::scaled_splat(self.kd * std::f32::consts::FRAC_1_PI, n_dot_l);
-        let f = Vec3Lanes::select(
-            lanes::le(n_dot_l, F32Lanes::ZERO),
-            &Vec3Lanes::default(),
-            &f,
-        );
-        let reflects = dense & above & !lanes::bits(f.is_zero());
-        let skips = &mut ctx.counters.light_skips;
-        skips.zero_density += u64::from((used & !dense).count_ones());
-        skips.below_surface += u64::from((dense & !above).count_ones());
-        skips.zero_brdf += u64::from((dense & above & !reflects).count_ones());
-        ctx.counters.light_shadow_rays += u64::from(reflects.count_ones());
-        let value = f.scale(F32Lanes::ONE / pdf);
+        let at = DiffusePoints {
+            point: &Vec3Lanes::splat(self.hit.point),
+            ng: &Vec3Lanes::splat(self.ng),
+            n: &Vec3Lanes::splat(self.n),
+            kd: &Vec3Lanes::splat(self.kd),
+        };
+        let (value, reflects) = at.light_samples(&position, pdf, chunk.used(), &mut ctx.counters);
         let values = std::array::from_fn(|k| value.lane(k));
         (position, values, reflects)
     }

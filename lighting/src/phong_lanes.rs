@@ -113,6 +113,16 @@ impl<'a> PhongLanes<'a> {
         self.specular
     }
 
+    /// Each lane's diffuse reflectance.
+    pub fn kd(&self) -> &Vec3Lanes {
+        &self.kd
+    }
+
+    /// Each lane's unit shading normal, on the viewer's side.
+    pub fn normals(&self) -> &Vec3Lanes {
+        &self.n
+    }
+
     /// Per lane, the fraction of a unit light from direction `l` reflected
     /// towards the lane's viewer: `kd · n·l + ks · lobe`, zero where `n·l ≤ 0`.
     #[inline]

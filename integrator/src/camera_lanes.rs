@@ -27,6 +27,7 @@
 
 use crate::direct::{PairAllocation, SampleContext, ShadingPoint, CULL_REACH};
 use crate::light_samples::{count_lanes, LightSampleLanes};
+use crate::physical::DiffusePoints;
 use crate::sampling::{
     DimensionPair, LaneSamples, Pcg32Lanes, SamplePattern, SamplePoints, SobolSequence,
 };
@@ -40,7 +41,8 @@ use glint_geometry::{
     Sphere, SurfaceLanes, SPHERE_UV_APPROX_ERROR,
 };
 use glint_lighting::{
-    AreaLight, Light, PhongLanes, PhongMaterial, PointLight, ShadingModel, UvTransform,
+    AreaLight, AreaLightSampler, Light, PhongLanes, PhongMaterial, PointLight, ShadingModel,
+    UvTransform,
 };
 use glint_texture::{Checkerboard, TexCoord, Texture};
 
@@ -50,14 +52,30 @@ impl DirectIntegrator {
     /// lights, no environment, materials without mirrors, and light points
     /// each sample can draw alone.
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
+        let lights = |admitted: fn(&Light) -> bool| scene.lights.iter().all(admitted);
         self.light_samples_in_lanes()
-            && scene.shading == ShadingModel::Phong
             && scene.environment.is_none()
-            && scene
-                .lights
-                .iter()
-                .all(|l| matches!(l, Light::Area(_) | Light::Point(_)))
             && scene.materials.iter().all(|m| m.reflectivity == 0.0)
+            && match scene.shading {
+                ShadingModel::Phong => lights(|l| matches!(l, Light::Area(_) | Light::Point(_))),
+                ShadingModel::Physical => {
+                    lights(|l| matches!(l, Light::Area(_))) && self.physical_in_lanes(scene)
+                }
+            }
+    }
+
+    /// Whether physical shading's first hits can take the lanes: diffuse
+    /// materials only (a zero specular color, so no lobe and no MIS), and
+    /// light points no random stream draws (a point behind a light draws
+    /// none, which would shift a stream's later draws).
+    fn physical_in_lanes(&self, scene: &Scene) -> bool {
+        let diffuse = |m: &PhongMaterial| {
+            m.specular.as_ref().and_then(Texture::as_constant) == Some(Vec3::ZERO)
+        };
+        matches!(
+            self.light_pattern,
+            SamplePattern::Sobol | SamplePattern::Grid
+        ) && scene.materials.iter().all(diffuse)
     }
 
     /// Whether each camera sample's light points can be drawn lane by lane, the
@@ -107,6 +125,7 @@ impl DirectIntegrator {
         )
         .then(|| Pcg32Lanes::new(samples.stream_seeds()));
         let mut pairs = PairAllocation::new(0);
+        let physical = scene.shading == ShadingModel::Physical;
         for (index, light) in scene.lights.iter().enumerate() {
             let term = match light {
                 Light::Area(area) => {
@@ -116,7 +135,11 @@ impl DirectIntegrator {
                     };
                     let pair = pairs.take(own, self.light_samples);
                     let points = (samples, pair, &mut rngs);
-                    self.area_light_term(scene, &shaded, (index, area), points, ctx)
+                    if physical {
+                        self.physical_area_light_term(scene, &shaded, (index, area), points, ctx)
+                    } else {
+                        self.area_light_term(scene, &shaded, (index, area), points, ctx)
+                    }
                 }
                 Light::Point(point) => {
                     ctx.counters.point_light_samples += u64::from(shaded.lanes.count_ones());
@@ -172,6 +195,83 @@ impl DirectIntegrator {
             ctx.light_points = grid;
         }
         Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(self.light_samples as f32)
+    }
+
+    /// `physical_area_light`'s `L · Σ (kd/π · cos θ / p · V) / n` for area
+    /// light `index` at every lane's diffuse point, each lane summing its own
+    /// `n` samples in order, drawn by its own point's sampler (by area or
+    /// solid angle, as `light.sampler` chooses for it) at the points of
+    /// `pair` for the lanes' camera samples. A lane behind the light takes no
+    /// sample: its term is +0, as `li_at` adds `Vec3::ZERO`.
+    fn physical_area_light_term<T: Tracer>(
+        &self,
+        scene: &Scene,
+        shaded: &ShadedLanes,
+        (index, area): (usize, &AreaLight),
+        (samples, pair, _): (&LaneSamples, DimensionPair, &mut Option<Pcg32Lanes>),
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let n = self.light_samples;
+        let center = area.surface().center();
+        let points: [Vec3; LANES] = lanes::array_from_fn(|k| shaded.point.lane(k));
+        let mut lit = 0u32;
+        let mut samplers: [Option<AreaLightSampler>; LANES] = std::array::from_fn(|_| None);
+        for k in lanes::each_set(shaded.lanes) {
+            if area.illuminates(center, points[k]) {
+                samplers[k] = Some(area.sampler(points[k], self.area_sampling));
+                lit |= 1 << k;
+            }
+        }
+        let counters = &mut ctx.counters;
+        counters.light_samples += u64::from(n) * u64::from(shaded.lanes.count_ones());
+        counters.light_skips.behind_light +=
+            u64::from(n) * u64::from((shaded.lanes & !lit).count_ones());
+        if lit == 0 {
+            return Vec3Lanes::default();
+        }
+        let grid = self.grid_points(pair, ctx);
+        let sequences = (self.light_pattern == SamplePattern::Sobol)
+            .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
+        let occluders = shaded.occluders(scene, index, area, ctx);
+        let at = DiffusePoints {
+            point: &shaded.point,
+            ng: &shaded.ng,
+            n: shaded.phong.normals(),
+            kd: shaded.phong.kd(),
+        };
+        let mut sum = Vec3Lanes::default();
+        for j in 0..n {
+            let (ux, uy) = match (&grid, &sequences) {
+                (Some(grid), _) => {
+                    let p = grid.get(j as usize);
+                    (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
+                }
+                (None, Some(sequences)) => sequences.points(j, n),
+                (None, None) => unreachable!("physical_in_lanes admits grid and Sobol points"),
+            };
+            let (ux, uy) = (ux.to_array(), uy.to_array());
+            let mut positions = points;
+            let mut pdfs = [0.0; LANES];
+            for k in lanes::each_set(lit) {
+                let s = samplers[k]
+                    .as_ref()
+                    .expect("a lit lane")
+                    .sample(Vec2::new(ux[k], uy[k]));
+                (positions[k], pdfs[k]) = (s.point, s.pdf);
+            }
+            let position = Vec3Lanes::from_lanes(positions);
+            let pdf = F32Lanes::new(pdfs);
+            let (values, traced) = at.light_samples(&position, pdf, lit, &mut ctx.counters);
+            let towards = position - shaded.point;
+            let ends = area.shadow_ends(&position);
+            let visible = traced & !shaded.blocked(scene, &occluders, &ends, &towards, traced);
+            let zero = Vec3Lanes::default();
+            sum = sum + Vec3Lanes::select(lanes::from_bits(visible), &values, &zero);
+        }
+        if let Some(grid) = grid {
+            ctx.light_points = grid;
+        }
+        Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(n as f32)
     }
 
     /// The grid pattern's points for `pair` (the same for every camera sample),
@@ -334,6 +434,8 @@ impl<'a> ShadedLanes<'a> {
                 }
             }
         }
+        // Lanes shaded on one object share one culling of occluders.
+        self.object = closest.common_object(self.lanes);
     }
 
     /// Puts `p`, of `material`, in lane `k`.
@@ -761,6 +863,101 @@ mod tests {
     /// Every camera sample of every pixel, in chunks of [`LANES`] (and of three
     /// and one, partly filled): the lanes give each sample's `li_at` radiance
     /// and the shading counts bit for bit, for every light pattern.
+    /// Every lane of [`DirectIntegrator::li_first_hits`] against `li_at` for
+    /// its sample alone, bit for bit, radiance and counts, over every pixel
+    /// of `scene` and several shapes of chunk; the samples compared, with
+    /// the counts added to `total` and the chunks' kinds to `common`.
+    fn compare_lanes_with_scalar(
+        scene: &Scene,
+        integrator: &DirectIntegrator,
+        footprints: bool,
+        total: &mut ShadingCounters,
+        common: &mut [usize; 3],
+    ) -> usize {
+        let (pattern, light_samples) = (integrator.light_pattern, integrator.light_samples);
+        let resolution = scene.camera.resolution();
+        let mut compared = 0;
+        // One context for every chunk, as a render's thread keeps it: the
+        // lanes' culling of occluders serves the chunks near it.
+        let mut lanes = SampleContext::new(light_samples, 4);
+        for pixel in 0..(resolution.x * resolution.y) as u64 {
+            let (x, y) = (pixel % resolution.x as u64, pixel / resolution.x as u64);
+            // One pixel's chunks (full, three lanes, one), then runs of
+            // several pixels' samples: four of four, sixteen of one, and
+            // three of four partly used.
+            for (chunk, used, per_pixel) in [
+                (0u64, LANES, LANES),
+                (1, 3, LANES),
+                (2, 1, LANES),
+                (0, LANES, 4),
+                (0, LANES, 1),
+                (1, 11, 4),
+            ] {
+                let cameras: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
+                    let n = LANES as f32;
+                    let jitter = ((k as f32 + 0.5) / n, ((k * 5 % LANES) as f32 + 0.5) / n);
+                    let raster = glam::Vec2::new(x as f32 + jitter.0, y as f32 + jitter.1);
+                    if footprints {
+                        crate::camera_ray(&scene.camera, raster, 0.25)
+                    } else {
+                        let c = scene.camera.generate_ray(raster.x, raster.y);
+                        let ray = Ray::new(c.origin, c.direction);
+                        (ray, RayDifferential::none(&ray))
+                    }
+                });
+                let rays = cameras.map(|(ray, _)| ray);
+                let diffs = cameras.map(|(_, diff)| diff);
+                let ray_lanes = RayLanes::new(rays);
+                let closest = scene
+                    .shapes
+                    .closest_lanes(&ray_lanes, used)
+                    .expect("spheres and parallelograms: hits in lanes");
+                let hit_lanes = closest.hits & ((1 << used) - 1);
+                match closest.common_object(hit_lanes) {
+                    Some(object) if scene.light_objects.contains(&object) => common[2] += 1,
+                    Some(_) => common[1] += 1,
+                    None => common[0] += 1,
+                }
+                let samples = LaneSamples {
+                    seed: 11,
+                    first: chunk * per_pixel as u64,
+                    per_pixel,
+                    pixels: std::array::from_fn(|run| pixel + 1000 * run as u64),
+                };
+                lanes.counters = ShadingCounters::default();
+                let values = integrator.li_first_hits(
+                    scene,
+                    &ray_lanes,
+                    footprints.then_some(&diffs),
+                    &closest,
+                    used,
+                    &samples,
+                    &mut lanes,
+                );
+                let mut scalar = SampleContext::new(light_samples, 4);
+                for (k, ray) in rays.iter().enumerate().take(used) {
+                    let sample = samples.lane(k);
+                    scalar.begin_sample(sample.seed, sample.pixel, sample.sample);
+                    let hit = scene.shapes.closest_hit(ray, f32::INFINITY);
+                    let expected = integrator.li_at(scene, ray, &diffs[k], hit, 0, &mut scalar);
+                    assert_eq!(
+                        values.lane(k).to_array().map(f32::to_bits),
+                        expected.to_array().map(f32::to_bits),
+                        "{pattern:?} × {light_samples}, pixel ({x}, {y}), {sample:?}: {} against {expected}",
+                        values.lane(k)
+                    );
+                    compared += 1;
+                }
+                assert_eq!(
+                    lanes.counters, scalar.counters,
+                    "{pattern:?} × {light_samples}, pixel ({x}, {y})"
+                );
+                *total += scalar.counters;
+            }
+        }
+        compared
+    }
+
     #[test]
     fn lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
         let mut total = ShadingCounters::default();
@@ -806,87 +1003,8 @@ mod tests {
                 mis: true,
             };
             assert!(integrator.shades_first_hits_in_lanes(&scene));
-            let resolution = scene.camera.resolution();
-            let mut compared = 0;
-            // One context for every chunk, as a render's thread keeps it: the
-            // lanes' culling of occluders serves the chunks near it.
-            let mut lanes = SampleContext::new(light_samples, 4);
-            for pixel in 0..(resolution.x * resolution.y) as u64 {
-                let (x, y) = (pixel % resolution.x as u64, pixel / resolution.x as u64);
-                // One pixel's chunks (full, three lanes, one), then runs of
-                // several pixels' samples: four of four, sixteen of one, and
-                // three of four partly used.
-                for (chunk, used, per_pixel) in [
-                    (0u64, LANES, LANES),
-                    (1, 3, LANES),
-                    (2, 1, LANES),
-                    (0, LANES, 4),
-                    (0, LANES, 1),
-                    (1, 11, 4),
-                ] {
-                    let cameras: [(Ray, RayDifferential); LANES] = std::array::from_fn(|k| {
-                        let n = LANES as f32;
-                        let jitter = ((k as f32 + 0.5) / n, ((k * 5 % LANES) as f32 + 0.5) / n);
-                        let raster = glam::Vec2::new(x as f32 + jitter.0, y as f32 + jitter.1);
-                        if footprints {
-                            crate::camera_ray(&scene.camera, raster, 0.25)
-                        } else {
-                            let c = scene.camera.generate_ray(raster.x, raster.y);
-                            let ray = Ray::new(c.origin, c.direction);
-                            (ray, RayDifferential::none(&ray))
-                        }
-                    });
-                    let rays = cameras.map(|(ray, _)| ray);
-                    let diffs = cameras.map(|(_, diff)| diff);
-                    let ray_lanes = RayLanes::new(rays);
-                    let closest = scene
-                        .shapes
-                        .closest_lanes(&ray_lanes, used)
-                        .expect("spheres and parallelograms: hits in lanes");
-                    let hit_lanes = closest.hits & ((1 << used) - 1);
-                    match closest.common_object(hit_lanes) {
-                        Some(object) if scene.light_objects.contains(&object) => common[2] += 1,
-                        Some(_) => common[1] += 1,
-                        None => common[0] += 1,
-                    }
-                    let samples = LaneSamples {
-                        seed: 11,
-                        first: chunk * per_pixel as u64,
-                        per_pixel,
-                        pixels: std::array::from_fn(|run| pixel + 1000 * run as u64),
-                    };
-                    lanes.counters = ShadingCounters::default();
-                    let values = integrator.li_first_hits(
-                        &scene,
-                        &ray_lanes,
-                        footprints.then_some(&diffs),
-                        &closest,
-                        used,
-                        &samples,
-                        &mut lanes,
-                    );
-                    let mut scalar = SampleContext::new(light_samples, 4);
-                    for (k, ray) in rays.iter().enumerate().take(used) {
-                        let sample = samples.lane(k);
-                        scalar.begin_sample(sample.seed, sample.pixel, sample.sample);
-                        let hit = scene.shapes.closest_hit(ray, f32::INFINITY);
-                        let expected =
-                            integrator.li_at(&scene, ray, &diffs[k], hit, 0, &mut scalar);
-                        assert_eq!(
-                            values.lane(k).to_array().map(f32::to_bits),
-                            expected.to_array().map(f32::to_bits),
-                            "{pattern:?} × {light_samples}, pixel ({x}, {y}), {sample:?}: {} against {expected}",
-                            values.lane(k)
-                        );
-                        compared += 1;
-                    }
-                    assert_eq!(
-                        lanes.counters, scalar.counters,
-                        "{pattern:?} × {light_samples}, pixel ({x}, {y})"
-                    );
-                    total += scalar.counters;
-                }
-            }
+            let compared =
+                compare_lanes_with_scalar(&scene, &integrator, footprints, &mut total, &mut common);
             assert_eq!(compared, 12 * 10 * (3 * LANES + 3 + 1 + 11));
         }
         // Both ways of gathering the points were taken, and lanes that all see a light.
@@ -943,6 +1061,75 @@ mod tests {
                 color: Vec3::ONE
             }
         ))));
+    }
+
+    /// The same under physical shading: the room's materials made diffuse
+    /// (no specular color), its area light sampled by area, by solid angle,
+    /// or as each point's distance decides, with Sobol and grid points.
+    #[test]
+    fn physical_lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
+        use glint_lighting::AreaSampling;
+        let (mut total, mut common) = (ShadingCounters::default(), [0; 3]);
+        for (pattern, light_samples, footprints, area_sampling) in [
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto),
+            (SamplePattern::Sobol, 5, false, AreaSampling::Auto),
+            (SamplePattern::Grid, 4, false, AreaSampling::Area),
+            (SamplePattern::Sobol, 4, true, AreaSampling::SolidAngle),
+        ] {
+            let mut scene = room();
+            scene.shading = ShadingModel::Physical;
+            for material in &mut scene.materials {
+                material.specular = Some(Texture::Constant(Vec3::ZERO));
+            }
+            if footprints {
+                scene.materials[0].diffuse = Texture::Checkerboard(Checkerboard {
+                    analytic: true,
+                    ..Checkerboard::new(Vec3::new(0.9, 0.2, 0.1), Vec3::new(0.1, 0.3, 0.8), 4)
+                });
+            }
+            let integrator = DirectIntegrator {
+                light_samples,
+                light_pattern: pattern,
+                environment_samples: 4,
+                environment_pattern: SamplePattern::Sobol,
+                max_depth: 4,
+                area_sampling,
+                mis: true,
+            };
+            assert!(integrator.shades_first_hits_in_lanes(&scene));
+            let compared =
+                compare_lanes_with_scalar(&scene, &integrator, footprints, &mut total, &mut common);
+            assert_eq!(compared, 12 * 10 * (3 * LANES + 3 + 1 + 11));
+        }
+        assert!(common.iter().all(|&n| n > 0), "{common:?}");
+        assert!(total.light_skips.behind_light > 0, "{total:?}");
+        assert!(total.light_skips.below_surface > 0, "{total:?}");
+        assert!(total.light_skips.zero_brdf > 0, "{total:?}");
+        assert!(total.light_shadow_rays > 0, "{total:?}");
+        assert!(total.footprints > 0, "{total:?}");
+        // A glossy material, or light points drawn from random streams, keep
+        // the one-by-one route.
+        let mut glossy = room();
+        glossy.shading = ShadingModel::Physical;
+        let sobol = DirectIntegrator {
+            light_samples: 4,
+            light_pattern: SamplePattern::Sobol,
+            environment_samples: 4,
+            environment_pattern: SamplePattern::Sobol,
+            max_depth: 4,
+            area_sampling: AreaSampling::Auto,
+            mis: true,
+        };
+        assert!(!sobol.shades_first_hits_in_lanes(&glossy));
+        for material in &mut glossy.materials {
+            material.specular = Some(Texture::Constant(Vec3::ZERO));
+        }
+        assert!(sobol.shades_first_hits_in_lanes(&glossy));
+        let random = DirectIntegrator {
+            light_pattern: SamplePattern::Random,
+            ..sobol
+        };
+        assert!(!random.shades_first_hits_in_lanes(&glossy));
     }
 
     /// Checks read from the normals in lanes are the scalar path's, bit for

@@ -41,8 +41,8 @@ use glint_geometry::{
     Sphere, SurfaceLanes, SPHERE_UV_APPROX_ERROR,
 };
 use glint_lighting::{
-    AreaLight, AreaLightSampler, Light, PhongLanes, PhongMaterial, PointLight, ShadingModel,
-    UvTransform,
+    AreaLight, AreaLightSampler, EnvironmentLight, Light, PhongLanes, PhongMaterial, PointLight,
+    ShadingModel, UvTransform,
 };
 use glint_texture::{Checkerboard, TexCoord, Texture};
 
@@ -54,10 +54,12 @@ impl DirectIntegrator {
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
         let lights = |admitted: fn(&Light) -> bool| scene.lights.iter().all(admitted);
         self.light_samples_in_lanes()
-            && scene.environment.is_none()
             && scene.materials.iter().all(|m| m.reflectivity == 0.0)
             && match scene.shading {
-                ShadingModel::Phong => lights(|l| matches!(l, Light::Area(_) | Light::Point(_))),
+                ShadingModel::Phong => {
+                    scene.environment.is_none()
+                        && lights(|l| matches!(l, Light::Area(_) | Light::Point(_)))
+                }
                 ShadingModel::Physical => {
                     lights(|l| matches!(l, Light::Area(_))) && self.physical_in_lanes(scene)
                 }
@@ -72,10 +74,19 @@ impl DirectIntegrator {
         let diffuse = |m: &PhongMaterial| {
             m.specular.as_ref().and_then(Texture::as_constant) == Some(Vec3::ZERO)
         };
+        let environment = match &scene.environment {
+            None => true,
+            // Drawn from the map at Sobol points, which no stream draws.
+            Some(env) => {
+                self.environment_samples == 0
+                    || (env.is_sampled_by_map() && self.environment_pattern == SamplePattern::Sobol)
+            }
+        };
         matches!(
             self.light_pattern,
             SamplePattern::Sobol | SamplePattern::Grid
         ) && scene.materials.iter().all(diffuse)
+            && environment
     }
 
     /// Whether each camera sample's light points can be drawn lane by lane, the
@@ -109,6 +120,13 @@ impl DirectIntegrator {
         if !shaded.set_common(scene, rays, closest, hit_lanes, &mut radiance, ctx) {
             let hits = (rays, diffs, closest);
             shaded.set_one_by_one(scene, hits, hit_lanes, &mut radiance, ctx);
+        }
+        if let Some(env) = &scene.environment {
+            // `environment_seen` under physical shading: the map unfiltered.
+            for k in lanes::each_set(((1 << used) - 1) & !closest.hits) {
+                ctx.counters.environment_lookups += 1;
+                radiance.set_lane(k, env.radiance(rays.lane(k).direction.normalize(), 0.0));
+            }
         }
         if shaded.lanes == 0 {
             return radiance;
@@ -152,9 +170,77 @@ impl DirectIntegrator {
             };
             radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
         }
-        // `li_at` adds the absent environment and mirror terms, zeros: a −0
-        // component becomes +0 there, so it must here too.
+        if let Some(env) = scene
+            .environment
+            .as_ref()
+            .filter(|_| self.environment_samples > 0)
+        {
+            let term = self.environment_term_lanes(scene, env, &shaded, samples, ctx);
+            radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
+        }
+        // `li_at` adds the absent mirror term, a zero: a −0 component becomes
+        // +0 there, so it must here too.
         Vec3Lanes::select(shaded_mask, &(radiance + Vec3Lanes::default()), &radiance)
+    }
+
+    /// `environment_light` at every lane's diffuse point: each lane's `n`
+    /// samples of the map drawn together across the lanes
+    /// ([`EnvironmentLight::sample_each`]) at its camera sample's points, then
+    /// `L · kd/π · cos θ / p` and the shadow rays in lanes, each lane summing
+    /// its own samples in order, bit for bit `add_environment_samples`.
+    fn environment_term_lanes<T: Tracer>(
+        &self,
+        scene: &Scene,
+        env: &EnvironmentLight,
+        shaded: &ShadedLanes,
+        samples: &LaneSamples,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let n = self.environment_samples;
+        let count = u64::from(shaded.lanes.count_ones());
+        ctx.counters.environment_samples += u64::from(n) * count;
+        let pair = self.environment_pair_at_first_hit(scene);
+        let sequences = RunSequences::new(samples, shaded.lanes, pair, n, ctx);
+        let len = (u32::BITS - shaded.lanes.leading_zeros()) as usize;
+        let kd_over_pi = shaded
+            .phong
+            .kd()
+            .scale(F32Lanes::splat(std::f32::consts::FRAC_1_PI));
+        let mut sum = Vec3Lanes::default();
+        for j in 0..n {
+            let (ux, uy) = sequences.points(j, n);
+            let (ux, uy) = (ux.to_array(), uy.to_array());
+            let points: [Vec2; LANES] = lanes::array_from_fn(|k| Vec2::new(ux[k], uy[k]));
+            let drawn = env.sample_each(Vec3::Y, &points, len);
+            let direction = Vec3Lanes::from_lanes(lanes::array_from_fn(|k| drawn[k].direction));
+            let radiance = Vec3Lanes::from_lanes(lanes::array_from_fn(|k| drawn[k].radiance));
+            let pdf = F32Lanes::new(lanes::array_from_fn(|k| drawn[k].pdf));
+            let dense = shaded.lanes
+                & lanes::bits(lanes::gt(pdf, F32Lanes::ZERO))
+                & !lanes::bits(radiance.is_zero());
+            let above = lanes::bits(lanes::gt(direction.dot(&shaded.ng), F32Lanes::ZERO));
+            // `brdf_cos_diffuse`: kd/π · n·l, zero where n·l ≤ 0.
+            let n_dot_l = shaded.phong.normals().dot(&direction);
+            let f = kd_over_pi.scale(n_dot_l);
+            let zero = Vec3Lanes::default();
+            let f = Vec3Lanes::select(lanes::le(n_dot_l, F32Lanes::ZERO), &zero, &f);
+            let traced = dense & above & !lanes::bits(f.is_zero());
+            let skips = &mut ctx.counters.environment_skips;
+            skips.zero_density += u64::from((shaded.lanes & !dense).count_ones());
+            skips.below_surface += u64::from((dense & !above).count_ones());
+            skips.zero_brdf += u64::from((dense & above & !traced).count_ones());
+            ctx.counters.environment_shadow_rays += u64::from(traced.count_ones());
+            let lit = Vec3Lanes::new(radiance.x * f.x, radiance.y * f.y, radiance.z * f.z);
+            let value = Vec3Lanes::new(lit.x / pdf, lit.y / pdf, lit.z / pdf);
+            let from_back = lanes::lt(direction.dot(&shaded.geometric_normal), F32Lanes::ZERO);
+            let origin = Vec3Lanes::select(from_back, &shaded.origins.back, &shaded.origins.front);
+            let rays = RayLanes { origin, direction };
+            let blocked =
+                (scene.shapes).any_hits_among(&Occluders::ALL, &rays, f32::INFINITY, traced);
+            let visible = lanes::from_bits(traced & !blocked);
+            sum = sum + Vec3Lanes::select(visible, &value, &zero);
+        }
+        sum.div_splat(n as f32)
     }
 
     /// `li_at`'s `L · (0 + Σ reflected) / n` for area light `index`, each lane
@@ -879,7 +965,7 @@ mod tests {
         let mut compared = 0;
         // One context for every chunk, as a render's thread keeps it: the
         // lanes' culling of occluders serves the chunks near it.
-        let mut lanes = SampleContext::new(light_samples, 4);
+        let mut lanes = SampleContext::new(light_samples, integrator.environment_samples);
         for pixel in 0..(resolution.x * resolution.y) as u64 {
             let (x, y) = (pixel % resolution.x as u64, pixel / resolution.x as u64);
             // One pixel's chunks (full, three lanes, one), then runs of
@@ -934,7 +1020,7 @@ mod tests {
                     &samples,
                     &mut lanes,
                 );
-                let mut scalar = SampleContext::new(light_samples, 4);
+                let mut scalar = SampleContext::new(light_samples, integrator.environment_samples);
                 for (k, ray) in rays.iter().enumerate().take(used) {
                     let sample = samples.lane(k);
                     scalar.begin_sample(sample.seed, sample.pixel, sample.sample);
@@ -1070,14 +1156,29 @@ mod tests {
     fn physical_lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
         use glint_lighting::AreaSampling;
         let (mut total, mut common) = (ShadingCounters::default(), [0; 3]);
-        for (pattern, light_samples, footprints, area_sampling) in [
-            (SamplePattern::Sobol, 1, false, AreaSampling::Auto),
-            (SamplePattern::Sobol, 5, false, AreaSampling::Auto),
-            (SamplePattern::Grid, 4, false, AreaSampling::Area),
-            (SamplePattern::Sobol, 4, true, AreaSampling::SolidAngle),
+        // A lat-long map with a bright patch, sampled by luminance.
+        let sky = || {
+            let image = glint_texture::Image::from_fn(32, 16, |x, y| {
+                let bright = (10..14).contains(&x) && (3..6).contains(&y);
+                Vec3::new(0.2 + 0.01 * x as f32, 0.3, 0.4) * if bright { 40.0 } else { 1.0 }
+            });
+            let map = glint_texture::Environment::LatLong(glint_texture::LatLongMap::new(image));
+            glint_lighting::EnvironmentLight::new(map, 0.3, 1.5)
+        };
+        for (pattern, light_samples, footprints, area_sampling, environment_samples) in [
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 0),
+            (SamplePattern::Sobol, 5, false, AreaSampling::Auto, 0),
+            (SamplePattern::Grid, 4, false, AreaSampling::Area, 0),
+            (SamplePattern::Sobol, 4, true, AreaSampling::SolidAngle, 0),
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 1),
+            (SamplePattern::Sobol, 4, true, AreaSampling::Auto, 3),
+            (SamplePattern::Grid, 1, false, AreaSampling::Area, 17),
         ] {
             let mut scene = room();
             scene.shading = ShadingModel::Physical;
+            if environment_samples > 0 {
+                scene.environment = Some(sky());
+            }
             for material in &mut scene.materials {
                 material.specular = Some(Texture::Constant(Vec3::ZERO));
             }
@@ -1090,7 +1191,7 @@ mod tests {
             let integrator = DirectIntegrator {
                 light_samples,
                 light_pattern: pattern,
-                environment_samples: 4,
+                environment_samples,
                 environment_pattern: SamplePattern::Sobol,
                 max_depth: 4,
                 area_sampling,
@@ -1101,6 +1202,9 @@ mod tests {
                 compare_lanes_with_scalar(&scene, &integrator, footprints, &mut total, &mut common);
             assert_eq!(compared, 12 * 10 * (3 * LANES + 3 + 1 + 11));
         }
+        assert!(total.environment_shadow_rays > 0, "{total:?}");
+        assert!(total.environment_lookups > 0, "{total:?}");
+        assert!(total.environment_skips.below_surface > 0, "{total:?}");
         assert!(common.iter().all(|&n| n > 0), "{common:?}");
         assert!(total.light_skips.behind_light > 0, "{total:?}");
         assert!(total.light_skips.below_surface > 0, "{total:?}");

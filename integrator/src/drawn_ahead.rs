@@ -73,7 +73,7 @@ impl DirectIntegrator {
 
     /// The dimension pair of the environment's samples at a first hit: the
     /// one `shade_with` gives it after the lights that sample take theirs.
-    fn environment_pair_at_first_hit(&self, scene: &Scene) -> DimensionPair {
+    pub(crate) fn environment_pair_at_first_hit(&self, scene: &Scene) -> DimensionPair {
         let mut pairs = PairAllocation::new(0);
         for (index, light) in scene.lights.iter().enumerate() {
             let samples = match light {

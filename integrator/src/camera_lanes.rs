@@ -15,9 +15,16 @@
 //! this is the wavefront form of the same sums.
 //!
 //! This is only done where a scene needs nothing else at a first hit
-//! ([`DirectIntegrator::shades_first_hits_in_lanes`]): the course's model,
-//! area and point lights, no environment, no mirrors, and light points that
-//! each sample can draw alone (not a stratified pattern of several). Textures
+//! ([`DirectIntegrator::shades_first_hits_in_lanes`]): no mirrors, light
+//! points that each sample can draw alone (not a stratified pattern of
+//! several), and either the course's model with area and point lights and no
+//! environment, or physical shading of diffuse materials under area lights
+//! and an environment map. Physical shading draws each lane's light samples
+//! with its own point's sampler (by area or solid angle) and takes them
+//! through the diffuse kernel a point's light samples share
+//! ([`crate::physical::DiffusePoints`]); its environment samples are drawn
+//! together across the lanes ([`glint_lighting::EnvironmentLight::sample_each`]),
+//! and the lanes that miss read the map. Textures
 //! filtered over a footprint are looked up lane by lane, from each lane's ray
 //! differentials. Every lane
 //! repeats the scalar path's operations in its order, and its random numbers

@@ -956,6 +956,14 @@ mod tests {
     /// Every camera sample of every pixel, in chunks of [`LANES`] (and of three
     /// and one, partly filled): the lanes give each sample's `li_at` radiance
     /// and the shading counts bit for bit, for every light pattern.
+    /// The room's checkered material filtered over each ray's footprint.
+    fn checks_over_footprints(scene: &mut Scene) {
+        scene.materials[0].diffuse = Texture::Checkerboard(Checkerboard {
+            analytic: true,
+            ..Checkerboard::new(Vec3::new(0.9, 0.2, 0.1), Vec3::new(0.1, 0.3, 0.8), 4)
+        });
+    }
+
     /// Every lane of [`DirectIntegrator::li_first_hits`] against `li_at` for
     /// its sample alone, bit for bit, radiance and counts, over every pixel
     /// of `scene` and several shapes of chunk; the samples compared, with
@@ -1080,11 +1088,7 @@ mod tests {
                 scene.lights.push(point(Vec3::new(2.5, 0.0, -1.0)));
             }
             if footprints {
-                // A checkerboard filtered over each ray's footprint.
-                scene.materials[0].diffuse = Texture::Checkerboard(Checkerboard {
-                    analytic: true,
-                    ..Checkerboard::new(Vec3::new(0.9, 0.2, 0.1), Vec3::new(0.1, 0.3, 0.8), 4)
-                });
+                checks_over_footprints(&mut scene);
             }
             let integrator = DirectIntegrator {
                 light_samples,
@@ -1190,10 +1194,7 @@ mod tests {
                 material.specular = Some(Texture::Constant(Vec3::ZERO));
             }
             if footprints {
-                scene.materials[0].diffuse = Texture::Checkerboard(Checkerboard {
-                    analytic: true,
-                    ..Checkerboard::new(Vec3::new(0.9, 0.2, 0.1), Vec3::new(0.1, 0.3, 0.8), 4)
-                });
+                checks_over_footprints(&mut scene);
             }
             let integrator = DirectIntegrator {
                 light_samples,

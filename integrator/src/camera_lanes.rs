@@ -15,11 +15,11 @@
 //! this is the wavefront form of the same sums.
 //!
 //! This is only done where a scene needs nothing else at a first hit
-//! ([`DirectIntegrator::shades_first_hits_in_lanes`]): no mirrors, light
-//! points that each sample can draw alone (not a stratified pattern of
-//! several), and either the course's model with area and point lights and no
-//! environment, or physical shading of diffuse materials under area lights
-//! and an environment map. Physical shading draws each lane's light samples
+//! ([`DirectIntegrator::shades_first_hits_in_lanes`]): light points that each
+//! sample can draw alone (not a stratified pattern of several), and either
+//! the course's model with area and point lights, no environment and no
+//! mirrors, or physical shading of diffuse materials under area lights and an
+//! environment map, whose lanes on a mirror are each traced alone by `li_at`. Physical shading draws each lane's light samples
 //! with its own point's sampler (by area or solid angle) and takes them
 //! through the diffuse kernel a point's light samples share
 //! ([`crate::physical::DiffusePoints`]); its environment samples are drawn
@@ -61,10 +61,10 @@ impl DirectIntegrator {
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
         let lights = |admitted: fn(&Light) -> bool| scene.lights.iter().all(admitted);
         self.light_samples_in_lanes()
-            && scene.materials.iter().all(|m| m.reflectivity == 0.0)
             && match scene.shading {
                 ShadingModel::Phong => {
                     scene.environment.is_none()
+                        && scene.materials.iter().all(|m| m.reflectivity == 0.0)
                         && lights(|l| matches!(l, Light::Area(_) | Light::Point(_)))
                 }
                 ShadingModel::Physical => {
@@ -78,8 +78,10 @@ impl DirectIntegrator {
     /// light points no random stream draws (a point behind a light draws
     /// none, which would shift a stream's later draws).
     fn physical_in_lanes(&self, scene: &Scene) -> bool {
+        // A mirror's lanes are traced one by one (`mirrored_alone`).
         let diffuse = |m: &PhongMaterial| {
-            m.specular.as_ref().and_then(Texture::as_constant) == Some(Vec3::ZERO)
+            m.reflectivity > 0.0
+                || m.specular.as_ref().and_then(Texture::as_constant) == Some(Vec3::ZERO)
         };
         let environment = match &scene.environment {
             None => true,
@@ -124,6 +126,9 @@ impl DirectIntegrator {
         let mut radiance = Vec3Lanes::default();
         let mut shaded = ShadedLanes::default();
         let hit_lanes = closest.hits & ((1 << used) - 1);
+        let hits = (rays, diffs, closest);
+        let hit_lanes =
+            hit_lanes & !self.mirrored_alone(scene, hits, hit_lanes, samples, &mut radiance, ctx);
         if !shaded.set_common(scene, rays, closest, hit_lanes, &mut radiance, ctx) {
             let hits = (rays, diffs, closest);
             shaded.set_one_by_one(scene, hits, hit_lanes, &mut radiance, ctx);
@@ -188,6 +193,43 @@ impl DirectIntegrator {
         // `li_at` adds the absent mirror term, a zero: a −0 component becomes
         // +0 there, so it must here too.
         Vec3Lanes::select(shaded_mask, &(radiance + Vec3Lanes::default()), &radiance)
+    }
+
+    /// The lanes of `hit_lanes` on a mirror (physical shading only), each
+    /// traced alone by `li_at` for its camera sample, its radiance put in
+    /// `radiance`: the next wave of lanes it starts is not in lanes yet.
+    fn mirrored_alone<T: Tracer>(
+        &self,
+        scene: &Scene,
+        (rays, diffs, closest): (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
+        hit_lanes: u32,
+        samples: &LaneSamples,
+        radiance: &mut Vec3Lanes,
+        ctx: &mut SampleContext<T>,
+    ) -> u32 {
+        if scene.shading == ShadingModel::Phong {
+            return 0;
+        }
+        let mut mirrored = 0;
+        for k in lanes::each_set(hit_lanes) {
+            let mirror = match scene.surface_of_primitive(closest.object[k], 0) {
+                SurfaceKind::Material(material) => material.reflectivity > 0.0,
+                SurfaceKind::Emitter(_) => false,
+            };
+            if !mirror {
+                continue;
+            }
+            let sample = samples.lane(k);
+            ctx.begin_sample(sample.seed, sample.pixel, sample.sample);
+            let ray = rays.lane(k);
+            let diff = diffs.map_or_else(|| RayDifferential::none(&ray), |d| d[k]);
+            let hit = closest
+                .hit(k)
+                .and_then(|found| scene.shapes.surface_record(&ray, found));
+            radiance.set_lane(k, self.li_at(scene, &ray, &diff, hit, 0, ctx));
+            mirrored |= 1 << k;
+        }
+        mirrored
     }
 
     /// `environment_light` at every lane's diffuse point: each lane's `n`
@@ -1176,14 +1218,23 @@ mod tests {
             let map = glint_texture::Environment::LatLong(glint_texture::LatLongMap::new(image));
             glint_lighting::EnvironmentLight::new(map, 0.3, 1.5)
         };
-        for (pattern, light_samples, footprints, area_sampling, environment_samples) in [
-            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 0),
-            (SamplePattern::Sobol, 5, false, AreaSampling::Auto, 0),
-            (SamplePattern::Grid, 4, false, AreaSampling::Area, 0),
-            (SamplePattern::Sobol, 4, true, AreaSampling::SolidAngle, 0),
-            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 1),
-            (SamplePattern::Sobol, 4, true, AreaSampling::Auto, 3),
-            (SamplePattern::Grid, 1, false, AreaSampling::Area, 17),
+        for (pattern, light_samples, footprints, area_sampling, environment_samples, mirrors) in [
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 0, false),
+            (SamplePattern::Sobol, 5, false, AreaSampling::Auto, 0, false),
+            (SamplePattern::Grid, 4, false, AreaSampling::Area, 0, false),
+            (
+                SamplePattern::Sobol,
+                4,
+                true,
+                AreaSampling::SolidAngle,
+                0,
+                false,
+            ),
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 1, false),
+            (SamplePattern::Sobol, 4, true, AreaSampling::Auto, 3, false),
+            (SamplePattern::Grid, 1, false, AreaSampling::Area, 17, false),
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 4, true),
+            (SamplePattern::Sobol, 4, true, AreaSampling::Auto, 1, true),
         ] {
             let mut scene = room();
             scene.shading = ShadingModel::Physical;
@@ -1192,6 +1243,11 @@ mod tests {
             }
             for material in &mut scene.materials {
                 material.specular = Some(Texture::Constant(Vec3::ZERO));
+            }
+            if mirrors {
+                // A mirror, traced alone, and a half mirror, with local shading.
+                scene.materials[2].reflectivity = 1.0;
+                scene.materials[3].reflectivity = 0.5;
             }
             if footprints {
                 checks_over_footprints(&mut scene);
@@ -1212,6 +1268,7 @@ mod tests {
         }
         assert!(total.environment_shadow_rays > 0, "{total:?}");
         assert!(total.environment_lookups > 0, "{total:?}");
+        assert!(total.reflection_rays > 0, "{total:?}");
         assert!(total.environment_skips.below_surface > 0, "{total:?}");
         assert!(common.iter().all(|&n| n > 0), "{common:?}");
         assert!(total.light_skips.behind_light > 0, "{total:?}");

@@ -55,9 +55,10 @@ use glint_texture::{Checkerboard, TexCoord, Texture};
 
 impl DirectIntegrator {
     /// Whether the first hits of `scene`'s camera samples can be shaded [`LANES`] at
-    /// a time (`li_first_hits`): the course's shading model, area and point
-    /// lights, no environment, materials without mirrors, and light points
-    /// each sample can draw alone.
+    /// a time (`li_first_hits`): light points each sample can draw alone, and
+    /// either the course's shading model with area and point lights, no
+    /// environment and no mirrors, or physical shading as
+    /// [`Self::physical_in_lanes`] admits it.
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
         let lights = |admitted: fn(&Light) -> bool| scene.lights.iter().all(admitted);
         self.light_samples_in_lanes()
@@ -73,12 +74,13 @@ impl DirectIntegrator {
             }
     }
 
-    /// Whether physical shading's first hits can take the lanes: diffuse
-    /// materials only (a zero specular color, so no lobe and no MIS), and
-    /// light points no random stream draws (a point behind a light draws
-    /// none, which would shift a stream's later draws).
+    /// Whether physical shading's first hits can take the lanes: materials
+    /// that are diffuse (a zero specular color, so no lobe and no MIS) or
+    /// mirrors (whose lanes are traced alone, `mirrored_alone`), an
+    /// environment map sampled at Sobol points or none, and light points no
+    /// random stream draws (a point behind a light draws none, which would
+    /// shift a stream's later draws).
     fn physical_in_lanes(&self, scene: &Scene) -> bool {
-        // A mirror's lanes are traced one by one (`mirrored_alone`).
         let diffuse = |m: &PhongMaterial| {
             m.reflectivity > 0.0
                 || m.specular.as_ref().and_then(Texture::as_constant) == Some(Vec3::ZERO)
@@ -130,7 +132,6 @@ impl DirectIntegrator {
         let hit_lanes =
             hit_lanes & !self.mirrored_alone(scene, hits, hit_lanes, samples, &mut radiance, ctx);
         if !shaded.set_common(scene, rays, closest, hit_lanes, &mut radiance, ctx) {
-            let hits = (rays, diffs, closest);
             shaded.set_one_by_one(scene, hits, hit_lanes, &mut radiance, ctx);
         }
         if let Some(env) = &scene.environment {
@@ -207,7 +208,8 @@ impl DirectIntegrator {
         radiance: &mut Vec3Lanes,
         ctx: &mut SampleContext<T>,
     ) -> u32 {
-        if scene.shading == ShadingModel::Phong {
+        let reflects = |m: &PhongMaterial| m.reflectivity > 0.0;
+        if scene.shading == ShadingModel::Phong || !scene.materials.iter().any(reflects) {
             return 0;
         }
         let mut mirrored = 0;
@@ -281,8 +283,7 @@ impl DirectIntegrator {
             ctx.counters.environment_shadow_rays += u64::from(traced.count_ones());
             let lit = Vec3Lanes::new(radiance.x * f.x, radiance.y * f.y, radiance.z * f.z);
             let value = Vec3Lanes::new(lit.x / pdf, lit.y / pdf, lit.z / pdf);
-            let from_back = lanes::lt(direction.dot(&shaded.geometric_normal), F32Lanes::ZERO);
-            let origin = Vec3Lanes::select(from_back, &shaded.origins.back, &shaded.origins.front);
+            let origin = shaded.origins_towards(&direction);
             let rays = RayLanes { origin, direction };
             let blocked =
                 (scene.shapes).any_hits_among(&Occluders::ALL, &rays, f32::INFINITY, traced);
@@ -772,13 +773,21 @@ impl<'a> ShadedLanes<'a> {
         towards: &Vec3Lanes,
         traced: u32,
     ) -> u32 {
-        let from_back = lanes::lt(towards.dot(&self.geometric_normal), F32Lanes::ZERO);
-        let origin = Vec3Lanes::select(from_back, &self.origins.back, &self.origins.front);
+        let origin = self.origins_towards(towards);
         let rays = RayLanes {
             origin,
             direction: *end - origin,
         };
         scene.shapes.any_hits_among(occluders, &rays, 1.0, traced)
+    }
+
+    /// Each lane's shadow-ray origin: its point offset to the side of its
+    /// surface that `towards` leaves on, as `spawn_ray` and `spawn_ray_to`
+    /// choose it.
+    #[inline]
+    fn origins_towards(&self, towards: &Vec3Lanes) -> Vec3Lanes {
+        let from_back = lanes::lt(towards.dot(&self.geometric_normal), F32Lanes::ZERO);
+        Vec3Lanes::select(from_back, &self.origins.back, &self.origins.front)
     }
 }
 

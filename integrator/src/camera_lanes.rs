@@ -126,14 +126,10 @@ impl DirectIntegrator {
     ) -> Vec3Lanes {
         debug_assert!(self.shades_first_hits_in_lanes(scene));
         let mut radiance = Vec3Lanes::default();
-        let mut shaded = ShadedLanes::default();
         let hit_lanes = closest.hits & ((1 << used) - 1);
         let hits = (rays, diffs, closest);
         let hit_lanes =
             hit_lanes & !self.mirrored_alone(scene, hits, hit_lanes, samples, &mut radiance, ctx);
-        if !shaded.set_common(scene, rays, closest, hit_lanes, &mut radiance, ctx) {
-            shaded.set_one_by_one(scene, hits, hit_lanes, &mut radiance, ctx);
-        }
         if let Some(env) = &scene.environment {
             // `environment_seen` under physical shading: the map unfiltered.
             for k in lanes::each_set(((1 << used) - 1) & !closest.hits) {
@@ -141,11 +137,25 @@ impl DirectIntegrator {
                 radiance.set_lane(k, env.radiance(rays.lane(k).direction.normalize(), 0.0));
             }
         }
+        // Each arm builds the lanes in place: made over a default, or moved
+        // out of an `Option`, their kilobytes cost a zeroing or a copy a chunk.
+        let shaded = match FirstHits::of(scene, closest, hit_lanes) {
+            FirstHits::OnOneObject(object, shape, material) => {
+                let on = (object, shape, material);
+                ShadedLanes::on_one_object(scene, rays, closest, hit_lanes, on, &mut radiance, ctx)
+            }
+            FirstHits::OnOneEmitter(area) => {
+                let color = Vec3Lanes::splat(area.color);
+                return Vec3Lanes::select(lanes::from_bits(hit_lanes), &color, &radiance);
+            }
+            FirstHits::Several => {
+                ShadedLanes::one_by_one(scene, hits, hit_lanes, &mut radiance, ctx)
+            }
+        };
         if shaded.lanes == 0 {
             return radiance;
         }
         let shaded_mask = lanes::from_bits(shaded.lanes);
-        shaded.origins = ShadowOrigins::of(&shaded);
         // Each lane's own stream, as `SampleContext::begin_sample` makes it. The
         // random pattern draws a point as two uniforms; so does the stratified
         // one for a single point (its one cell is the whole square, and
@@ -485,8 +495,38 @@ impl RunSequences {
     }
 }
 
+/// What a chunk's hit lanes landed on, as far as shading them together goes.
+enum FirstHits<'a> {
+    /// All on one sphere or parallelogram (its object index) of a material
+    /// whose textures need no footprint.
+    OnOneObject(u32, &'a Shape, &'a PhongMaterial),
+    /// All on one emitter: an area light's colour, or nothing.
+    OnOneEmitter(&'a AreaLight),
+    /// On several objects, other shapes, a footprint's material, or none.
+    Several,
+}
+
+impl<'a> FirstHits<'a> {
+    fn of(scene: &'a Scene, closest: &ClosestLanes, hit_lanes: u32) -> Self {
+        let Some(object) = closest.common_object(hit_lanes) else {
+            return Self::Several;
+        };
+        let shape = match scene.shapes.object(object) {
+            ObjectRef::Shape(shape @ (Shape::Sphere(_) | Shape::Parallelogram(_))) => shape,
+            _ => return Self::Several,
+        };
+        match scene.surface_of_primitive(object, 0) {
+            // Its footprints need each lane's surface record: one by one.
+            SurfaceKind::Material(material) if material.uses_footprint() => Self::Several,
+            SurfaceKind::Material(material) => Self::OnOneObject(object, shape, material),
+            SurfaceKind::Emitter(Light::Area(area)) => Self::OnOneEmitter(area),
+            SurfaceKind::Emitter(_) => Self::Several,
+        }
+    }
+}
+
 /// The shading points of up to [`LANES`] lanes: all at once where the lanes hit
-/// one shape ([`ShadedLanes::set_common`]), else one by one ([`ShadedLanes::set`]).
+/// one shape ([`ShadedLanes::on_one_object`]), else one by one ([`ShadedLanes::set`]).
 #[derive(Default)]
 struct ShadedLanes<'a> {
     /// The lanes holding a point (bit k for lane k).
@@ -513,8 +553,8 @@ struct ShadowOrigins {
 }
 
 impl ShadowOrigins {
-    fn of(shaded: &ShadedLanes) -> Self {
-        let (point, error, g) = (&shaded.point, &shaded.error, &shaded.geometric_normal);
+    #[inline]
+    fn of(point: &Vec3Lanes, error: &Vec3Lanes, g: &Vec3Lanes) -> Self {
         Self {
             front: offset_ray_origins(point, error, g),
             back: offset_ray_origins(point, error, &-*g),
@@ -523,6 +563,21 @@ impl ShadowOrigins {
 }
 
 impl<'a> ShadedLanes<'a> {
+    /// The shading points of the lanes `hit_lanes`, set one by one
+    /// ([`Self::set_one_by_one`]), with their shadow rays' origins.
+    fn one_by_one<T: Tracer>(
+        scene: &'a Scene,
+        hits: (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
+        hit_lanes: u32,
+        radiance: &mut Vec3Lanes,
+        ctx: &mut SampleContext<T>,
+    ) -> Self {
+        let mut shaded = Self::default();
+        shaded.set_one_by_one(scene, hits, hit_lanes, radiance, ctx);
+        shaded.origins = ShadowOrigins::of(&shaded.point, &shaded.error, &shaded.geometric_normal);
+        shaded
+    }
+
     /// The lanes of `hit_lanes` set one by one: each lane's surface point,
     /// its emitted light or ambient term in `radiance`, and its shading point.
     /// A material that filters its textures over a footprint is looked up
@@ -585,53 +640,33 @@ impl<'a> ShadedLanes<'a> {
         self.ng.set_lane(k, p.ng);
     }
 
-    /// Where every lane of `hit_lanes` hits the same sphere or parallelogram
-    /// (most of a pixel's samples), sets them all at once and returns true:
-    /// each lane what [`Self::set`] gives it from its [`ShadingPoint`], and
-    /// `radiance` its ambient or emitted part. Returns false, setting nothing,
-    /// for lanes on several objects (or none) or on other shapes.
-    fn set_common<T: Tracer>(
-        &mut self,
+    /// The shading points of the lanes `hit_lanes`, all on `object`, a sphere
+    /// or parallelogram of `material` (most of a pixel's samples), made all at
+    /// once: each lane what [`Self::set`] gives it from its [`ShadingPoint`],
+    /// and `radiance` its ambient part.
+    fn on_one_object<T: Tracer>(
         scene: &'a Scene,
         rays: &RayLanes,
         closest: &ClosestLanes,
         hit_lanes: u32,
+        (object, shape, material): (u32, &Shape, &'a PhongMaterial),
         radiance: &mut Vec3Lanes,
         ctx: &mut SampleContext<T>,
-    ) -> bool {
-        let Some(object) = closest.common_object(hit_lanes) else {
-            return false;
-        };
-        let kind = scene.surface_of_primitive(object, 0);
-        let shape = scene.shapes.object(object);
+    ) -> Self {
         // A sphere's texture coordinates cost an `acos` and an `atan2` a lane:
         // only where the material reads them, and not for checks.
-        let checks = match (&kind, shape) {
-            (SurfaceKind::Material(m), ObjectRef::Shape(Shape::Sphere(_))) if !ctx.detailed => {
-                SphereChecks::of(m)
-            }
+        let checks = match shape {
+            Shape::Sphere(_) if !ctx.detailed => SphereChecks::of(material),
             _ => None,
         };
-        let uv_lanes = match kind {
-            SurfaceKind::Material(material) if material.reads_uv() && checks.is_none() => hit_lanes,
-            _ => 0,
+        let uv_lanes = match material.reads_uv() && checks.is_none() {
+            true => hit_lanes,
+            false => 0,
         };
         let surface = match shape {
-            ObjectRef::Shape(Shape::Sphere(s)) => s.surface_points_lanes(rays, closest.t, uv_lanes),
-            ObjectRef::Shape(Shape::Parallelogram(p)) => p.surface_points_lanes(rays, closest.t),
-            _ => return false,
-        };
-        let material = match kind {
-            // Its footprints need each lane's surface record: one by one.
-            SurfaceKind::Material(material) if material.uses_footprint() => return false,
-            SurfaceKind::Material(material) => material,
-            SurfaceKind::Emitter(light) => {
-                if let Light::Area(area) = light {
-                    let color = Vec3Lanes::splat(area.color);
-                    *radiance = Vec3Lanes::select(lanes::from_bits(hit_lanes), &color, radiance);
-                }
-                return true;
-            }
+            Shape::Sphere(s) => s.surface_points_lanes(rays, closest.t, uv_lanes),
+            Shape::Parallelogram(p) => p.surface_points_lanes(rays, closest.t),
+            _ => unreachable!("FirstHits::of admits spheres and parallelograms"),
         };
         let (kd, ks) = match &checks {
             Some(checks) => checks.reflectances_lanes(material, &surface.normal, hit_lanes),
@@ -645,17 +680,18 @@ impl<'a> ShadedLanes<'a> {
         let ng = Vec3Lanes::select(lanes::lt(g.dot(&n), F32Lanes::ZERO), &-*g, g);
         let v = -d.normalize();
         let specular = hit_lanes & !lanes::bits(ks.is_zero());
-        self.phong
-            .set_lanes(hit_lanes, material, &kd, &ks, &n, &v, specular);
         let ambient = Vec3Lanes::scaled_splat_lanes(scene.ambient, &kd);
         *radiance = Vec3Lanes::select(lanes::from_bits(hit_lanes), &ambient, radiance);
-        self.lanes = hit_lanes;
-        self.object = Some(object);
-        self.point = surface.point;
-        self.error = surface.error;
-        self.geometric_normal = surface.normal;
-        self.ng = ng;
-        true
+        Self {
+            lanes: hit_lanes,
+            origins: ShadowOrigins::of(&surface.point, &surface.error, &surface.normal),
+            point: surface.point,
+            error: surface.error,
+            geometric_normal: surface.normal,
+            ng,
+            phong: PhongLanes::of_lanes(hit_lanes, material, &kd, &ks, &n, &v, specular),
+            object: Some(object),
+        }
     }
 
     /// The shapes that may block the lanes' shadow rays to area light `index`,

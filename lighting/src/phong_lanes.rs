@@ -58,12 +58,12 @@ impl<'a> PhongLanes<'a> {
         self.set_material(1 << lane, material, if specular { 1 << lane } else { 0 });
     }
 
-    /// Sets the lanes `lanes` (bit k for lane k) to points of one `material`,
+    /// The lanes `lanes` (bit k for lane k) set to points of one `material`,
     /// with the reflectances, normals and viewer directions of [`Self::set`] in
-    /// lanes; `specular` holds the lanes whose specular term is evaluated.
+    /// lanes, the others unset; `specular` holds the lanes whose specular term
+    /// is evaluated. Each lane is what [`Self::set`] gives it.
     #[allow(clippy::too_many_arguments)]
-    pub fn set_lanes(
-        &mut self,
+    pub fn of_lanes(
         lanes: u32,
         material: &'a PhongMaterial,
         kd: &Vec3Lanes,
@@ -71,31 +71,34 @@ impl<'a> PhongLanes<'a> {
         n: &Vec3Lanes,
         v: &Vec3Lanes,
         specular: u32,
-    ) {
-        let mask = lanes::from_bits(lanes);
-        self.kd = Vec3Lanes::select(mask, kd, &self.kd);
-        self.ks = Vec3Lanes::select(mask, ks, &self.ks);
-        self.n = Vec3Lanes::select(mask, n, &self.n);
-        self.v = Vec3Lanes::select(mask, v, &self.v);
-        self.set_material(lanes, material, specular & lanes);
+    ) -> Self {
+        let (mask, unset) = (lanes::from_bits(lanes), Vec3Lanes::default());
+        let exponent = lane_exponent(material);
+        let with_exponent = if exponent.is_some() { lanes } else { 0 };
+        let exponent = exponent.unwrap_or(0);
+        Self {
+            materials: std::array::from_fn(|k| (lanes >> k & 1 == 1).then_some(material)),
+            kd: Vec3Lanes::select(mask, kd, &unset),
+            ks: Vec3Lanes::select(mask, ks, &unset),
+            n: Vec3Lanes::select(mask, n, &unset),
+            v: Vec3Lanes::select(mask, v, &unset),
+            specular: specular & lanes,
+            lane_lobes: with_exponent,
+            exponent_bits: std::array::from_fn(|b| if exponent >> b & 1 == 1 { lanes } else { 0 }),
+            exponent_top: exponent,
+        }
     }
 
     /// Gives the lanes `lanes` `material`, with specular terms in `specular`.
     fn set_material(&mut self, lanes: u32, material: &'a PhongMaterial, specular: u32) {
         self.specular = (self.specular & !lanes) | specular;
-        let in_lanes = material.lobe == SpecularLobe::Phong
-            && material.integral_exponent()
-            && material.shininess >= 0.0;
-        self.lane_lobes = (self.lane_lobes & !lanes) | if in_lanes { lanes } else { 0 };
-        let exponent = if in_lanes {
-            material.shininess as u32
-        } else {
-            0
-        };
+        let exponent = lane_exponent(material);
+        let with_exponent = if exponent.is_some() { lanes } else { 0 };
+        self.lane_lobes = (self.lane_lobes & !lanes) | with_exponent;
         for k in lanes::each_set(lanes) {
             self.materials[k] = Some(material);
         }
-        self.set_exponent(lanes, exponent);
+        self.set_exponent(lanes, exponent.unwrap_or(0));
     }
 
     /// Gives the lanes `lanes` the lobe exponent `exponent`.
@@ -166,6 +169,15 @@ impl<'a> PhongLanes<'a> {
         }
         result
     }
+}
+
+/// The exponent of `material`'s lobe where it is taken in lanes: a Phong lobe
+/// with a non-negative integral exponent (else the lane is taken alone).
+fn lane_exponent(material: &PhongMaterial) -> Option<u32> {
+    let in_lanes = material.lobe == SpecularLobe::Phong
+        && material.integral_exponent()
+        && material.shininess >= 0.0;
+    in_lanes.then_some(material.shininess as u32)
 }
 
 #[cfg(test)]
@@ -254,26 +266,23 @@ mod tests {
 
     /// Lanes set together with one material reflect what lanes set one by one do.
     #[test]
-    fn lanes_set_together_are_lanes_set_one_by_one() {
+    fn lanes_made_together_are_lanes_set_one_by_one() {
         let unit = |a: f32| Vec3::new(a.sin(), a.cos(), 0.3 * a).normalize();
         let shiny = PhongMaterial::new(Vec3::new(0.7, 0.5, 0.2), 22.0);
-        let other = PhongMaterial::new(Vec3::ONE, 3.0);
         let kd: [Vec3; LANES] = std::array::from_fn(|k| Vec3::new(0.1 * k as f32, 0.5, 0.9));
         let ks: [Vec3; LANES] = std::array::from_fn(|k| Vec3::splat(0.05 * k as f32));
         let n: [Vec3; LANES] = std::array::from_fn(|k| unit(0.1 * k as f32));
         let v: [Vec3; LANES] = std::array::from_fn(|k| unit(0.2 - 0.05 * k as f32));
         let (lanes, specular) = (0b1011_0110, 0b0011_0100);
-        let mut together = PhongLanes::default();
-        together.set(0, &other, Vec3::ONE, Vec3::ONE, Vec3::Y, Vec3::Y, true);
         let x = |a: [Vec3; LANES]| Vec3Lanes::from_lanes(a);
-        together.set_lanes(lanes, &shiny, &x(kd), &x(ks), &x(n), &x(v), specular | 1);
+        let together =
+            PhongLanes::of_lanes(lanes, &shiny, &x(kd), &x(ks), &x(n), &x(v), specular | 1);
         let mut one_by_one = PhongLanes::default();
-        one_by_one.set(0, &other, Vec3::ONE, Vec3::ONE, Vec3::Y, Vec3::Y, true);
         for k in lanes::each_set(lanes) {
             one_by_one.set(k, &shiny, kd[k], ks[k], n[k], v[k], specular >> k & 1 == 1);
         }
         assert_eq!(together.specular_lanes(), one_by_one.specular_lanes());
-        assert_eq!(together.specular_lanes(), 0b0011_0101);
+        assert_eq!(together.specular_lanes(), 0b0011_0100);
         let l = x(std::array::from_fn(|k| unit(0.15 * k as f32 + 0.02)));
         let (a, b) = (together.reflect(&l), one_by_one.reflect(&l));
         for k in 0..LANES {

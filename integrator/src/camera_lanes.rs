@@ -132,10 +132,10 @@ impl DirectIntegrator {
             hit_lanes & !self.mirrored_alone(scene, hits, hit_lanes, samples, &mut radiance, ctx);
         if let Some(env) = &scene.environment {
             // `environment_seen` under physical shading: the map unfiltered.
-            for k in lanes::each_set(((1 << used) - 1) & !closest.hits) {
-                ctx.counters.environment_lookups += 1;
-                radiance.set_lane(k, env.radiance(rays.lane(k).direction.normalize(), 0.0));
-            }
+            let misses = ((1 << used) - 1) & !closest.hits;
+            ctx.counters.environment_lookups += u64::from(misses.count_ones());
+            let seen = env.radiance_each(&rays.direction.normalize(), misses);
+            radiance = Vec3Lanes::select(lanes::from_bits(misses), &seen, &radiance);
         }
         // Each arm builds the lanes in place: made over a default, or moved
         // out of an `Option`, their kilobytes cost a zeroing or a copy a chunk.

@@ -1,9 +1,10 @@
 use crate::distribution::PiecewiseConstant2D;
 use glam::{Vec2, Vec3};
+use glint_geometry::lanes::{self, Float, Vec3Lanes};
 use glint_geometry::prefetch;
 use glint_texture::{
-    cube_direction, cube_face_st, latlong_direction_and_sin_theta, latlong_texel, latlong_uv,
-    CubeMap, Environment,
+    cube_direction, cube_face_st, latlong_coordinates, latlong_direction_and_sin_theta,
+    latlong_texel, latlong_uv, CubeMap, Environment,
 };
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -79,6 +80,27 @@ impl EnvironmentLight {
     #[inline]
     pub fn radiance(&self, d: Vec3, width: f32) -> Vec3 {
         self.scale * self.environment.radiance(self.to_map(d), width)
+    }
+
+    /// [`Self::radiance`] with no width (the map unfiltered) along the unit
+    /// directions `d` of lanes `lanes` (bit k for lane k; the others zero),
+    /// each lane's bits the scalar one's: a lat-long map's coordinates in
+    /// lanes, its texels lane by lane.
+    pub fn radiance_each(&self, d: &Vec3Lanes, lanes: u32) -> Vec3Lanes {
+        let mut out = Vec3Lanes::default();
+        let Environment::LatLong(map) = &self.environment else {
+            for k in lanes::each_set(lanes) {
+                out.set_lane(k, self.radiance(d.lane(k), 0.0));
+            }
+            return out;
+        };
+        let [x, y, z] = rotate_y_of([d.x, d.y, d.z], -self.rotation);
+        let (u, v) = latlong_coordinates(x, y, z);
+        let (u, v) = (u.to_array(), v.to_array());
+        for k in lanes::each_set(lanes) {
+            out.set_lane(k, self.scale * map.bilinear(Vec2::new(u[k], v[k])));
+        }
+        out
     }
 
     /// Whether samples are drawn from the map (by luminance), not about a
@@ -215,11 +237,19 @@ impl EnvironmentLight {
 
 /// `d` turned by `angle` radians about +y (counter-clockwise seen from above).
 fn rotate_y(d: Vec3, angle: f32) -> Vec3 {
+    let [x, y, z] = rotate_y_of([d.x, d.y, d.z], angle);
+    Vec3::new(x, y, z)
+}
+
+/// [`rotate_y`] of `(x, y, z)`, in one lane or in many.
+#[inline(always)]
+fn rotate_y_of<F: Float>([x, y, z]: [F; 3], angle: f32) -> [F; 3] {
     if angle == 0.0 {
-        return d;
+        return [x, y, z];
     }
     let (s, c) = angle.sin_cos();
-    Vec3::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z)
+    let (s, c, minus_s) = (F::splat(s), F::splat(c), F::splat(-s));
+    [c * x + s * z, y, minus_s * x + c * z]
 }
 
 /// The six faces side by side in [0, 1]²: face `f` covers `u ∈ [f/6, (f+1)/6)`.

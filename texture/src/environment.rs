@@ -14,6 +14,7 @@
 
 use crate::{Image, TextureImage, WrapMode};
 use glam::{Vec2, Vec3};
+use glint_lanes::{acos_approx, atan2_approx, Float};
 use std::f32::consts::{PI, TAU};
 use std::sync::Arc;
 
@@ -66,9 +67,21 @@ pub fn cube_direction(face: CubeFace, st: Vec2) -> Vec3 {
 /// Lat-long coordinates `(u, v)` ∈ [0, 1]² of a unit direction.
 #[inline]
 pub fn latlong_uv(d: Vec3) -> Vec2 {
-    let u = 0.5 + d.x.atan2(-d.z) / TAU;
-    let v = d.y.clamp(-1.0, 1.0).acos() / PI;
-    Vec2::new(u.rem_euclid(1.0), v)
+    let (u, v) = latlong_coordinates(d.x, d.y, d.z);
+    Vec2::new(u, v)
+}
+
+/// [`latlong_uv`] of unit direction `(x, y, z)`, in one lane or in many, the
+/// same bits in each: `u = ½ + atan2(x, −z)/2π` (1 wrapping to 0) and
+/// `v = acos(y)/π`, the angles by polynomials within a few units in the last
+/// place of libm's ([`atan2_approx`], [`acos_approx`]), which would take the
+/// lanes one at a time.
+#[inline(always)]
+pub fn latlong_coordinates<F: Float>(x: F, y: F, z: F) -> (F, F) {
+    let u = F::splat(0.5) + atan2_approx(x, -z) / F::splat(TAU);
+    let u = F::select(u.ge(F::ONE), u - F::ONE, u);
+    let v = acos_approx(y.max(F::splat(-1.0)).min(F::ONE)) / F::splat(PI);
+    (u, v)
 }
 
 /// The unit direction at lat-long coordinates `(u, v)`; inverse of [`latlong_uv`].

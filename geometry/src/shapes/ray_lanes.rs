@@ -116,15 +116,17 @@ impl Sphere {
     /// Each lane's texture coordinates as [`Sphere::uv_of_normal`] gives
     /// them from its unit normal `n`, within [`SPHERE_UV_APPROX_ERROR`] in u
     /// and in v, except across u's seam (a u near 0 may come out near 1, and
-    /// the other way), by polynomial `acos` and `atan2` in lanes. NaN at the
-    /// poles, where `atan2(0, 0)` has no value.
+    /// the other way), by polynomial `acos` and `atan2` in lanes. u is NaN at
+    /// the poles, where libm's `atan2(±0, ±0)` depends on the zeros' signs.
     #[inline]
     pub fn uv_of_normals_approx(n: &Vec3Lanes) -> (F32Lanes, F32Lanes) {
         use std::f32::consts::{PI, TAU};
         let y = n.y.max(F32Lanes::splat(-1.0)).min(F32Lanes::ONE);
         let theta = lanes::acos_approx(y);
+        let pole = Float::eq(n.x, F32Lanes::ZERO) & Float::eq(n.z, F32Lanes::ZERO);
         let phi = lanes::atan2_approx(-n.z, n.x);
         let phi = F32Lanes::select(phi.lt(F32Lanes::ZERO), phi + F32Lanes::splat(TAU), phi);
+        let phi = F32Lanes::select(pole, F32Lanes::splat(f32::NAN), phi);
         let u = phi / F32Lanes::splat(TAU);
         (u, F32Lanes::ONE - theta / F32Lanes::splat(PI))
     }

@@ -365,6 +365,7 @@ fn neighbourhood_max(lum: impl Fn(i64, i64) -> f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glint_geometry::lanes::LANES;
     use glint_texture::{CubeMap, Image, LatLongMap};
 
     fn hot_spot_latlong() -> Environment {
@@ -531,6 +532,39 @@ mod tests {
         for d in directions {
             let p = 4.0 * PI * light.pdf(Vec3::Y, d);
             assert!((0.99..1.01).contains(&p), "{d}: 4π·pdf = {p}");
+        }
+    }
+
+    /// Every lane of `radiance_each` is `radiance` with no width, bit for bit,
+    /// rotated or not, at the poles and the seam too; unasked lanes are zero.
+    #[test]
+    fn radiance_in_lanes_is_each_lanes_radiance() {
+        let directions: [Vec3; LANES] = std::array::from_fn(|k| match k {
+            0 => Vec3::Y,
+            1 => -Vec3::Y,
+            2 => Vec3::Z,
+            3 => Vec3::new(-1e-7, 0.2, 1.0).normalize(),
+            _ => {
+                let a = 0.83 * k as f32;
+                Vec3::new(a.sin(), (0.37 * k as f32).cos(), -a.cos()).normalize()
+            }
+        });
+        let d = Vec3Lanes::from_lanes(directions);
+        let asked = !(1u32 << 6) & ((1 << LANES) - 1);
+        for (rotation, env) in [(0.0, hot_spot_latlong()), (0.7, hot_spot_latlong())] {
+            let light = EnvironmentLight::new(env, rotation, 2.0);
+            let each = light.radiance_each(&d, asked);
+            for (k, &direction) in directions.iter().enumerate() {
+                let want = match asked >> k & 1 {
+                    1 => light.radiance(direction, 0.0),
+                    _ => Vec3::ZERO,
+                };
+                assert_eq!(
+                    each.lane(k).to_array().map(f32::to_bits),
+                    want.to_array().map(f32::to_bits),
+                    "rotation {rotation}, lane {k}"
+                );
+            }
         }
     }
 

@@ -44,8 +44,8 @@ use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, LANES};
 use glint_geometry::{
-    offset_ray_origins, ClosestLanes, ObjectRef, Occluders, RayDifferential, RayLanes, Shape,
-    Sphere, SurfaceLanes, SPHERE_UV_APPROX_ERROR,
+    offset_ray_origins, reflect, spawn_ray, ClosestLanes, ObjectRef, Occluders, RayDifferential,
+    RayLanes, Shape, Sphere, SurfaceLanes, SPHERE_UV_APPROX_ERROR,
 };
 use glint_lighting::{
     AreaLight, AreaLightSampler, EnvironmentLight, Light, PhongLanes, PhongMaterial, PointLight,
@@ -76,7 +76,7 @@ impl DirectIntegrator {
 
     /// Whether physical shading's first hits can take the lanes: materials
     /// that are diffuse (a zero specular color, so no lobe and no MIS) or
-    /// mirrors (whose lanes are traced alone, `mirrored_alone`), an
+    /// mirrors (reflected as a next wave, or traced alone: `mirrored`), an
     /// environment map sampled at Sobol points or none, and light points no
     /// random stream draws (a point behind a light draws none, which would
     /// shift a stream's later draws).
@@ -129,7 +129,7 @@ impl DirectIntegrator {
         let hit_lanes = closest.hits & ((1 << used) - 1);
         let hits = (rays, diffs, closest);
         let hit_lanes =
-            hit_lanes & !self.mirrored_alone(scene, hits, hit_lanes, samples, &mut radiance, ctx);
+            hit_lanes & !self.mirrored(scene, hits, hit_lanes, samples, &mut radiance, ctx);
         if let Some(env) = &scene.environment {
             // `environment_seen` under physical shading: the map unfiltered.
             let misses = ((1 << used) - 1) & !closest.hits;
@@ -206,13 +206,14 @@ impl DirectIntegrator {
         Vec3Lanes::select(shaded_mask, &(radiance + Vec3Lanes::default()), &radiance)
     }
 
-    /// The lanes of `hit_lanes` on a mirror (physical shading only), each
-    /// traced alone by `li_at` for its camera sample, its radiance put in
-    /// `radiance`: the next wave of lanes it starts is not in lanes yet.
-    fn mirrored_alone<T: Tracer>(
+    /// The lanes of `hit_lanes` on a mirror (physical shading only), their
+    /// radiance put in `radiance`: a perfect mirror's reflected rays as the
+    /// next wave of lanes ([`Self::mirror_wave`]), any other mirror's lanes
+    /// each traced alone by `li_at` for its camera sample.
+    fn mirrored<T: Tracer>(
         &self,
         scene: &Scene,
-        (rays, diffs, closest): (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
+        hits: (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
         hit_lanes: u32,
         samples: &LaneSamples,
         radiance: &mut Vec3Lanes,
@@ -222,15 +223,94 @@ impl DirectIntegrator {
         if scene.shading == ShadingModel::Phong || !scene.materials.iter().any(reflects) {
             return 0;
         }
-        let mut mirrored = 0;
+        let (mut perfect, mut partial) = (0, 0);
         for k in lanes::each_set(hit_lanes) {
-            let mirror = match scene.surface_of_primitive(closest.object[k], 0) {
-                SurfaceKind::Material(material) => material.reflectivity > 0.0,
-                SurfaceKind::Emitter(_) => false,
+            if let SurfaceKind::Material(m) = scene.surface_of_primitive(hits.2.object[k], 0) {
+                match m.reflectivity {
+                    1.0 if self.max_depth > 0 => perfect |= 1 << k,
+                    r if r > 0.0 => partial |= 1 << k,
+                    _ => {}
+                }
+            }
+        }
+        let alone = partial | self.mirror_wave(scene, hits, perfect, radiance, ctx);
+        self.traced_alone(scene, hits, alone, samples, radiance, ctx);
+        perfect | partial
+    }
+
+    /// The lanes `wave`, on perfect mirrors (no local shading), reflected as
+    /// `li_at` reflects them, their rays gathered into the first lanes of a
+    /// wave and their closest hits found together. Where a reflected ray
+    /// leaves the scene, its lane's radiance is the mirror's tint times the
+    /// map (unfiltered, as physical shading reads it), in `li_at`'s
+    /// operations; the lanes whose rays meet a surface are returned, to be
+    /// traced alone.
+    fn mirror_wave<T: Tracer>(
+        &self,
+        scene: &Scene,
+        (rays, _, closest): (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
+        wave: u32,
+        radiance: &mut Vec3Lanes,
+        ctx: &mut SampleContext<T>,
+    ) -> u32 {
+        if wave == 0 {
+            return 0;
+        }
+        let (mut origins, mut directions) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+        let (mut from, mut used, mut alone) = ([0; LANES], 0, 0);
+        for k in lanes::each_set(wave) {
+            let ray = rays.lane(k);
+            let found = closest.hit(k).expect("a hit lane");
+            let Some(hit) = scene.shapes.surface_point(&ray, found) else {
+                alone |= 1 << k;
+                continue;
             };
-            if !mirror {
+            // `reflect_differential`'s direction, and `spawn_ray`'s origin.
+            let wi = reflect(-ray.direction.normalize(), hit.facing_normal(ray.direction));
+            let reflected = spawn_ray(&hit, wi);
+            (origins[used], directions[used]) = (reflected.origin, reflected.direction);
+            from[used] = k;
+            used += 1;
+        }
+        let reflected = RayLanes {
+            origin: Vec3Lanes::from_lanes(origins),
+            direction: Vec3Lanes::from_lanes(directions),
+        };
+        let Some(next) = scene.shapes.closest_lanes(&reflected, used) else {
+            return wave;
+        };
+        let leaving = ((1u32 << used) - 1) & !next.hits;
+        let seen = (scene.environment.as_ref())
+            .map(|env| env.radiance_each(&reflected.direction.normalize(), leaving));
+        for (j, &k) in from.iter().enumerate().take(used) {
+            if leaving >> j & 1 == 0 {
+                alone |= 1 << k;
                 continue;
             }
+            ctx.counters.reflection_rays += 1;
+            ctx.counters.environment_lookups += u64::from(seen.is_some());
+            let material = match scene.surface_of_primitive(closest.object[k], 0) {
+                SurfaceKind::Material(material) => material,
+                SurfaceKind::Emitter(_) => unreachable!("a mirror's lane"),
+            };
+            let environment = seen.as_ref().map_or(Vec3::ZERO, |seen| seen.lane(j));
+            let (r, mirror) = (material.reflectivity, material.mirror_tint * environment);
+            radiance.set_lane(k, (1.0 - r) * Vec3::ZERO + r * mirror);
+        }
+        alone
+    }
+
+    /// The lanes `alone`, each traced by `li_at` for its camera sample.
+    fn traced_alone<T: Tracer>(
+        &self,
+        scene: &Scene,
+        (rays, diffs, closest): (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
+        alone: u32,
+        samples: &LaneSamples,
+        radiance: &mut Vec3Lanes,
+        ctx: &mut SampleContext<T>,
+    ) {
+        for k in lanes::each_set(alone) {
             let sample = samples.lane(k);
             ctx.begin_sample(sample.seed, sample.pixel, sample.sample);
             let ray = rays.lane(k);
@@ -239,9 +319,7 @@ impl DirectIntegrator {
                 .hit(k)
                 .and_then(|found| scene.shapes.surface_record(&ray, found));
             radiance.set_lane(k, self.li_at(scene, &ray, &diff, hit, 0, ctx));
-            mirrored |= 1 << k;
         }
-        mirrored
     }
 
     /// `environment_light` at every lane's diffuse point: each lane's `n`
@@ -1290,7 +1368,8 @@ mod tests {
                 material.specular = Some(Texture::Constant(Vec3::ZERO));
             }
             if mirrors {
-                // A mirror, traced alone, and a half mirror, with local shading.
+                // A mirror, reflected as a next wave of lanes, and a half
+                // mirror, with local shading, traced alone.
                 scene.materials[2].reflectivity = 1.0;
                 scene.materials[3].reflectivity = 0.5;
             }

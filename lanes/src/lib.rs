@@ -12,7 +12,7 @@ mod float;
 mod vector;
 mod width;
 
-pub use approx::{acos_approx, atan2_approx, ACOS_ERROR, ATAN2_ERROR};
+pub use approx::{acos_approx, atan2_approx, sin_cos_approx, ACOS_ERROR, ATAN2_ERROR};
 pub use float::{Float, Mask};
 pub use vector::Vector3;
 pub use width::*;

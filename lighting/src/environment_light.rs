@@ -1,10 +1,10 @@
 use crate::distribution::PiecewiseConstant2D;
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{self, Float, Vec3Lanes};
+use glint_geometry::lanes::{self, Float, Vec3Lanes, LANES};
 use glint_geometry::prefetch;
 use glint_texture::{
-    cube_direction, cube_face_st, latlong_coordinates, latlong_direction_and_sin_theta,
-    latlong_texel, latlong_uv, CubeMap, Environment,
+    cube_direction, cube_face_st, latlong_coordinates, latlong_direction_of, latlong_texel,
+    latlong_uv, CubeMap, Environment,
 };
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -171,11 +171,34 @@ impl EnvironmentLight {
         for k in 0..len {
             out[k].radiance = self.radiance_at(uv[k].0);
         }
-        for k in 0..len {
-            let (map_dir, pdf) = self.map_direction(uv[k].0, uv[k].1);
-            (out[k].direction, out[k].pdf) = (self.to_world(map_dir), pdf);
+        match &self.environment {
+            Environment::LatLong(_) => self.latlong_directions(&uv[..len], &mut out[..len]),
+            _ => {
+                for k in 0..len {
+                    let (map_dir, pdf) = self.map_direction(uv[k].0, uv[k].1);
+                    (out[k].direction, out[k].pdf) = (self.to_world(map_dir), pdf);
+                }
+            }
         }
         out
+    }
+
+    /// A lat-long map's samples' world directions and densities, from their
+    /// coordinates and densities per unit area `uv`, [`LANES`] at a time:
+    /// each what [`Self::map_direction`] and [`Self::to_world`] give it.
+    fn latlong_directions(&self, uv: &[(Vec2, f32)], out: &mut [EnvironmentSample]) {
+        for (uv, out) in uv.chunks(LANES).zip(out.chunks_mut(LANES)) {
+            let lane = |k: usize| uv[k.min(uv.len() - 1)];
+            let u = lanes::from_fn(|k| lane(k).0.x);
+            let v = lanes::from_fn(|k| lane(k).0.y);
+            let p = lanes::from_fn(|k| lane(k).1);
+            let (map_dir, pdf) = latlong_direction_and_pdf(u, v, p);
+            let [x, y, z] = rotate_y_of(map_dir, self.rotation).map(|c| c.to_array());
+            let pdf = pdf.to_array();
+            for (k, out) in out.iter_mut().enumerate() {
+                (out.direction, out.pdf) = (Vec3::new(x[k], y[k], z[k]), pdf[k]);
+            }
+        }
     }
 
     /// The radiance at map coordinates `uv`, scaled, read unfiltered: what
@@ -204,13 +227,8 @@ impl EnvironmentLight {
             let d = cube_direction(face, st);
             return (d.normalize(), p / cube_jacobian(st));
         }
-        let (direction, sin_theta) = latlong_direction_and_sin_theta(uv);
-        let pdf = if sin_theta > 0.0 {
-            p / (2.0 * PI * PI * sin_theta)
-        } else {
-            0.0
-        };
-        (direction, pdf)
+        let ([x, y, z], pdf) = latlong_direction_and_pdf(uv.x, uv.y, p);
+        (Vec3::new(x, y, z), pdf)
     }
 
     /// The solid-angle density with which [`Self::sample`] picks world direction
@@ -233,6 +251,19 @@ impl EnvironmentLight {
             }
         }
     }
+}
+
+/// A lat-long map's direction at `(u, v)` and, for a density `p` per unit
+/// area of [0, 1]², its density in solid angle `p / (2π² sin θ)` (zero at
+/// the poles), in one lane or in many.
+#[inline(always)]
+fn latlong_direction_and_pdf<F: Float>(u: F, v: F, p: F) -> ([F; 3], F) {
+    let (direction, sin_theta) = latlong_direction_of(u, v);
+    let density = p / (F::splat(2.0 * PI * PI) * sin_theta);
+    (
+        direction,
+        F::select(sin_theta.gt(F::ZERO), density, F::ZERO),
+    )
 }
 
 /// `d` turned by `angle` radians about +y (counter-clockwise seen from above).

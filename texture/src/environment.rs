@@ -14,7 +14,7 @@
 
 use crate::{Image, TextureImage, WrapMode};
 use glam::{Vec2, Vec3};
-use glint_lanes::{acos_approx, atan2_approx, Float};
+use glint_lanes::{acos_approx, atan2_approx, sin_cos_approx, Float};
 use std::f32::consts::{PI, TAU};
 use std::sync::Arc;
 
@@ -94,11 +94,21 @@ pub fn latlong_direction(uv: Vec2) -> Vec3 {
 /// Jacobian of the map's coordinates has it), from the one sine.
 #[inline]
 pub fn latlong_direction_and_sin_theta(uv: Vec2) -> (Vec3, f32) {
-    let phi = (uv.x - 0.5) * TAU;
-    let theta = uv.y * PI;
-    let (sin_t, cos_t) = theta.sin_cos();
-    let (sin_p, cos_p) = phi.sin_cos();
-    (Vec3::new(sin_t * sin_p, cos_t, -sin_t * cos_p), sin_t)
+    let ([x, y, z], sin_t) = latlong_direction_of(uv.x, uv.y);
+    (Vec3::new(x, y, z), sin_t)
+}
+
+/// [`latlong_direction_and_sin_theta`] at `(u, v)` ∈ [0, 1]², in one lane
+/// or in many, the same bits in each: `θ = v·π`, `φ = (u − ½)·2π`, their
+/// sines and cosines by polynomials within a unit in the last place of
+/// libm's ([`sin_cos_approx`]).
+#[inline(always)]
+pub fn latlong_direction_of<F: Float>(u: F, v: F) -> ([F; 3], F) {
+    let phi = (u - F::splat(0.5)) * F::splat(TAU);
+    let theta = v * F::splat(PI);
+    let (sin_t, cos_t) = sin_cos_approx(theta);
+    let (sin_p, cos_p) = sin_cos_approx(phi);
+    ([sin_t * sin_p, cos_t, -sin_t * cos_p], sin_t)
 }
 
 /// Six square faces of one size, each with its own lazily built pyramid.

@@ -38,8 +38,8 @@ pub use crate::image::{Image, WrapMode};
 pub use checkerboard::Checkerboard;
 pub use environment::{
     cube_direction, cube_face_st, latlong_coordinates, latlong_direction,
-    latlong_direction_and_sin_theta, latlong_texel, latlong_uv, CubeFace, CubeMap, Environment,
-    LatLongMap,
+    latlong_direction_and_sin_theta, latlong_direction_of, latlong_texel, latlong_uv, CubeFace,
+    CubeMap, Environment, LatLongMap,
 };
 pub use image_texture::{ImageTexture, TextureFilter, TextureImage};
 pub use io::{load_image, srgb_to_linear, ImageLoadError, MAX_IMAGE_SIDE, MAX_IMAGE_TEXELS};

@@ -524,13 +524,19 @@ mod tests {
         for env in [hot_spot_latlong(), hot_spot_cube(), constant] {
             let light = EnvironmentLight::new(env, 0.4, 2.0);
             let normal = Vec3::new(0.3, 0.8, -0.2).normalize();
-            let points: [Vec2; 16] = std::array::from_fn(|k| {
-                Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 + 0.5) / 16.0)
+            // More than a chunk of lanes, and fewer.
+            let points: [Vec2; 40] = std::array::from_fn(|k| {
+                Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 + 0.5) / 40.0)
             });
-            for len in [16, 5, 0] {
+            for len in [40, 37, 16, 5, 0] {
                 let together = light.sample_each(normal, &points, len);
                 for (k, s) in together.iter().enumerate().take(len) {
-                    assert_eq!(*s, light.sample(normal, points[k]), "sample {k} of {len}");
+                    let alone = light.sample(normal, points[k]);
+                    let bits = |s: &EnvironmentSample| {
+                        let parts = [s.direction.to_array(), s.radiance.to_array(), [s.pdf; 3]];
+                        parts.map(|a| a.map(f32::to_bits))
+                    };
+                    assert_eq!(bits(s), bits(&alone), "sample {k} of {len}");
                 }
             }
         }

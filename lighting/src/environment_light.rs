@@ -1,6 +1,6 @@
 use crate::distribution::PiecewiseConstant2D;
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{self, Float, Vec3Lanes, LANES};
+use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, LANES};
 use glint_geometry::prefetch;
 use glint_texture::{
     cube_direction, cube_face_st, latlong_coordinates, latlong_direction_of, latlong_texel,
@@ -84,8 +84,9 @@ impl EnvironmentLight {
 
     /// [`Self::radiance`] with no width (the map unfiltered) along the unit
     /// directions `d` of lanes `lanes` (bit k for lane k; the others zero),
-    /// each lane's bits the scalar one's: a lat-long map's coordinates in
-    /// lanes, its texels lane by lane.
+    /// each lane's bits the scalar one's: a lat-long map's coordinates and
+    /// texels in lanes ([`glint_texture::LatLongMap::bilinear_each`]), others
+    /// lane by lane.
     pub fn radiance_each(&self, d: &Vec3Lanes, lanes: u32) -> Vec3Lanes {
         let mut out = Vec3Lanes::default();
         let Environment::LatLong(map) = &self.environment else {
@@ -96,11 +97,8 @@ impl EnvironmentLight {
         };
         let [x, y, z] = rotate_y_of([d.x, d.y, d.z], -self.rotation);
         let (u, v) = latlong_coordinates(x, y, z);
-        let (u, v) = (u.to_array(), v.to_array());
-        for k in lanes::each_set(lanes) {
-            out.set_lane(k, self.scale * map.bilinear(Vec2::new(u[k], v[k])));
-        }
-        out
+        map.bilinear_each(u, v, lanes)
+            .scale(F32Lanes::splat(self.scale))
     }
 
     /// Whether samples are drawn from the map (by luminance), not about a

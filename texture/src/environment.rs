@@ -14,7 +14,7 @@
 
 use crate::{Image, TextureImage, WrapMode};
 use glam::{Vec2, Vec3};
-use glint_lanes::{acos_approx, atan2_approx, sin_cos_approx, Float};
+use glint_lanes::{acos_approx, atan2_approx, sin_cos_approx, F32Lanes, Float, Vec3Lanes};
 use std::f32::consts::{PI, TAU};
 use std::sync::Arc;
 
@@ -247,6 +247,23 @@ impl LatLongMap {
         latlong_bilinear(self.image.image(), uv)
     }
 
+    /// [`Self::bilinear`] at `(u, v)` in the lanes of `lanes` (zero in the
+    /// others), each lane's bits the scalar one's: the texels of lanes inside
+    /// the image read in lanes, those of lanes across the seam or a pole one
+    /// by one.
+    #[inline]
+    pub fn bilinear_each(&self, u: F32Lanes, v: F32Lanes, lanes: u32) -> Vec3Lanes {
+        let image = self.image.image();
+        let (mut value, edges) = image.bilinear_inside_lanes(u, v, lanes);
+        if edges != 0 {
+            let (u, v) = (u.to_array(), v.to_array());
+            for k in glint_lanes::each_set(edges) {
+                value.set_lane(k, latlong_bilinear(image, Vec2::new(u[k], v[k])));
+            }
+        }
+        value
+    }
+
     /// Radiance towards `d`, filtered over a cone of angular width `width`: the
     /// level whose texels span `width` along the meridian (`π/H` at level 0), so
     /// `log2(width·H/π)`. Towards the poles a texel narrows across (`2π·sin θ/W`)
@@ -328,6 +345,64 @@ impl Environment {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glint_lanes::LANES;
+
+    /// Every lane of `bilinear_each` is `bilinear`'s bits: inside the image,
+    /// across the seam, at and past the poles, on texel centres and edges,
+    /// and NaN; lanes not asked for are zero.
+    #[test]
+    fn bilinear_in_lanes_is_each_lanes_bilinear() {
+        let (w, h) = (24, 12);
+        let map = LatLongMap::new(Image::from_fn(w, h, |x, y| {
+            Vec3::new(
+                x as f32 * 0.37 + 1.0,
+                y as f32 * 1.3,
+                ((x * 7 + y * 3) % 5) as f32,
+            )
+        }));
+        let mut points: Vec<Vec2> = (0..400)
+            .map(|i| {
+                Vec2::new(
+                    (i as f32 * 0.618_034).fract(),
+                    (i as f32 * 0.414_214).fract(),
+                )
+            })
+            .collect();
+        for edge in [
+            0.0,
+            0.5 / 24.0,
+            1.0 / 24.0,
+            1.0 - 0.5 / 24.0,
+            1.0,
+            0.5 / 12.0,
+            f32::NAN,
+        ] {
+            points.extend([
+                Vec2::new(edge, 0.4),
+                Vec2::new(0.3, edge),
+                Vec2::splat(edge),
+            ]);
+        }
+        for (chunk, points) in points.chunks(LANES).enumerate() {
+            let lane = |k: usize| points[k.min(points.len() - 1)];
+            let u = glint_lanes::from_fn(|k| lane(k).x);
+            let v = glint_lanes::from_fn(|k| lane(k).y);
+            let asked = ((1u32 << points.len()) - 1) & !(1 << (chunk % 3));
+            let each = map.bilinear_each(u, v, asked);
+            for (k, &uv) in points.iter().enumerate() {
+                let want = if asked >> k & 1 == 1 {
+                    map.bilinear(uv)
+                } else {
+                    Vec3::ZERO
+                };
+                assert_eq!(
+                    each.lane(k).to_array().map(f32::to_bits),
+                    want.to_array().map(f32::to_bits),
+                    "{uv}"
+                );
+            }
+        }
+    }
 
     fn directions() -> impl Iterator<Item = Vec3> {
         (0..2000).map(|i| {

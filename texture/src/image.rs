@@ -2,6 +2,7 @@
 //! its borders.
 
 use glam::{Vec2, Vec3};
+use glint_lanes::{F32Lanes, Float, Mask, Vec3Lanes, LANES};
 
 /// A linear RGB image of `f32` texels, row-major with the **top** row first.
 ///
@@ -103,6 +104,45 @@ impl Image {
             ],
         };
         lerp(lerp(t00, t10, f.x), lerp(t01, t11, f.x), f.y)
+    }
+
+    /// [`Self::bilinear_with`] at `(s, t)` in the lanes of `lanes` whose 2 × 2
+    /// texels all lie inside the image, each lane's bits the scalar one's, in
+    /// the same operations. Also returns the lanes of `lanes` whose texels do
+    /// not all lie inside (zero here), left to the caller's rule past the
+    /// edges.
+    #[inline]
+    pub fn bilinear_inside_lanes(&self, s: F32Lanes, t: F32Lanes, lanes: u32) -> (Vec3Lanes, u32) {
+        let (w, h) = (self.width as f32, self.height as f32);
+        let half = F32Lanes::splat(0.5);
+        let (px, py) = (s * F32Lanes::splat(w) - half, t * F32Lanes::splat(h) - half);
+        let (x0, y0) = (px.floor(), py.floor());
+        let (fx, fy) = (px - x0, py - y0);
+        let inside = Float::ge(x0, F32Lanes::ZERO)
+            & Float::ge(y0, F32Lanes::ZERO)
+            & Float::lt(x0, F32Lanes::splat(w - 1.0))
+            & Float::lt(y0, F32Lanes::splat(h - 1.0));
+        let inside = lanes & Mask::bits(inside);
+        let (x0, y0) = (x0.to_array(), y0.to_array());
+        let first: [usize; LANES] = glint_lanes::array_from_fn(|k| match inside >> k & 1 {
+            1 => y0[k] as usize * self.width as usize + x0[k] as usize,
+            _ => 0,
+        });
+        let texels = |offset: usize| {
+            let texel = |k: usize| self.texels[first[k] + offset];
+            Vec3Lanes::new(
+                glint_lanes::from_fn(|k| texel(k).x),
+                glint_lanes::from_fn(|k| texel(k).y),
+                glint_lanes::from_fn(|k| texel(k).z),
+            )
+        };
+        let row = self.width as usize;
+        let (t00, t10, t01, t11) = (texels(0), texels(1), texels(row), texels(row + 1));
+        let lerp = |a: Vec3Lanes, b: Vec3Lanes, f: F32Lanes| a + (b - a).scale(f);
+        let value = lerp(lerp(t00, t10, fx), lerp(t01, t11, fx), fy);
+        let zero = Vec3Lanes::default();
+        let value = Vec3Lanes::select(glint_lanes::from_bits(inside), &value, &zero);
+        (value, lanes & !inside)
     }
 
     /// The first of the 2 × 2 texels bilinear filtering reads at `st`, and

@@ -256,33 +256,34 @@ impl DirectIntegrator {
         if wave == 0 {
             return 0;
         }
-        let (mut origins, mut directions) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-        let (mut from, mut used, mut alone) = ([0; LANES], 0, 0);
-        for k in lanes::each_set(wave) {
-            let ray = rays.lane(k);
-            let found = closest.hit(k).expect("a hit lane");
-            let Some(hit) = scene.shapes.surface_point(&ray, found) else {
-                alone |= 1 << k;
-                continue;
-            };
-            // `reflect_differential`'s direction, and `spawn_ray`'s origin.
-            let wi = reflect(-ray.direction.normalize(), hit.facing_normal(ray.direction));
-            let reflected = spawn_ray(&hit, wi);
-            (origins[used], directions[used]) = (reflected.origin, reflected.direction);
-            from[used] = k;
-            used += 1;
-        }
-        let reflected = RayLanes {
-            origin: Vec3Lanes::from_lanes(origins),
-            direction: Vec3Lanes::from_lanes(directions),
+        let in_place = reflected_in_place(scene, rays, closest, wave);
+        let (reflected, from, used, mut alone) = match in_place {
+            Some(reflected) => {
+                let from = lanes::array_from_fn(|k| k);
+                (
+                    reflected,
+                    from,
+                    (u32::BITS - wave.leading_zeros()) as usize,
+                    0,
+                )
+            }
+            None => reflected_gathered(scene, rays, closest, wave),
+        };
+        // The lanes of `reflected` that hold a wave's ray.
+        let held = match in_place {
+            Some(_) => wave,
+            None => (1u32 << used) - 1,
         };
         let Some(next) = scene.shapes.closest_lanes(&reflected, used) else {
             return wave;
         };
-        let leaving = ((1u32 << used) - 1) & !next.hits;
+        let leaving = held & !next.hits;
         let seen = (scene.environment.as_ref())
             .map(|env| env.radiance_each(&reflected.direction.normalize(), leaving));
         for (j, &k) in from.iter().enumerate().take(used) {
+            if held >> j & 1 == 0 {
+                continue;
+            }
             if leaving >> j & 1 == 0 {
                 alone |= 1 << k;
                 continue;
@@ -571,6 +572,67 @@ impl RunSequences {
         }
         (u.x, u.y)
     }
+}
+
+/// The reflected rays of the lanes `wave`, all on one sphere or
+/// parallelogram, made in their own lanes: `reflect_differential`'s
+/// direction and `spawn_ray`'s origin, from the surface points of
+/// [`ShadedLanes::on_one_object`] (no texture coordinates, so no `acos` and
+/// `atan2` a lane). None where the lanes lie on several objects or others.
+fn reflected_in_place(
+    scene: &Scene,
+    rays: &RayLanes,
+    closest: &ClosestLanes,
+    wave: u32,
+) -> Option<RayLanes> {
+    let object = closest.common_object(wave)?;
+    let surface = match scene.shapes.object(object) {
+        ObjectRef::Shape(Shape::Sphere(s)) => s.surface_points_lanes(rays, closest.t, 0),
+        ObjectRef::Shape(Shape::Parallelogram(p)) => p.surface_points_lanes(rays, closest.t),
+        _ => return None,
+    };
+    let (d, g) = (&rays.direction, &surface.normal);
+    let n = Vec3Lanes::select(lanes::gt(g.dot(d), F32Lanes::ZERO), &-*g, g);
+    let wo = -d.normalize();
+    let wi = n.scale(F32Lanes::splat(2.0) * wo.dot(&n)) - wo;
+    let origins = ShadowOrigins::of(&surface.point, &surface.error, g);
+    let from_back = lanes::lt(wi.dot(g), F32Lanes::ZERO);
+    Some(RayLanes {
+        origin: Vec3Lanes::select(from_back, &origins.back, &origins.front),
+        direction: wi,
+    })
+}
+
+/// The reflected rays of the lanes `wave`, each made as `li_at` makes it
+/// and gathered into the first lanes: the rays, the lane each came from,
+/// their number, and the lanes without a surface record (left alone).
+fn reflected_gathered(
+    scene: &Scene,
+    rays: &RayLanes,
+    closest: &ClosestLanes,
+    wave: u32,
+) -> (RayLanes, [usize; LANES], usize, u32) {
+    let (mut origins, mut directions) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+    let (mut from, mut used, mut alone) = ([0; LANES], 0, 0);
+    for k in lanes::each_set(wave) {
+        let ray = rays.lane(k);
+        let found = closest.hit(k).expect("a hit lane");
+        let Some(hit) = scene.shapes.surface_point(&ray, found) else {
+            alone |= 1 << k;
+            continue;
+        };
+        // `reflect_differential`'s direction, and `spawn_ray`'s origin.
+        let wi = reflect(-ray.direction.normalize(), hit.facing_normal(ray.direction));
+        let reflected = spawn_ray(&hit, wi);
+        (origins[used], directions[used]) = (reflected.origin, reflected.direction);
+        from[used] = k;
+        used += 1;
+    }
+    let reflected = RayLanes {
+        origin: Vec3Lanes::from_lanes(origins),
+        direction: Vec3Lanes::from_lanes(directions),
+    };
+    (reflected, from, used, alone)
 }
 
 /// What a chunk's hit lanes landed on, as far as shading them together goes.
@@ -1323,6 +1385,54 @@ mod tests {
                 color: Vec3::ONE
             }
         ))));
+    }
+
+    /// The reflected rays made in place for lanes on one sphere or wall are
+    /// those made lane by lane, origins and directions bit for bit (the
+    /// origin only decides which lanes meet a surface, so the radiance test
+    /// cannot see it).
+    #[test]
+    fn reflected_rays_in_place_are_those_made_one_by_one() {
+        let scene = room();
+        let mut checked = [0usize; 2];
+        for i in 0..64u32 {
+            let rays = RayLanes {
+                origin: Vec3Lanes::splat(Vec3::new(0.3, 0.5, 1.0)),
+                direction: Vec3Lanes::from_lanes(std::array::from_fn(|k| {
+                    let a = (i * 16 + k as u32) as f32;
+                    Vec3::new(
+                        (a * 0.618_034).sin(),
+                        (a * 0.414_214).cos(),
+                        -(a * 0.3).cos(),
+                    )
+                })),
+            };
+            let closest = scene.shapes.closest_lanes(&rays, LANES).unwrap();
+            let first = closest.hits.trailing_zeros() as usize;
+            let object = closest.object[first];
+            let wave = lanes::each_set(closest.hits)
+                .filter(|&k| closest.object[k] == object)
+                .fold(0, |wave, k| wave | 1 << k);
+            let Some(in_place) = reflected_in_place(&scene, &rays, &closest, wave) else {
+                continue;
+            };
+            let (gathered, from, used, alone) = reflected_gathered(&scene, &rays, &closest, wave);
+            assert_eq!((alone, used), (0, wave.count_ones() as usize));
+            for (j, &k) in from.iter().enumerate().take(used) {
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                assert_eq!(bits(in_place.origin.lane(k)), bits(gathered.origin.lane(j)));
+                assert_eq!(
+                    bits(in_place.direction.lane(k)),
+                    bits(gathered.direction.lane(j))
+                );
+            }
+            let sphere = matches!(
+                scene.shapes.object(object),
+                ObjectRef::Shape(Shape::Sphere(_))
+            );
+            checked[usize::from(sphere)] += used;
+        }
+        assert!(checked.iter().all(|&n| n > 0), "{checked:?}");
     }
 
     /// The same under physical shading: the room's materials made diffuse

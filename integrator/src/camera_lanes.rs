@@ -137,6 +137,9 @@ impl DirectIntegrator {
             let seen = env.radiance_each(&rays.direction.normalize(), misses);
             radiance = Vec3Lanes::select(lanes::from_bits(misses), &seen, &radiance);
         }
+        if hit_lanes == 0 {
+            return radiance;
+        }
         // Each arm builds the lanes in place: made over a default, or moved
         // out of an `Option`, their kilobytes cost a zeroing or a copy a chunk.
         let shaded = match FirstHits::of(scene, closest, hit_lanes) {

@@ -128,15 +128,8 @@ impl Image {
             1 => y0[k] as usize * self.width as usize + x0[k] as usize,
             _ => 0,
         });
-        let texels = |offset: usize| {
-            let texel = |k: usize| self.texels[first[k] + offset];
-            Vec3Lanes::new(
-                glint_lanes::from_fn(|k| texel(k).x),
-                glint_lanes::from_fn(|k| texel(k).y),
-                glint_lanes::from_fn(|k| texel(k).z),
-            )
-        };
         let row = self.width as usize;
+        let texels = |offset: usize| gather(&self.texels, &first, offset);
         let (t00, t10, t01, t11) = (texels(0), texels(1), texels(row), texels(row + 1));
         let lerp = |a: Vec3Lanes, b: Vec3Lanes, f: F32Lanes| a + (b - a).scale(f);
         let value = lerp(lerp(t00, t10, fx), lerp(t01, t11, fx), fy);
@@ -211,6 +204,17 @@ pub(crate) fn reduce_st(st: Vec2, wrap: WrapMode) -> Vec2 {
         }
     };
     Vec2::new(reduce(st.x), reduce(st.y))
+}
+
+/// Texel `first[k] + offset` in lane k.
+#[inline(always)]
+fn gather(texels: &[Vec3], first: &[usize; LANES], offset: usize) -> Vec3Lanes {
+    let texel = |k: usize| texels[first[k] + offset];
+    Vec3Lanes::new(
+        glint_lanes::from_fn(|k| texel(k).x),
+        glint_lanes::from_fn(|k| texel(k).y),
+        glint_lanes::from_fn(|k| texel(k).z),
+    )
 }
 
 /// `a + (b − a)·t`: exactly `a` when `a = b` (glam's `Vec3::lerp`, `a(1 − t) + b t`,

@@ -7,7 +7,7 @@ use glint_geometry::prefetch;
 /// A piecewise-constant density over [0, 1] with `n` equal bins.
 #[derive(Clone, Debug)]
 pub struct PiecewiseConstant1D {
-    /// Entry `i` holds CDF value `i`, bin `i`'s weight (0 past the last bin)
+    /// Entry `i` holds CDF value `i`, bin `i`'s density (0 past the last bin)
     /// and guide entry `i`: what a sample near `i/n` reads, in one place, so
     /// that a sample's search touches one or two cache lines, not one in
     /// each of three arrays.
@@ -24,7 +24,9 @@ struct Entry {
     /// bins a million times lighter than the total keep a non-zero width (and
     /// so are sampled with the density `pdf` reports).
     cdf: f64,
-    weight: f32,
+    /// The bin's density, its weight over the integral (made once here, not
+    /// divided on every sample).
+    density: f32,
     /// A guide table (Chen and Asau, "On generating random variates from an
     /// empirical distribution", AIIE Transactions 6(2), 1974): entry `j` is
     /// the number of CDF values in buckets before `j`, bucket
@@ -64,7 +66,7 @@ impl PiecewiseConstant1D {
         let entries = (0..=n)
             .map(|i| Entry {
                 cdf: cdf[i],
-                weight: weights.get(i).copied().unwrap_or(0.0),
+                density: weights.get(i).map_or(0.0, |&w| w.max(0.0) / integral),
                 guide: cdf.partition_point(|&c| bucket(c, n) < i) as u32,
             })
             .collect();
@@ -142,7 +144,7 @@ impl PiecewiseConstant1D {
 
     #[inline]
     fn pdf_of_bin(&self, bin: usize) -> f32 {
-        self.entries[bin].weight.max(0.0) / self.integral
+        self.entries[bin].density
     }
 }
 

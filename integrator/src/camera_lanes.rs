@@ -158,6 +158,20 @@ impl DirectIntegrator {
         if shaded.lanes == 0 {
             return radiance;
         }
+        self.with_direct_lighting(scene, &shaded, samples, radiance, ctx)
+    }
+
+    /// `radiance` plus, in the lanes of `shaded`, each light's term and the
+    /// environment's, added in `li_at`'s order, for the camera samples
+    /// `samples`.
+    fn with_direct_lighting<T: Tracer>(
+        &self,
+        scene: &Scene,
+        shaded: &ShadedLanes,
+        samples: &LaneSamples,
+        mut radiance: Vec3Lanes,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
         let shaded_mask = lanes::from_bits(shaded.lanes);
         // Each lane's own stream, as `SampleContext::begin_sample` makes it. The
         // random pattern draws a point as two uniforms; so does the stratified
@@ -180,9 +194,9 @@ impl DirectIntegrator {
                     let pair = pairs.take(own, self.light_samples);
                     let points = (samples, pair, &mut rngs);
                     if physical {
-                        self.physical_area_light_term(scene, &shaded, (index, area), points, ctx)
+                        self.physical_area_light_term(scene, shaded, (index, area), points, ctx)
                     } else {
-                        self.area_light_term(scene, &shaded, (index, area), points, ctx)
+                        self.area_light_term(scene, shaded, (index, area), points, ctx)
                     }
                 }
                 Light::Point(point) => {
@@ -201,7 +215,7 @@ impl DirectIntegrator {
             .as_ref()
             .filter(|_| self.environment_samples > 0)
         {
-            let term = self.environment_term_lanes(scene, env, &shaded, samples, ctx);
+            let term = self.environment_term_lanes(scene, env, shaded, samples, ctx);
             radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
         }
         // `li_at` adds the absent mirror term, a zero: a −0 component becomes

@@ -256,8 +256,10 @@ impl DirectIntegrator {
     }
 
     /// The lanes `wave`, on perfect mirrors (no local shading), reflected as
-    /// `li_at` reflects them, their rays gathered into the first lanes of a
-    /// wave and their closest hits found together. Where a reflected ray
+    /// `li_at` reflects them: their rays made in their own lanes where they
+    /// lie on one sphere or wall, else gathered into the first lanes, and
+    /// their closest hits found together (lanes outside the wave hold rays
+    /// whose answers are not read). Where a reflected ray
     /// leaves the scene, its lane's radiance is the mirror's tint times the
     /// map (unfiltered, as physical shading reads it), in `li_at`'s
     /// operations; the lanes whose rays meet a surface are returned, to be

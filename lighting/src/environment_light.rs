@@ -88,8 +88,8 @@ impl EnvironmentLight {
     /// texels in lanes ([`glint_texture::LatLongMap::bilinear_each`]), others
     /// lane by lane.
     pub fn radiance_each(&self, d: &Vec3Lanes, lanes: u32) -> Vec3Lanes {
-        let mut out = Vec3Lanes::default();
         let Environment::LatLong(map) = &self.environment else {
+            let mut out = Vec3Lanes::default();
             for k in lanes::each_set(lanes) {
                 out.set_lane(k, self.radiance(d.lane(k), 0.0));
             }

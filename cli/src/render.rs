@@ -6,7 +6,9 @@ use crate::{named, progress_bar, Failure};
 use clap::Args;
 use glam::UVec2;
 use glint_camera::{ImageFormat, PartialFilm};
-use glint_integrator::{Aov, AreaSampling, Crop, RenderControl, RenderSettings, SamplePattern};
+use glint_integrator::{
+    Aov, AreaSampling, Crop, EnvironmentSampling, RenderControl, RenderSettings, SamplePattern,
+};
 use glint_scene::SceneDescription;
 use glint_texture::TextureFilter;
 use std::path::{Path, PathBuf};
@@ -107,6 +109,13 @@ pub(crate) struct SceneArgs {
     /// patterns, grid needing a square count
     #[arg(long, value_name = "PATTERN", value_parser = named(&SamplePattern::NAMES, SamplePattern::from_name))]
     environment_sampler: Option<SamplePattern>,
+
+    /// How environment directions are drawn (overrides
+    /// render.environment_sampling): luminance (in proportion to the map's
+    /// luminance; best with small bright sources) or cosine (cosine-weighted
+    /// about the shading normal; best under broad skies)
+    #[arg(long, value_name = "STRATEGY", value_parser = named(&EnvironmentSampling::NAMES, EnvironmentSampling::from_name))]
+    environment_sampling: Option<EnvironmentSampling>,
 
     /// Physical shading: how area lights are sampled (overrides
     /// render.area_sampling): auto (by solid angle where a light subtends more
@@ -447,6 +456,13 @@ impl SceneArgs {
             glint_scene::load(&self.scene).map_err(|e| Failure::Input(e.to_string()))?;
         self.apply_overrides(&mut description.settings);
         let scene = &mut description.scene;
+        let settings = &description.settings;
+        if let (Some(env), 1..) = (&scene.environment, settings.environment_samples) {
+            // The map's distribution is part of loading it, not of the render.
+            let start = std::time::Instant::now();
+            env.prepare(settings.environment_sampling);
+            description.timings.assets += start.elapsed();
+        }
         if let Some(filter) = self.texture_filter {
             scene.override_texture_filter(filter);
         }
@@ -494,6 +510,9 @@ impl SceneArgs {
         }
         if let Some(p) = args.environment_sampler {
             settings.environment_pattern = p;
+        }
+        if let Some(s) = args.environment_sampling {
+            settings.environment_sampling = s;
         }
     }
 }

@@ -144,6 +144,7 @@ fn li(c: &mut Criterion) {
             light_pattern: SamplePattern::Sobol,
             environment_samples: 0,
             environment_pattern: SamplePattern::Sobol,
+            environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
             max_depth: 4,
             area_sampling: glint_lighting::AreaSampling::Auto,
             mis: true,

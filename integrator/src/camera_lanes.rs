@@ -87,10 +87,9 @@ impl DirectIntegrator {
         };
         let environment = match &scene.environment {
             None => true,
-            // Drawn from the map at Sobol points, which no stream draws.
-            Some(env) => {
-                self.environment_samples == 0
-                    || (env.is_sampled_by_map() && self.environment_pattern == SamplePattern::Sobol)
+            // Drawn at Sobol points, which no stream draws.
+            Some(_) => {
+                self.environment_samples == 0 || self.environment_pattern == SamplePattern::Sobol
             }
         };
         matches!(
@@ -365,15 +364,22 @@ impl DirectIntegrator {
             .phong
             .kd()
             .scale(F32Lanes::splat(std::f32::consts::FRAC_1_PI));
+        let by_map = self.samples_environment_by_map(scene);
         let mut sum = Vec3Lanes::default();
         for j in 0..n {
-            let (ux, uy) = sequences.points(j, n);
-            let (ux, uy) = (ux.to_array(), uy.to_array());
-            let points: [Vec2; LANES] = lanes::array_from_fn(|k| Vec2::new(ux[k], uy[k]));
-            let drawn = env.sample_each(Vec3::Y, &points, len);
-            let direction = Vec3Lanes::from_lanes(lanes::array_from_fn(|k| drawn[k].direction));
-            let radiance = Vec3Lanes::from_lanes(lanes::array_from_fn(|k| drawn[k].radiance));
-            let pdf = F32Lanes::new(lanes::array_from_fn(|k| drawn[k].pdf));
+            let u = sequences.points(j, n);
+            let (direction, radiance, pdf) = if by_map {
+                let (ux, uy) = (u.0.to_array(), u.1.to_array());
+                let points: [Vec2; LANES] = lanes::array_from_fn(|k| Vec2::new(ux[k], uy[k]));
+                let drawn = env.sample_each(Vec3::Y, &points, len);
+                (
+                    Vec3Lanes::from_lanes(lanes::array_from_fn(|k| drawn[k].direction)),
+                    Vec3Lanes::from_lanes(lanes::array_from_fn(|k| drawn[k].radiance)),
+                    F32Lanes::new(lanes::array_from_fn(|k| drawn[k].pdf)),
+                )
+            } else {
+                env.sample_cosine_each(shaded.phong.normals(), u, shaded.lanes)
+            };
             let dense = shaded.lanes
                 & lanes::bits(lanes::gt(pdf, F32Lanes::ZERO))
                 & !lanes::bits(radiance.is_zero());
@@ -1341,6 +1347,7 @@ mod tests {
                 light_pattern: pattern,
                 environment_samples: 4,
                 environment_pattern: SamplePattern::Sobol,
+                environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
                 max_depth: 4,
                 area_sampling: glint_lighting::AreaSampling::Auto,
                 mis: true,
@@ -1372,6 +1379,7 @@ mod tests {
             light_pattern: SamplePattern::Random,
             environment_samples: 0,
             environment_pattern: SamplePattern::Sobol,
+            environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
             max_depth: 4,
             area_sampling: glint_lighting::AreaSampling::Auto,
             mis: true,
@@ -1510,6 +1518,7 @@ mod tests {
                 light_pattern: pattern,
                 environment_samples,
                 environment_pattern: SamplePattern::Sobol,
+                environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
                 max_depth: 4,
                 area_sampling,
                 mis: true,
@@ -1538,6 +1547,7 @@ mod tests {
             light_pattern: SamplePattern::Sobol,
             environment_samples: 4,
             environment_pattern: SamplePattern::Sobol,
+            environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
             max_depth: 4,
             area_sampling: AreaSampling::Auto,
             mis: true,

@@ -17,8 +17,8 @@ use glint_geometry::{
     RayDifferential, RayLanes, RayTarget,
 };
 use glint_lighting::{
-    AreaLight, AreaSampling, EnvironmentLight, EnvironmentSample, Light, PhongMaterial,
-    ShadingModel,
+    AreaLight, AreaSampling, EnvironmentLight, EnvironmentSample, EnvironmentSampling, Light,
+    PhongMaterial, ShadingModel,
 };
 use glint_texture::TexCoord;
 
@@ -50,6 +50,7 @@ pub struct DirectIntegrator {
     pub light_pattern: SamplePattern,
     pub environment_samples: u32,
     pub environment_pattern: SamplePattern,
+    pub environment_sampling: EnvironmentSampling,
     pub max_depth: u32,
     /// Physical shading: how area lights are sampled.
     pub area_sampling: AreaSampling,
@@ -157,6 +158,7 @@ impl DirectIntegrator {
             light_pattern: settings.light_pattern,
             environment_samples: settings.environment_samples,
             environment_pattern: settings.environment_pattern,
+            environment_sampling: settings.environment_sampling,
             max_depth: settings.max_depth,
             area_sampling: settings.area_sampling,
             mis: settings.mis,
@@ -484,6 +486,13 @@ impl DirectIntegrator {
         light.color * sum / self.light_samples as f32
     }
 
+    /// Whether the scene's environment samples are drawn from its map, by
+    /// luminance, so that they do not depend on the shading normal.
+    pub(crate) fn samples_environment_by_map(&self, scene: &Scene) -> bool {
+        self.environment_sampling == EnvironmentSampling::Luminance
+            && (scene.environment.as_ref()).is_some_and(EnvironmentLight::is_sampled_by_map)
+    }
+
     /// Monte Carlo estimate of `∫ L_env(ω)·V(ω)·f(ω)·cos θ dω` with directions
     /// importance-sampled from the environment (the points of
     /// `environment_pattern` over [0, 1)² mapped to directions), for a shading
@@ -512,7 +521,7 @@ impl DirectIntegrator {
             let mut samples = std::mem::take(&mut ctx.environment_points);
             ctx.fill_points(self.environment_pattern, pair, &mut samples);
             for chunk in samples.chunks() {
-                let drawn = drawn_together(env, point.n, &chunk);
+                let drawn = drawn_together(env, self.environment_sampling, point.n, &chunk);
                 let drawn = &drawn[..chunk.len];
                 point.add_environment_samples(scene, drawn, one_by_one, &mut sum, ctx);
             }
@@ -637,6 +646,7 @@ impl ShadowOrigins {
 #[inline]
 fn drawn_together(
     env: &EnvironmentLight,
+    sampling: EnvironmentSampling,
     normal: Vec3,
     chunk: &PointChunk,
 ) -> [EnvironmentSample; LANES] {
@@ -644,7 +654,21 @@ fn drawn_together(
     for (point, u) in points.iter_mut().zip(chunk.iter()) {
         *point = u;
     }
-    env.sample_each(normal, &points, chunk.len)
+    if sampling == EnvironmentSampling::Luminance {
+        return env.sample_each(normal, &points, chunk.len);
+    }
+    let u = (
+        lanes::from_fn(|k| points[k].x),
+        lanes::from_fn(|k| points[k].y),
+    );
+    let used = (1 << chunk.len) - 1;
+    let (d, radiance, pdf) = env.sample_cosine_each(&Vec3Lanes::splat(normal), u, used);
+    let pdf = pdf.to_array();
+    lanes::array_from_fn(|k| EnvironmentSample {
+        direction: d.lane(k),
+        radiance: radiance.lane(k),
+        pdf: pdf[k],
+    })
 }
 
 /// Tells the tracer of environment sample `s`: its `f · cos θ`, its shadow

@@ -65,10 +65,7 @@ impl DirectIntegrator {
     pub(crate) fn draws_environment_ahead(&self, scene: &Scene) -> bool {
         (1..DRAWN_ALONE_FROM).contains(&self.environment_samples)
             && self.environment_pattern == SamplePattern::Sobol
-            && scene
-                .environment
-                .as_ref()
-                .is_some_and(EnvironmentLight::is_sampled_by_map)
+            && self.samples_environment_by_map(scene)
     }
 
     /// The dimension pair of the environment's samples at a first hit: the

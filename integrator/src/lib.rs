@@ -53,7 +53,7 @@ pub use aov::Aov;
 pub use counters::{LookupKind, ShadingCounters, Skips, TextureCounters};
 pub use direct::{DirectIntegrator, SampleContext};
 pub use explain::{explain_pixel, ExplainError, PixelExplanation};
-pub use glint_lighting::{AreaSampling, ShadingModel};
+pub use glint_lighting::{AreaSampling, EnvironmentSampling, ShadingModel};
 pub use render::{
     camera_ray, render, render_with, RenderControl, RenderOutput, RenderStats, TILE_SIZE,
 };

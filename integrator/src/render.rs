@@ -130,6 +130,9 @@ pub fn render_with(
             return Err(SettingsError::ResumeResolution { film, camera });
         }
     }
+    if let (Some(env), 1..) = (&scene.environment, settings.environment_samples) {
+        env.prepare(settings.environment_sampling);
+    }
     let run = || render_on_current_pool(scene, settings, on_tile_done, control, window);
     match settings.threads {
         None => Ok(run()),

@@ -4,7 +4,7 @@
 use crate::sampling::SamplePattern;
 use crate::Aov;
 use glam::UVec2;
-use glint_lighting::AreaSampling;
+use glint_lighting::{AreaSampling, EnvironmentSampling};
 
 /// The most mirror reflections a render follows.
 pub const MAX_DEPTH: u32 = 64;
@@ -39,6 +39,9 @@ pub struct RenderSettings {
     /// Where in [0, 1)² the environment samples fall before they are mapped to
     /// directions.
     pub environment_pattern: SamplePattern,
+    /// How those points are mapped to directions: by the map's luminance or
+    /// by the cosine about the shading normal.
+    pub environment_sampling: EnvironmentSampling,
     /// Gather the detailed counts of [`RenderStats`] (intersection tests, BVH
     /// visits, texture lookups by level); the image is the same either way.
     pub stats: bool,
@@ -63,6 +66,7 @@ impl Default for RenderSettings {
             max_depth: 4,
             environment_samples: 16,
             environment_pattern: SamplePattern::Sobol,
+            environment_sampling: EnvironmentSampling::Luminance,
             stats: false,
             area_sampling: AreaSampling::Auto,
             mis: true,

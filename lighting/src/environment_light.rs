@@ -1,12 +1,13 @@
 use crate::distribution::PiecewiseConstant2D;
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, LANES};
+use glint_geometry::lanes::{self, sin_cos_approx, F32Lanes, Float, Vec3Lanes, Vector3, LANES};
 use glint_geometry::prefetch;
 use glint_texture::{
     cube_direction, cube_face_st, latlong_coordinates, latlong_direction_of, latlong_texel,
     latlong_uv, CubeMap, Environment,
 };
 use std::f32::consts::{FRAC_1_PI, PI};
+use std::sync::OnceLock;
 
 /// A direction sampled towards the environment, with the radiance it brings and
 /// its density in solid angle.
@@ -29,13 +30,57 @@ pub struct EnvironmentSample {
 /// `J = 4/(1 + s² + t²)^{3/2}` per face (times 6 faces) for cube maps. A constant
 /// environment is sampled with the cosine-weighted hemisphere about the shading
 /// normal, the exact optimum for it (`L·cos θ/π` then has zero variance); so is a
-/// map whose texels are all equal.
+/// map whose texels are all equal. A map may also be sampled by that cosine
+/// ([`EnvironmentSampling::Cosine`], [`Self::sample_cosine`]).
 #[derive(Clone, Debug)]
 pub struct EnvironmentLight {
     environment: Environment,
     rotation: f32,
     scale: f32,
-    distribution: Option<PiecewiseConstant2D>,
+    /// Built on the first sample by luminance: a render that samples by
+    /// the cosine, or takes no samples, never pays for it.
+    distribution: OnceLock<Option<PiecewiseConstant2D>>,
+}
+
+/// How an environment's directions are drawn for the light it sends to a
+/// surface point.
+///
+/// The best choice depends on the map: the estimate `L · f · cos θ / p` is
+/// noisy where the density `p` follows one factor of the integrand and the
+/// other varies. By luminance suits maps with small bright sources (a sun, a
+/// studio's lamps), which a cosine-weighted direction seldom finds; by the
+/// cosine suits broad skies (no sample lost below the horizon, and each
+/// direction costs no search of the map). On `physical-environment` (a city
+/// street), at 4 samples a point and 64 a pixel, relMSE 1.2·10⁻⁴ by
+/// luminance, 0.9·10⁻⁴ by the cosine (docs/environment-lighting.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum EnvironmentSampling {
+    /// In proportion to the map's luminance times the solid angle of its
+    /// texels (pbrt-v4 §12.5); a constant or uniform map by the cosine.
+    #[default]
+    Luminance,
+    /// Cosine-weighted about the shading normal, `p = cos θ / π` (Malley's
+    /// method; pbrt-v4 §A.5.3): the diffuse BRDF's own sampling.
+    Cosine,
+}
+
+impl EnvironmentSampling {
+    pub const NAMES: [&'static str; 2] = ["luminance", "cosine"];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            EnvironmentSampling::Luminance => "luminance",
+            EnvironmentSampling::Cosine => "cosine",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "luminance" => Some(EnvironmentSampling::Luminance),
+            "cosine" => Some(EnvironmentSampling::Cosine),
+            _ => None,
+        }
+    }
 }
 
 /// Weight added to every texel of the sampling distribution, relative to the mean,
@@ -44,12 +89,28 @@ const WEIGHT_FLOOR: f32 = 1e-3;
 
 impl EnvironmentLight {
     pub fn new(environment: Environment, rotation: f32, scale: f32) -> Self {
-        let distribution = sampling_distribution(&environment);
         Self {
             environment,
             rotation,
             scale,
-            distribution,
+            distribution: OnceLock::new(),
+        }
+    }
+
+    /// The luminance distribution over the map (`None` for a constant or
+    /// uniform map), built on the first call.
+    #[inline]
+    fn distribution(&self) -> Option<&PiecewiseConstant2D> {
+        self.distribution
+            .get_or_init(|| sampling_distribution(&self.environment))
+            .as_ref()
+    }
+
+    /// Builds the luminance distribution now, if `sampling` will need it,
+    /// rather than in the first sample's thread while the others wait.
+    pub fn prepare(&self, sampling: EnvironmentSampling) {
+        if sampling == EnvironmentSampling::Luminance {
+            self.distribution();
         }
     }
 
@@ -104,23 +165,14 @@ impl EnvironmentLight {
     /// Whether samples are drawn from the map (by luminance), not about a
     /// shading normal: then they do not depend on the normal.
     pub fn is_sampled_by_map(&self) -> bool {
-        self.distribution.is_some() && !matches!(self.environment, Environment::Constant(_))
+        !matches!(self.environment, Environment::Constant(_)) && self.distribution().is_some()
     }
 
     /// A direction chosen in proportion to the environment's radiance (or, for a
     /// constant environment, to the cosine about `normal`), for uniform `u`.
     pub fn sample(&self, normal: Vec3, u: Vec2) -> EnvironmentSample {
-        let (uv, p) = match (&self.environment, &self.distribution) {
-            (Environment::Constant(_), _) | (_, None) => {
-                let local = cosine_hemisphere(u);
-                let (t, b) = normal.any_orthonormal_pair();
-                let d = t * local.x + b * local.y + normal * local.z;
-                return EnvironmentSample {
-                    direction: d,
-                    radiance: self.radiance(d, 0.0),
-                    pdf: local.z * FRAC_1_PI,
-                };
-            }
+        let (uv, p) = match (&self.environment, self.distribution()) {
+            (Environment::Constant(_), _) | (_, None) => return self.sample_cosine(normal, u),
             (_, Some(dist)) => dist.sample(u),
         };
         let (map_dir, pdf) = self.map_direction(uv, p);
@@ -147,7 +199,7 @@ impl EnvironmentLight {
             pdf: 0.0,
         }; N];
         let len = len.min(N);
-        let dist = match (&self.environment, &self.distribution) {
+        let dist = match (&self.environment, self.distribution()) {
             (Environment::Constant(_), _) | (_, None) => {
                 for k in 0..len {
                     out[k] = self.sample(normal, u[k]);
@@ -199,6 +251,34 @@ impl EnvironmentLight {
         }
     }
 
+    /// A direction cosine-weighted about the unit `normal` for uniform `u`,
+    /// with the radiance along it ([`Self::radiance`], no width) and its
+    /// density `cos θ / π` ([`cosine_direction_of`]).
+    pub fn sample_cosine(&self, normal: Vec3, u: Vec2) -> EnvironmentSample {
+        let n = Vector3::new(normal.x, normal.y, normal.z);
+        let (d, pdf) = cosine_direction_of(&n, u.x, u.y);
+        let direction = Vec3::new(d.x, d.y, d.z);
+        EnvironmentSample {
+            direction,
+            radiance: self.radiance(direction, 0.0),
+            pdf,
+        }
+    }
+
+    /// [`Self::sample_cosine`] in the lanes `lanes` (bit k for lane k), about
+    /// each lane's unit normal at each lane's point `(u, v)`: directions,
+    /// radiance ([`Self::radiance_each`]) and densities, each lane's bits the
+    /// scalar one's. Lanes outside `lanes` hold directions but no radiance.
+    pub fn sample_cosine_each(
+        &self,
+        normals: &Vec3Lanes,
+        (u, v): (F32Lanes, F32Lanes),
+        lanes: u32,
+    ) -> (Vec3Lanes, Vec3Lanes, F32Lanes) {
+        let (direction, pdf) = cosine_direction_of(normals, u, v);
+        (direction, self.radiance_each(&direction, lanes), pdf)
+    }
+
     /// The radiance at map coordinates `uv`, scaled, read unfiltered: what
     /// [`Self::radiance`] reads along the direction of `uv` (the same texels,
     /// weighted alike up to the rounding of the direction), without turning
@@ -232,7 +312,7 @@ impl EnvironmentLight {
     /// The solid-angle density with which [`Self::sample`] picks world direction
     /// `d` (given the same `normal`).
     pub fn pdf(&self, normal: Vec3, d: Vec3) -> f32 {
-        match (&self.environment, &self.distribution) {
+        match (&self.environment, self.distribution()) {
             (Environment::Constant(_), _) | (_, None) => normal.dot(d).max(0.0) * FRAC_1_PI,
             (Environment::LatLong(_), Some(dist)) => {
                 let uv = latlong_uv(self.to_map(d));
@@ -301,14 +381,30 @@ fn cube_jacobian(st: Vec2) -> f32 {
     24.0 / (r2 * r2.sqrt())
 }
 
-/// Cosine-weighted direction on the hemisphere about +z (Malley's method: a
-/// uniform point on the disk, projected up).
-fn cosine_hemisphere(u: Vec2) -> Vec3 {
-    let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    let (s, c) = phi.sin_cos();
-    let (x, y) = (r * c, r * s);
-    Vec3::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt())
+/// A direction cosine-weighted about the unit normal `n` for `(u, v)` ∈
+/// [0, 1)², and its density `cos θ / π`, in one lane or in many, the same
+/// bits in each. Malley's method (pbrt-v4 §A.5.3): a uniform point on the
+/// unit disk at radius `√u` and angle `2πv − π` (within [−π, π), where
+/// [`sin_cos_approx`] holds), raised to the hemisphere, `cos θ = √(1 − u)`;
+/// the disk's axes are the frame of Duff et al., "Building an Orthonormal
+/// Basis, Revisited" (JCGT 6(1), 2017), which has no branch.
+#[inline(always)]
+pub(crate) fn cosine_direction_of<F: Float>(n: &Vector3<F>, u: F, v: F) -> (Vector3<F>, F) {
+    let r = u.sqrt();
+    let (sin_phi, cos_phi) = sin_cos_approx(v * F::splat(2.0 * PI) - F::splat(PI));
+    let (x, y) = (r * cos_phi, r * sin_phi);
+    let cos_theta = (F::ONE - u).max(F::ZERO).sqrt();
+    let sign = n.z.signum();
+    let a = -(F::ONE / (sign + n.z));
+    let b = n.x * n.y * a;
+    let tangent = Vector3::new(F::ONE + sign * n.x * n.x * a, sign * b, -(sign * n.x));
+    let bitangent = Vector3::new(b, sign + n.y * n.y * a, -n.y);
+    let direction = Vector3::new(
+        tangent.x * x + bitangent.x * y + n.x * cos_theta,
+        tangent.y * x + bitangent.y * y + n.y * cos_theta,
+        tangent.z * x + bitangent.z * y + n.z * cos_theta,
+    );
+    (direction, cos_theta * F::splat(FRAC_1_PI))
 }
 
 fn luminance(c: Vec3) -> f32 {
@@ -622,6 +718,74 @@ mod tests {
             scaled.radiance(Vec3::X, 0.0),
             3.0 * light.radiance(Vec3::X, 0.0)
         );
+    }
+
+    /// Cosine samples in lanes are each lane's scalar sample, bit for bit,
+    /// about normals on every axis, either side of z = 0 (the frame's branch
+    /// point, −0 included) and at random; each is a unit direction in the
+    /// normal's hemisphere with the density `cos θ/π`.
+    #[test]
+    fn cosine_samples_in_lanes_are_each_lanes_sample() {
+        let normals: [Vec3; LANES] = std::array::from_fn(|k| match k {
+            0 => Vec3::Z,
+            1 => -Vec3::Z,
+            2 => Vec3::X,
+            3 => -Vec3::Y,
+            4 => Vec3::new(0.6, 0.8, 0.0),
+            5 => Vec3::new(0.6, 0.8, -0.0),
+            6 => Vec3::new(0.0, -1.0, -1e-7).normalize(),
+            _ => {
+                let a = 1.3 * k as f32;
+                Vec3::new(a.sin(), (0.61 * k as f32).cos(), a.cos() - 0.2).normalize()
+            }
+        });
+        let light = EnvironmentLight::new(hot_spot_latlong(), 0.4, 1.5);
+        for i in 0..64 {
+            let u: [Vec2; LANES] = std::array::from_fn(|k| {
+                let x = ((i * LANES + k) as f32 * 0.618_034).fract();
+                Vec2::new(x, (i as f32 + 0.5) / 64.0)
+            });
+            let us = (lanes::from_fn(|k| u[k].x), lanes::from_fn(|k| u[k].y));
+            let (d, radiance, pdf) =
+                light.sample_cosine_each(&Vec3Lanes::from_lanes(normals), us, (1 << LANES) - 1);
+            for k in 0..LANES {
+                let s = light.sample_cosine(normals[k], u[k]);
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                let lane = (d.lane(k), radiance.lane(k), pdf.to_array()[k]);
+                assert_eq!(bits(lane.0), bits(s.direction), "lane {k}, point {i}");
+                assert_eq!(bits(lane.1), bits(s.radiance), "lane {k}, point {i}");
+                assert_eq!(lane.2.to_bits(), s.pdf.to_bits(), "lane {k}, point {i}");
+                let cos = s.direction.dot(normals[k]);
+                assert!((s.direction.length() - 1.0).abs() < 1e-5, "{}", s.direction);
+                assert!(cos >= -1e-6 && (s.pdf - cos * FRAC_1_PI).abs() < 1e-5);
+            }
+        }
+    }
+
+    /// Cosine directions fall in the cosine's proportions: the share with
+    /// `cos θ > c` is `1 − c²`, within 4 standard errors over 20 000
+    /// stratified points (a uniform hemisphere gives `1 − c`, 0.25 off at
+    /// `c = ½`).
+    #[test]
+    fn cosine_samples_follow_the_cosine() {
+        let light = EnvironmentLight::new(hot_spot_latlong(), 0.0, 1.0);
+        let n = Vec3::new(0.3, -0.5, 0.4).normalize();
+        let count = 20_000;
+        for c in [0.25f32, 0.5, 0.9] {
+            let above = (0..count)
+                .filter(|&i| {
+                    let u = Vec2::new(
+                        ((i as f32) * 0.754_877_7).fract(),
+                        (i as f32 + 0.5) / count as f32,
+                    );
+                    light.sample_cosine(n, u).direction.dot(n) > c
+                })
+                .count() as f32
+                / count as f32;
+            let p = 1.0 - c * c;
+            let sigma = (p * (1.0 - p) / count as f32).sqrt();
+            assert!((above - p).abs() < 4.0 * sigma, "c = {c}: {above} vs {p}");
+        }
     }
 
     #[test]

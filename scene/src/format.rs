@@ -85,6 +85,8 @@ pub struct RenderTable {
     pub max_depth: Spanned<u32>,
     pub environment_samples: Spanned<u32>,
     pub environment_sampler: Spanned<Pattern>,
+    /// How the environment's directions are drawn: by luminance or by the cosine.
+    pub environment_sampling: EnvironmentSamplingName,
     /// Physical shading: how area lights are sampled.
     pub area_sampling: AreaSamplingName,
     /// Physical shading: multiple importance sampling of glossy lobes.
@@ -127,6 +129,7 @@ impl Default for RenderTable {
             max_depth: Spanned::new(0..0, settings.max_depth),
             environment_samples: Spanned::new(0..0, settings.environment_samples),
             environment_sampler: Spanned::new(0..0, Pattern(settings.environment_pattern)),
+            environment_sampling: EnvironmentSamplingName(settings.environment_sampling),
             area_sampling: AreaSamplingName(settings.area_sampling),
             mis: settings.mis,
         }

@@ -3,7 +3,7 @@
 
 use glam::{UVec2, Vec3};
 use glint_integrator::SamplePattern;
-use glint_lighting::{AreaSampling, ShadingModel, SpecularLobe};
+use glint_lighting::{AreaSampling, EnvironmentSampling, ShadingModel, SpecularLobe};
 use glint_texture::{TextureFilter, WrapMode};
 use serde::de::{self, Deserialize, Deserializer, Visitor};
 use std::fmt;
@@ -246,6 +246,21 @@ pub struct AreaSamplingName(pub AreaSampling);
 impl<'de> Deserialize<'de> for AreaSamplingName {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         named(d, &AreaSampling::NAMES, AreaSampling::from_name).map(AreaSamplingName)
+    }
+}
+
+/// An environment sampling name: `"luminance"` or `"cosine"`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvironmentSamplingName(pub EnvironmentSampling);
+
+impl<'de> Deserialize<'de> for EnvironmentSamplingName {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        named(
+            d,
+            &EnvironmentSampling::NAMES,
+            EnvironmentSampling::from_name,
+        )
+        .map(EnvironmentSamplingName)
     }
 }
 

@@ -6,7 +6,8 @@
 use glam::{UVec2, Vec3};
 use glint_integrator::trace::{Event, SampleSelection};
 use glint_integrator::{
-    explain_pixel, render, render_with, Crop, ExplainError, RenderControl, RenderSettings, Scene,
+    explain_pixel, render, render_with, Crop, EnvironmentSampling, ExplainError, RenderControl,
+    RenderSettings, Scene,
 };
 use glint_scene::load;
 use glint_tests::scene_path;
@@ -90,6 +91,20 @@ fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
             scene("physical-environment", size, few),
         ),
         ("cornell-physical", scene("cornell-physical", size, few)),
+        // Environment directions by the cosine about each point's normal:
+        // in lanes at first hits, a point's own in the scalar path.
+        ("physical-environment, by the cosine", {
+            scene("physical-environment", size, |s| {
+                few(s);
+                s.environment_sampling = EnvironmentSampling::Cosine;
+            })
+        }),
+        ("environment, by the cosine", {
+            scene("environment", size, |s| {
+                few(s);
+                s.environment_sampling = EnvironmentSampling::Cosine;
+            })
+        }),
     ]
     .into_iter()
     .map(|(name, (scene, settings))| (name, scene, settings))

@@ -75,16 +75,33 @@ class Config:
 
     renderer: str  # "glint" or "mitsuba"
     pattern: str  # Glint's pixel, light and environment pattern, or Mitsuba's sampler
-    samples: int  # Glint's light and environment samples; Mitsuba's emitter and BSDF samples
+    samples: int  # Glint's light and environment samples; Mitsuba's emitter and/or BSDF samples
+    # Glint's environment sampling (GLINT_STRATEGIES); Mitsuba's techniques (MITSUBA_STRATEGIES)
+    strategy: str = ""
 
     @property
     def label(self) -> str:
-        what = "light/env samples" if self.renderer == "glint" else "emitter+BSDF samples"
-        return f"{self.pattern}, {self.samples} {what}"
+        if self.renderer == "glint":
+            by = f", environment by {self.strategy}" if self.strategy != "luminance" else ""
+            return f"{self.pattern}, {self.samples} light/env samples{by}"
+        what = {"mis": "emitter+BSDF", "emitter": "emitter", "bsdf": "BSDF"}[self.strategy]
+        return f"{self.pattern}, {self.samples} {what} samples"
 
     @property
     def key(self) -> str:
-        return f"{self.renderer}-{self.pattern}-{self.samples}"
+        return f"{self.renderer}-{self.pattern}-{self.samples}-{self.strategy}"
+
+    def mitsuba_samples(self) -> dict[str, int]:
+        """The `direct` integrator's emitter_samples and bsdf_samples."""
+        n = self.samples
+        emitter, bsdf = {"mis": (n, n), "emitter": (n, 0), "bsdf": (0, n)}[self.strategy]
+        return {"emitter_samples": emitter, "bsdf_samples": bsdf}
+
+
+# Glint's environment sampling (`--environment-sampling`), tried on scenes with an environment.
+GLINT_STRATEGIES = ["luminance", "cosine"]
+# Mitsuba's `direct` integrator: emitter and BSDF samples combined by MIS, or either alone.
+MITSUBA_STRATEGIES = ["mis", "emitter", "bsdf"]
 
 
 @dataclass
@@ -144,7 +161,8 @@ class Glint:
             "--stats-json", str(stats),
         ]
         if scene.has_environment:
-            args += ["--environment-samples", str(cfg.samples), "--environment-sampler", cfg.pattern]
+            args += ["--environment-samples", str(cfg.samples), "--environment-sampler", cfg.pattern,
+                     "--environment-sampling", cfg.strategy or "luminance"]
         t0 = time.perf_counter()
         r = self.run(args, f"{scene.name}: glint render")
         wall = time.perf_counter() - t0
@@ -210,13 +228,13 @@ class MitsubaScenes:
         count = sampler.find("integer[@name='sample_count']")
         if count is not None:
             count.set("value", "16")
-        for name in ("emitter_samples", "bsdf_samples"):
+        for name, value in cfg.mitsuba_samples().items():
             e = integrator.find(f"integer[@name='{name}']")
             if e is None:
                 e = ET.SubElement(integrator, "integer", name=name)
-            e.set("value", str(cfg.samples))
+            e.set("value", str(value))
         # Beside the export, so that its relative asset paths resolve.
-        out = self.xml.with_name(f"{self.xml.stem}-{cfg.pattern}-{cfg.samples}.xml")
+        out = self.xml.with_name(f"{self.xml.stem}-{cfg.pattern}-{cfg.samples}-{cfg.strategy}.xml")
         tree.write(out, encoding="utf-8", xml_declaration=True)
         return out
 
@@ -303,8 +321,10 @@ def run_scene(args, scene: Scene, glint: Glint, ms: compare.Mitsuba, out_dir: Pa
         log(f"export: {w}")
     mscenes = MitsubaScenes(ms, xml)
 
-    gcfgs = [Config("glint", p, n) for p in args.glint_patterns for n in args.glint_samples]
-    mcfgs = [Config("mitsuba", s, n) for s in args.mitsuba_samplers for n in args.mitsuba_samples]
+    gstrategies = args.glint_environment_sampling if scene.has_environment else ["luminance"]
+    gcfgs = [Config("glint", p, n, s) for p in args.glint_patterns for n in args.glint_samples for s in gstrategies]
+    mcfgs = [Config("mitsuba", p, n, s) for p in args.mitsuba_samplers for n in args.mitsuba_samples
+             for s in args.mitsuba_strategies]
 
     # References: two independent halves each (seeds far from the ladder's), so that
     # their difference estimates the reference's own noise, which adds to every
@@ -312,7 +332,7 @@ def run_scene(args, scene: Scene, glint: Glint, ms: compare.Mitsuba, out_dir: Pa
     refs = {}
     t_ref = time.perf_counter()
     half_spp = args.glint_reference_spp // 2
-    gref_cfg = Config("glint", "sobol", args.glint_reference_samples)
+    gref_cfg = Config("glint", "sobol", args.glint_reference_samples, "luminance")
     halves = []
     for k in range(2):
         p = work / f"glint-reference-{k}.exr"
@@ -324,7 +344,7 @@ def run_scene(args, scene: Scene, glint: Glint, ms: compare.Mitsuba, out_dir: Pa
     refs["glint"] = {"path": gref, "floor": glint.rel_mse(halves[0], halves[1]) / 4}
 
     half_spp = args.mitsuba_reference_spp // 2
-    mref_cfg = Config("mitsuba", args.mitsuba_reference_sampler, args.mitsuba_reference_samples)
+    mref_cfg = Config("mitsuba", args.mitsuba_reference_sampler, args.mitsuba_reference_samples, "mis")
     # One wavefront of W·H·spp lanes holds all of a pass in memory: split the half
     # into equal passes of at most --mitsuba-pass-lanes, each a count the sampler
     # takes as it is.
@@ -497,6 +517,7 @@ def run_scene(args, scene: Scene, glint: Glint, ms: compare.Mitsuba, out_dir: Pa
                 at[str(target)] = {"time_s": est["median"][0], "how": est["median"][1],
                                    "time_min_s": est["min"][0], "time_max_s": est["max"][0]}
             ladders.append({"renderer": renderer, "pattern": cfg.pattern, "samples": cfg.samples,
+                            "strategy": cfg.strategy,
                             "label": cfg.label, "timed": cfg in timed, "rungs": rungs, "at": at,
                             "mitsuba_first_render_s": first.get(cfg)})
 
@@ -640,8 +661,13 @@ def parse_args(argv):
                    help="Glint's light (and environment) samples per camera sample (default 1,4,16)")
     p.add_argument("--mitsuba-samplers", type=name_list(["independent", "stratified", "multijitter", "ldsampler", "orthogonal"]),
                    default=["independent", "multijitter", "ldsampler"], help="Mitsuba's samplers (default independent,multijitter,ldsampler)")
+    p.add_argument("--glint-environment-sampling", type=name_list(GLINT_STRATEGIES), default=GLINT_STRATEGIES,
+                   help="Glint's environment sampling on scenes with an environment (default luminance,cosine)")
     p.add_argument("--mitsuba-samples", type=int_list, default=[1, 4, 16],
-                   help="the direct integrator's emitter_samples = bsdf_samples (default 1,4,16)")
+                   help="the direct integrator's emitter_samples and bsdf_samples (default 1,4,16)")
+    p.add_argument("--mitsuba-strategies", type=name_list(MITSUBA_STRATEGIES), default=MITSUBA_STRATEGIES,
+                   help="the direct integrator's techniques: mis (emitter_samples = bsdf_samples), emitter "
+                        "(bsdf_samples = 0) or bsdf (emitter_samples = 0) (default mis,emitter,bsdf)")
     p.add_argument("--pairs", type=int, default=3, help="alternated rounds per rung (default 3)")
     p.add_argument("--glint-reference-spp", type=int, default=512, help="Glint's reference: spp, in two halves (default 512)")
     p.add_argument("--glint-reference-samples", type=int, default=4,

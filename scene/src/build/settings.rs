@@ -18,6 +18,7 @@ pub(super) fn settings(render: &RenderTable) -> Result<RenderSettings, Problem> 
         max_depth: *render.max_depth.get_ref(),
         environment_samples: *render.environment_samples.get_ref(),
         environment_pattern: render.environment_sampler.get_ref().0,
+        environment_sampling: render.environment_sampling.0,
         stats: false,
         area_sampling: render.area_sampling.0,
         mis: render.mis,

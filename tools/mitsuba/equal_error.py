@@ -18,6 +18,7 @@ as EXR and measured by ``glint diff`` too.
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import math
 import os
@@ -259,6 +260,14 @@ class MitsubaScenes:
     def render(self, cfg: Config, spp: int, seed: int):
         return self.ms.render(self.scene(cfg), spp, seed)
 
+    def release(self, cfgs: list[Config]):
+        """Frees the scenes of configurations no longer rendered. Every loaded
+        scene slows each render of the others: 1 spp of one configuration took
+        17 ms with 9 loaded and 43 ms with 27 (AMD EPYC)."""
+        for cfg in cfgs:
+            self.loaded.pop(cfg, None)
+        gc.collect()
+
     def write(self, img, path: Path):
         self.ms.mi.Bitmap(img).write(str(path))
 
@@ -455,6 +464,7 @@ def run_scene(args, scene: Scene, glint: Glint, ms: compare.Mitsuba, out_dir: Pa
     for cfg in gcfgs + mcfgs:
         if cfg not in timed:
             log(f"screened out: {cfg.renderer} {cfg.label}")
+    mscenes.release([c for c in mcfgs if c not in timed])
 
     jobs = {r: [(c, s) for c in cfgs if c in timed for s in rungs_of[c]] for r, cfgs in (("glint", gcfgs), ("mitsuba", mcfgs))}
     runs = {key: [] for key in ((c, s) for r in jobs.values() for c, s in r)}

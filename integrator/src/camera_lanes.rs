@@ -342,8 +342,9 @@ impl DirectIntegrator {
     }
 
     /// `environment_light` at every lane's diffuse point: each lane's `n`
-    /// samples of the map drawn together across the lanes
-    /// ([`EnvironmentLight::sample_each`]) at its camera sample's points, then
+    /// samples drawn together across the lanes at its camera sample's points,
+    /// from the map ([`EnvironmentLight::sample_each`]) or about each lane's
+    /// normal ([`EnvironmentLight::sample_cosine_each`]), then
     /// `L · kd/π · cos θ / p` and the shadow rays in lanes, each lane summing
     /// its own samples in order, bit for bit `add_environment_samples`.
     fn environment_term_lanes<T: Tracer>(

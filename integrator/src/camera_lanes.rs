@@ -480,6 +480,8 @@ impl DirectIntegrator {
         if lit == 0 {
             return Vec3Lanes::default();
         }
+        let by_area =
+            (samplers.iter().flatten()).all(|s| matches!(s, AreaLightSampler::Area { .. }));
         let grid = self.grid_points(pair, ctx);
         let sequences = (self.light_pattern == SamplePattern::Sobol)
             .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
@@ -500,18 +502,16 @@ impl DirectIntegrator {
                 (None, Some(sequences)) => sequences.points(j, n),
                 (None, None) => unreachable!("physical_in_lanes admits grid and Sobol points"),
             };
-            let (ux, uy) = (ux.to_array(), uy.to_array());
-            let mut positions = points;
-            let mut pdfs = [0.0; LANES];
-            for k in lanes::each_set(lit) {
-                let s = samplers[k]
-                    .as_ref()
-                    .expect("a lit lane")
-                    .sample(Vec2::new(ux[k], uy[k]));
-                (positions[k], pdfs[k]) = (s.point, s.pdf);
-            }
-            let position = Vec3Lanes::from_lanes(positions);
-            let pdf = F32Lanes::new(pdfs);
+            let (position, pdf) = if by_area {
+                let (position, pdf) = area.sample_by_area_lanes(&shaded.point, (ux, uy));
+                let lit = lanes::from_bits(lit);
+                (
+                    Vec3Lanes::select(lit, &position, &shaded.point),
+                    F32Lanes::select(lit, pdf, F32Lanes::ZERO),
+                )
+            } else {
+                each_lanes_sample(&samplers, &points, lit, (ux, uy))
+            };
             let (values, traced) = at.light_samples(&position, pdf, lit, &mut ctx.counters);
             let towards = position - shaded.point;
             let ends = area.shadow_ends(&position);
@@ -689,6 +689,28 @@ impl<'a> FirstHits<'a> {
             SurfaceKind::Emitter(_) => Self::Several,
         }
     }
+}
+
+/// Each lit lane's point on the light and its density, drawn by its own
+/// sampler at its `(ux, uy)`; the other lanes keep their shading point and a
+/// zero density.
+fn each_lanes_sample(
+    samplers: &[Option<AreaLightSampler>; LANES],
+    points: &[Vec3; LANES],
+    lit: u32,
+    (ux, uy): (F32Lanes, F32Lanes),
+) -> (Vec3Lanes, F32Lanes) {
+    let (ux, uy) = (ux.to_array(), uy.to_array());
+    let mut positions = *points;
+    let mut pdfs = [0.0; LANES];
+    for k in lanes::each_set(lit) {
+        let s = samplers[k]
+            .as_ref()
+            .expect("a lit lane")
+            .sample(Vec2::new(ux[k], uy[k]));
+        (positions[k], pdfs[k]) = (s.point, s.pdf);
+    }
+    (Vec3Lanes::from_lanes(positions), F32Lanes::new(pdfs))
 }
 
 /// The shading points of up to [`LANES`] lanes: all at once where the lanes hit

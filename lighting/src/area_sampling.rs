@@ -19,6 +19,7 @@
 
 use crate::{AreaLight, SphericalRectangle};
 use glam::{Vec2, Vec3};
+use glint_geometry::lanes::{F32Lanes, Float, Vec3Lanes, Vector3};
 
 /// The solid angles (steradians) sampled by solid angle; outside, by area.
 /// Below about 3e-4 sr the f32 parametrisation's angles are too close together
@@ -168,18 +169,38 @@ impl AreaLightSampler<'_> {
     }
 }
 
+impl AreaLight {
+    /// [`AreaLightSampler::sample`] by area ([`AreaSampling::Area`]) for the
+    /// shading points `x`, sixteen at a time: each lane's point on the light
+    /// for its `(ux, uy)` and its density in solid angle, bit for bit the
+    /// scalar sample's.
+    #[inline]
+    pub fn sample_by_area_lanes(
+        &self,
+        x: &Vec3Lanes,
+        (ux, uy): (F32Lanes, F32Lanes),
+    ) -> (Vec3Lanes, F32Lanes) {
+        let y = self.sample_points(ux, uy);
+        let pdf = area_pdf_of(self, x, &y);
+        (y, pdf)
+    }
+}
+
 /// `‖y − x‖² / (A · |cos θ′|)`: the area density `1/A` per unit solid angle at `x`.
 #[inline]
 fn area_pdf(light: &AreaLight, x: Vec3, y: Vec3) -> f32 {
-    let d = y - x;
-    let distance2 = d.length_squared();
-    let cos_light = light.surface().normal().dot(d).abs() / distance2.sqrt();
-    let denominator = light.surface().area() * cos_light;
-    if denominator > 0.0 {
-        distance2 / denominator
-    } else {
-        0.0
-    }
+    let at = |v: Vec3| Vector3::new(v.x, v.y, v.z);
+    area_pdf_of(light, &at(x), &at(y))
+}
+
+/// [`area_pdf`] in one lane or in many, the same bits in each.
+#[inline(always)]
+fn area_pdf_of<F: Float>(light: &AreaLight, x: &Vector3<F>, y: &Vector3<F>) -> F {
+    let d = Vector3::new(y.x - x.x, y.y - x.y, y.z - x.z);
+    let distance2 = d.dot(&d);
+    let cos_light = d.dot_splat(light.surface().normal()).abs() / distance2.sqrt();
+    let denominator = F::splat(light.surface().area()) * cos_light;
+    F::select(denominator.gt(F::ZERO), distance2 / denominator, F::ZERO)
 }
 
 #[cfg(test)]
@@ -195,6 +216,45 @@ mod tests {
         )
         .unwrap()
         .facing(-Vec3::Y)
+    }
+
+    /// Samples by area in lanes are each lane's scalar sample, bit for bit,
+    /// from points near and far, oblique, and in the light's plane (density 0).
+    #[test]
+    fn samples_by_area_in_lanes_are_each_lanes_sample() {
+        use glint_geometry::lanes::{self, LANES};
+        let light = light();
+        let points: [Vec3; LANES] = std::array::from_fn(|k| match k {
+            0 => Vec3::new(0.3, 2.0, 0.5),
+            1 => Vec3::new(5.0, 2.0, -1.0),
+            2 => Vec3::new(0.5, 1.999, 1.0),
+            _ => Vec3::new(
+                0.7 * k as f32 - 4.0,
+                -0.3 * k as f32,
+                (1.3 * k as f32).sin(),
+            ),
+        });
+        let x = Vec3Lanes::from_lanes(points);
+        for i in 0..32 {
+            let u: [Vec2; LANES] = std::array::from_fn(|k| {
+                Vec2::new(
+                    ((i * LANES + k) as f32 * 0.618_034).fract(),
+                    (i as f32 + 0.5) / 32.0,
+                )
+            });
+            let us = (lanes::from_fn(|k| u[k].x), lanes::from_fn(|k| u[k].y));
+            let (y, pdf) = light.sample_by_area_lanes(&x, us);
+            for k in 0..LANES {
+                let s = light.sampler(points[k], AreaSampling::Area).sample(u[k]);
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                assert_eq!(bits(y.lane(k)), bits(s.point), "lane {k}, point {i}");
+                assert_eq!(
+                    pdf.to_array()[k].to_bits(),
+                    s.pdf.to_bits(),
+                    "lane {k}, point {i}"
+                );
+            }
+        }
     }
 
     /// Both samplers estimate the solid angle the light subtends, `∫ 1 dω`,

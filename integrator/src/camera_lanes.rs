@@ -465,12 +465,12 @@ impl DirectIntegrator {
         let n = self.light_samples;
         let center = area.surface().center();
         let points: [Vec3; LANES] = lanes::array_from_fn(|k| shaded.point.lane(k));
-        let mut lit = 0u32;
+        let lit = area.illuminates_lanes(&Vec3Lanes::splat(center), &shaded.point);
+        let lit = shaded.lanes & lanes::bits(lit);
         let mut samplers: [Option<AreaLightSampler>; LANES] = std::array::from_fn(|_| None);
-        for k in lanes::each_set(shaded.lanes) {
-            if area.illuminates(center, points[k]) {
+        if lit & area.by_solid_angle_lanes(&shaded.point, self.area_sampling) != 0 {
+            for k in lanes::each_set(lit) {
                 samplers[k] = Some(area.sampler(points[k], self.area_sampling));
-                lit |= 1 << k;
             }
         }
         let counters = &mut ctx.counters;

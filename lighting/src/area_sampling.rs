@@ -19,7 +19,7 @@
 
 use crate::{AreaLight, SphericalRectangle};
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{F32Lanes, Float, Vec3Lanes, Vector3};
+use glint_geometry::lanes::{F32Lanes, Float, Mask, Vec3Lanes, Vector3};
 
 /// The solid angles (steradians) sampled by solid angle; outside, by area.
 /// Below about 3e-4 sr the f32 parametrisation's angles are too close together
@@ -107,10 +107,8 @@ impl AreaLight {
             AreaSampling::SolidAngle => true,
             AreaSampling::Area => false,
             AreaSampling::Auto => {
-                let d = surface.center() - reference;
-                let distance2 = d.length_squared();
-                let projected = surface.area() * surface.normal().dot(d).abs();
-                projected >= AUTO_SOLID_ANGLE_FROM * distance2 * distance2.sqrt()
+                let reference = Vector3::new(reference.x, reference.y, reference.z);
+                self.subtends_enough(&reference)
             }
         };
         if by_solid_angle {
@@ -170,6 +168,37 @@ impl AreaLightSampler<'_> {
 }
 
 impl AreaLight {
+    /// Whether [`AreaSampling::Auto`] would sample this light by solid angle
+    /// from `reference`: its solid angle, estimated as `A·|cos θ′|/d²` from
+    /// its centre, is at least [`AUTO_SOLID_ANGLE_FROM`]. In one lane or in
+    /// many, the same answer in each.
+    #[inline(always)]
+    fn subtends_enough<F: Float>(&self, reference: &Vector3<F>) -> F::Mask {
+        let surface = self.surface();
+        let c = surface.center();
+        let d = Vector3::new(
+            F::splat(c.x) - reference.x,
+            F::splat(c.y) - reference.y,
+            F::splat(c.z) - reference.z,
+        );
+        let distance2 = d.dot(&d);
+        let projected = F::splat(surface.area()) * d.dot_splat(surface.normal()).abs();
+        projected.ge(F::splat(AUTO_SOLID_ANGLE_FROM) * distance2 * distance2.sqrt())
+    }
+
+    /// The lanes of the points `reference` (bit k for lane k) that `strategy`
+    /// may sample by solid angle ([`Self::sampler`] still falls back to area
+    /// where the rectangle's parametrisation does); the others it samples by
+    /// area.
+    #[inline]
+    pub fn by_solid_angle_lanes(&self, reference: &Vec3Lanes, strategy: AreaSampling) -> u32 {
+        match strategy {
+            AreaSampling::SolidAngle => u32::MAX,
+            AreaSampling::Area => 0,
+            AreaSampling::Auto => self.subtends_enough(reference).bits(),
+        }
+    }
+
     /// [`AreaLightSampler::sample`] by area ([`AreaSampling::Area`]) for the
     /// shading points `x`, sixteen at a time: each lane's point on the light
     /// for its `(ux, uy)` and its density in solid angle, bit for bit the
@@ -219,15 +248,17 @@ mod tests {
     }
 
     /// Samples by area in lanes are each lane's scalar sample, bit for bit,
-    /// from points near and far, oblique, and in the light's plane (density 0).
+    /// from points near and far, oblique, and in the light's plane (density 0);
+    /// so is `Auto`'s choice of solid angle.
     #[test]
     fn samples_by_area_in_lanes_are_each_lanes_sample() {
         use glint_geometry::lanes::{self, LANES};
         let light = light();
         let points: [Vec3; LANES] = std::array::from_fn(|k| match k {
-            0 => Vec3::new(0.3, 2.0, 0.5),
+            0 => Vec3::new(0.1, 1.5, 0.2),
             1 => Vec3::new(5.0, 2.0, -1.0),
             2 => Vec3::new(0.5, 1.999, 1.0),
+            3 => Vec3::new(0.3, 2.0, 0.5),
             _ => Vec3::new(
                 0.7 * k as f32 - 4.0,
                 -0.3 * k as f32,
@@ -235,6 +266,23 @@ mod tests {
             ),
         });
         let x = Vec3Lanes::from_lanes(points);
+        // Auto's choice in lanes is each lane's: a lane it leaves out is
+        // sampled by area, one it keeps subtends at least the threshold.
+        let solid = light.by_solid_angle_lanes(&x, AreaSampling::Auto);
+        assert!(solid & 1 == 1 && solid & 2 == 0, "{solid:b}");
+        for (k, &p) in points.iter().enumerate() {
+            let by_area = matches!(
+                light.sampler(p, AreaSampling::Auto),
+                AreaLightSampler::Area { .. }
+            );
+            let kept = solid >> k & 1 == 1;
+            assert_eq!(
+                kept,
+                light.subtends_enough(&Vector3::new(p.x, p.y, p.z)),
+                "lane {k}"
+            );
+            assert!(kept || by_area, "lane {k}");
+        }
         for i in 0..32 {
             let u: [Vec2; LANES] = std::array::from_fn(|k| {
                 Vec2::new(

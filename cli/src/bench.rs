@@ -6,7 +6,8 @@ use clap::Args;
 use glam::UVec2;
 use glint_bench::budget::{parse_counts, parse_durations, sample_ladder, Ladder};
 use glint_bench::strategy::{
-    combine, parse_light_strategies, parse_samplers, parse_texture_filters,
+    combine, parse_environment_samplings, parse_light_strategies, parse_samplers,
+    parse_texture_filters, Choices,
 };
 use glint_bench::{BenchConfig, BenchError, Progress, ReferenceChoice, RegionChoice};
 use glint_metrics::Region;
@@ -48,6 +49,12 @@ pub(crate) struct BenchArgs {
     /// solid-angle+mis,solid-angle,area+mis,area [default: the scene's]
     #[arg(long, value_name = "LIST")]
     light_strategies: Option<String>,
+
+    /// Environment samplings to compare (each with every other choice),
+    /// comma-separated: luminance (the map's luminance) or cosine (the cosine
+    /// about the shading normal) [default: the scene's]
+    #[arg(long, value_name = "LIST")]
+    environment_samplings: Option<String>,
 
     /// Camera samples per pixel at each step of the ladder, comma-separated
     #[arg(long, value_name = "LIST", default_value = "1,4,16,64,256")]
@@ -198,6 +205,11 @@ fn config(args: &BenchArgs) -> Result<BenchConfig, Failure> {
         }
         None => Vec::new(),
     };
+    let environments = match &args.environment_samplings {
+        Some(list) => parse_environment_samplings(list)
+            .map_err(|e| input(format!("--environment-samplings: {e}")))?,
+        None => Vec::new(),
+    };
     let light = parse_counts("--light-samples", &args.light_samples, 1).map_err(input)?;
     let environment = match &args.environment_samples {
         Some(list) => parse_counts("--environment-samples", list, 0).map_err(input)?,
@@ -243,7 +255,14 @@ fn config(args: &BenchArgs) -> Result<BenchConfig, Failure> {
     };
     Ok(BenchConfig {
         scene: args.scene.clone(),
-        strategies: combine(&samplers, &filters, &lights),
+        strategies: combine(
+            &samplers,
+            &Choices {
+                filters,
+                lights,
+                environments,
+            },
+        ),
         ladder,
         repeat: args.repeat as usize,
         region,

@@ -1,9 +1,9 @@
 //! Strategies: what a bench compares. A strategy fixes where samples fall (the
 //! pixel, light and environment sample patterns) and, optionally, how every image
-//! texture is filtered and how physical shading samples area lights; everything
-//! else comes from the scene file.
+//! texture is filtered, how physical shading samples area lights and how the
+//! environment's directions are drawn; everything else comes from the scene file.
 
-use glint_integrator::{AreaSampling, RenderSettings, SamplePattern, Scene};
+use glint_integrator::{AreaSampling, EnvironmentSampling, RenderSettings, SamplePattern, Scene};
 use glint_texture::TextureFilter;
 
 /// One way of rendering the scene that the bench measures.
@@ -16,6 +16,8 @@ pub struct Strategy {
     pub texture_filter: Option<TextureChoice>,
     /// Overrides how physical shading samples area lights (`None`: the scene's).
     pub light_strategy: Option<LightStrategy>,
+    /// Overrides how environment directions are drawn (`None`: the scene's).
+    pub environment_sampling: Option<EnvironmentSampling>,
 }
 
 /// How physical shading samples area lights: the density of light samples,
@@ -91,13 +93,15 @@ impl Strategy {
             environment: pattern,
             texture_filter: None,
             light_strategy: None,
+            environment_sampling: None,
         }
     }
 
     /// The name the tables, files and plots use: `sobol` when one pattern places
     /// every sample, `PIXEL/LIGHT` or `PIXEL/LIGHT/ENVIRONMENT` otherwise, then
-    /// `+FILTER` when the texture filter is overridden and `+LIGHTS` when the
-    /// light strategy is (`sobol+area+mis`).
+    /// `+FILTER` when the texture filter is overridden, `+LIGHTS` when the
+    /// light strategy is (`sobol+area+mis`) and `+SAMPLING` when the
+    /// environment's sampling is (`sobol+cosine`).
     pub fn name(&self) -> String {
         let mut name = self.pixel.name().to_owned();
         if self.light != self.pixel || self.environment != self.light {
@@ -111,6 +115,9 @@ impl Strategy {
         }
         if let Some(lights) = self.light_strategy {
             name = format!("{name}+{}", lights.name());
+        }
+        if let Some(sampling) = self.environment_sampling {
+            name = format!("{name}+{}", sampling.name());
         }
         name
     }
@@ -134,6 +141,9 @@ impl Strategy {
         if let Some(lights) = self.light_strategy {
             settings.area_sampling = lights.sampling;
             settings.mis = lights.mis;
+        }
+        if let Some(sampling) = self.environment_sampling {
+            settings.environment_sampling = sampling;
         }
     }
 
@@ -167,17 +177,12 @@ pub fn parse_samplers(list: &str) -> Result<Vec<Strategy>, String> {
             [all] => Strategy::uniform(all),
             [pixel, light] => Strategy {
                 pixel,
-                light,
-                environment: light,
-                texture_filter: None,
-                light_strategy: None,
+                ..Strategy::uniform(light)
             },
             [pixel, light, environment] => Strategy {
-                pixel,
                 light,
                 environment,
-                texture_filter: None,
-                light_strategy: None,
+                ..Strategy::uniform(pixel)
             },
             _ => {
                 return Err(format!(
@@ -230,32 +235,55 @@ pub fn parse_light_strategies(list: &str) -> Result<Vec<LightStrategy>, String> 
     Ok(strategies)
 }
 
-/// Every sampler strategy with every texture filter and every light strategy
-/// (an empty list keeps the scene's own).
-pub fn combine(
-    samplers: &[Strategy],
-    filters: &[TextureChoice],
-    lights: &[LightStrategy],
-) -> Vec<Strategy> {
-    let filters: Vec<Option<TextureChoice>> = if filters.is_empty() {
-        vec![None]
-    } else {
-        filters.iter().copied().map(Some).collect()
-    };
-    let lights: Vec<Option<LightStrategy>> = if lights.is_empty() {
-        vec![None]
-    } else {
-        lights.iter().copied().map(Some).collect()
-    };
+/// Parses a list of environment samplings (`luminance,cosine`).
+pub fn parse_environment_samplings(list: &str) -> Result<Vec<EnvironmentSampling>, String> {
+    let mut samplings = Vec::new();
+    for name in list.split(',').map(str::trim) {
+        let sampling = EnvironmentSampling::from_name(name).ok_or_else(|| {
+            format!(
+                "unknown environment sampling \"{name}\", expected one of {}",
+                EnvironmentSampling::NAMES.join(", ")
+            )
+        })?;
+        if samplings.contains(&sampling) {
+            return Err(format!("environment sampling \"{name}\" is listed twice"));
+        }
+        samplings.push(sampling);
+    }
+    Ok(samplings)
+}
+
+/// What a bench varies besides the sample patterns; an empty list keeps the
+/// scene's own.
+#[derive(Clone, Debug, Default)]
+pub struct Choices {
+    pub filters: Vec<TextureChoice>,
+    pub lights: Vec<LightStrategy>,
+    pub environments: Vec<EnvironmentSampling>,
+}
+
+/// Every sampler strategy with every texture filter, every light strategy
+/// and every environment sampling of `choices`.
+pub fn combine(samplers: &[Strategy], choices: &Choices) -> Vec<Strategy> {
+    fn each<T: Copy>(list: &[T]) -> Vec<Option<T>> {
+        if list.is_empty() {
+            vec![None]
+        } else {
+            list.iter().copied().map(Some).collect()
+        }
+    }
     let mut all = Vec::new();
     for s in samplers {
-        for &texture_filter in &filters {
-            for &light_strategy in &lights {
-                all.push(Strategy {
-                    texture_filter,
-                    light_strategy,
-                    ..*s
-                });
+        for texture_filter in each(&choices.filters) {
+            for light_strategy in each(&choices.lights) {
+                for environment_sampling in each(&choices.environments) {
+                    all.push(Strategy {
+                        texture_filter,
+                        light_strategy,
+                        environment_sampling,
+                        ..*s
+                    });
+                }
             }
         }
     }
@@ -274,26 +302,34 @@ mod tests {
             names,
             ["sobol", "stratified/random", "grid/grid/random", "random"]
         );
-        let with_filter = combine(
-            &s[..1],
-            &[
+        let filters = Choices {
+            filters: vec![
                 TextureChoice::Filter(TextureFilter::Ewa),
                 TextureChoice::AnalyticCheckerboards,
             ],
-            &[],
-        );
+            ..Choices::default()
+        };
+        let with_filter = combine(&s[..1], &filters);
         assert_eq!(with_filter[0].name(), "sobol+ewa");
         assert_eq!(with_filter[1].name(), "sobol+analytic");
         let lights = parse_light_strategies("solid-angle+mis, area").unwrap();
-        let with_lights = combine(&s[..2], &[], &lights);
+        let environments = parse_environment_samplings("cosine").unwrap();
+        let with_lights = combine(
+            &s[..2],
+            &Choices {
+                lights,
+                environments,
+                ..Choices::default()
+            },
+        );
         let names: Vec<String> = with_lights.iter().map(Strategy::name).collect();
         assert_eq!(
             names,
             [
-                "sobol+solid-angle+mis",
-                "sobol+area",
-                "stratified/random+solid-angle+mis",
-                "stratified/random+area"
+                "sobol+solid-angle+mis+cosine",
+                "sobol+area+cosine",
+                "stratified/random+solid-angle+mis+cosine",
+                "stratified/random+area+cosine"
             ]
         );
         let mut settings = RenderSettings::default();
@@ -312,6 +348,7 @@ mod tests {
             (settings.area_sampling, settings.mis),
             (AreaSampling::Area, false)
         );
+        assert_eq!(settings.environment_sampling, EnvironmentSampling::Cosine);
         assert_eq!(
             parse_texture_filters("trilinear, analytic").unwrap(),
             [
@@ -327,6 +364,13 @@ mod tests {
         let e = parse_samplers("sobol,halton").unwrap_err();
         assert!(e.contains("\"halton\""), "{e}");
         let e = parse_samplers("sobol,sobol").unwrap_err();
+        assert!(e.contains("twice"), "{e}");
+        let e = parse_environment_samplings("cosine,uniform").unwrap_err();
+        assert!(
+            e.contains("\"uniform\"") && e.contains("luminance, cosine"),
+            "{e}"
+        );
+        let e = parse_environment_samplings("cosine, cosine").unwrap_err();
         assert!(e.contains("twice"), "{e}");
         let e = parse_samplers("a/b/c/d").unwrap_err();
         assert!(e.contains("unknown sampler"), "{e}");

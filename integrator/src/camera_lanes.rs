@@ -57,8 +57,8 @@ impl DirectIntegrator {
     /// Whether the first hits of `scene`'s camera samples can be shaded [`LANES`] at
     /// a time (`li_first_hits`): light points each sample can draw alone, and
     /// either the course's shading model with area and point lights, no
-    /// environment and no mirrors, or physical shading as
-    /// [`Self::physical_in_lanes`] admits it.
+    /// environment and no mirrors, or physical shading with area and point
+    /// lights as [`Self::physical_in_lanes`] admits it.
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
         let lights = |admitted: fn(&Light) -> bool| scene.lights.iter().all(admitted);
         self.light_samples_in_lanes()
@@ -69,7 +69,8 @@ impl DirectIntegrator {
                         && lights(|l| matches!(l, Light::Area(_) | Light::Point(_)))
                 }
                 ShadingModel::Physical => {
-                    lights(|l| matches!(l, Light::Area(_))) && self.physical_in_lanes(scene)
+                    lights(|l| matches!(l, Light::Area(_) | Light::Point(_)))
+                        && self.physical_in_lanes(scene)
                 }
             }
     }
@@ -200,8 +201,12 @@ impl DirectIntegrator {
                 }
                 Light::Point(point) => {
                     ctx.counters.point_light_samples += u64::from(shaded.lanes.count_ones());
-                    let reflected = shaded.point_light(scene, point, ctx);
-                    Vec3Lanes::scaled_splat_lanes(point.color, &reflected)
+                    if physical {
+                        shaded.physical_point_light(scene, point, ctx)
+                    } else {
+                        let reflected = shaded.point_light(scene, point, ctx);
+                        Vec3Lanes::scaled_splat_lanes(point.color, &reflected)
+                    }
                 }
                 Light::Sphere(_) => {
                     unreachable!("shades_first_hits_in_lanes admits no sphere lights")
@@ -958,6 +963,33 @@ impl<'a> ShadedLanes<'a> {
         let position = Vec3Lanes::splat(light.position);
         let s = LightSampleLanes::at(position, &self.point, &self.ng, self.lanes, reflect);
         self.unoccluded(scene, &s, &position, &Occluders::ALL, ctx)
+    }
+
+    /// Per lane, physical shading's `I · kd/π · cos θ / r²` of point light
+    /// `light` at a diffuse point, or zero where it is below the surface or
+    /// blocked: the scalar path's `point_light`, bit for bit, with its counts
+    /// (but the samples', which the caller counts).
+    fn physical_point_light<T: Tracer>(
+        &self,
+        scene: &Scene,
+        light: &PointLight,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let position = Vec3Lanes::splat(light.position);
+        let at = DiffusePoints {
+            point: &self.point,
+            ng: &self.ng,
+            n: self.phong.normals(),
+            kd: self.phong.kd(),
+        };
+        // A density of 1 leaves each lane's `kd/π · cos θ` as it is.
+        let (f, traced) = at.light_samples(&position, F32Lanes::ONE, self.lanes, &mut ctx.counters);
+        let towards = position - self.point;
+        let visible = traced & !self.blocked(scene, &Occluders::ALL, &position, &towards, traced);
+        let distance2 = towards.dot(&towards);
+        let lit = Vec3Lanes::scaled_splat_lanes(light.color, &f);
+        let value = Vec3Lanes::new(lit.x / distance2, lit.y / distance2, lit.z / distance2);
+        Vec3Lanes::select(lanes::from_bits(visible), &value, &Vec3Lanes::default())
     }
 
     /// The reflections of light samples `s` where their shadow rays, ending at

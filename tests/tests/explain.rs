@@ -91,6 +91,11 @@ fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
             scene("physical-environment", size, few),
         ),
         ("cornell-physical", scene("cornell-physical", size, few)),
+        // A point light under physical shading, in the camera-sample lanes.
+        (
+            "analytic-point-light",
+            scene("analytic-point-light", size, few),
+        ),
         // Environment directions by the cosine about each point's normal:
         // in lanes at first hits, a point's own in the scalar path.
         ("physical-environment, by the cosine", {

@@ -200,57 +200,48 @@ pub fn parse_samplers(list: &str) -> Result<Vec<Strategy>, String> {
 
 /// Parses a list of texture filters (`nearest,bilinear,trilinear,ewa,analytic`).
 pub fn parse_texture_filters(list: &str) -> Result<Vec<TextureChoice>, String> {
-    let mut filters = Vec::new();
-    for name in list.split(',').map(str::trim) {
-        let filter = TextureChoice::from_name(name).ok_or_else(|| {
-            format!(
-                "unknown texture filter \"{name}\", expected one of {}",
-                TextureChoice::NAMES.join(", ")
-            )
-        })?;
-        if filters.contains(&filter) {
-            return Err(format!("texture filter \"{name}\" is listed twice"));
-        }
-        filters.push(filter);
-    }
-    Ok(filters)
+    let expected = TextureChoice::NAMES.join(", ");
+    parse_names(list, "texture filter", TextureChoice::from_name, &expected)
 }
 
 /// Parses a list of light strategies (`solid-angle+mis,solid-angle,area+mis,area`).
 pub fn parse_light_strategies(list: &str) -> Result<Vec<LightStrategy>, String> {
-    let mut strategies = Vec::new();
-    for name in list.split(',').map(str::trim) {
-        let strategy = LightStrategy::from_name(name).ok_or_else(|| {
-            format!(
-                "unknown light strategy \"{name}\", expected one of {}, each \
-                 optionally followed by +mis",
-                AreaSampling::NAMES.join(", ")
-            )
-        })?;
-        if strategies.contains(&strategy) {
-            return Err(format!("light strategy \"{name}\" is listed twice"));
-        }
-        strategies.push(strategy);
-    }
-    Ok(strategies)
+    let expected = format!(
+        "{}, each optionally followed by +mis",
+        AreaSampling::NAMES.join(", ")
+    );
+    parse_names(list, "light strategy", LightStrategy::from_name, &expected)
 }
 
 /// Parses a list of environment samplings (`luminance,cosine`).
 pub fn parse_environment_samplings(list: &str) -> Result<Vec<EnvironmentSampling>, String> {
-    let mut samplings = Vec::new();
+    let expected = EnvironmentSampling::NAMES.join(", ");
+    parse_names(
+        list,
+        "environment sampling",
+        EnvironmentSampling::from_name,
+        &expected,
+    )
+}
+
+/// A comma-separated list of `what`s, each named once, refusing an unknown
+/// name (saying which names are `expected`) or one listed twice.
+fn parse_names<T: PartialEq>(
+    list: &str,
+    what: &str,
+    from_name: impl Fn(&str) -> Option<T>,
+    expected: &str,
+) -> Result<Vec<T>, String> {
+    let mut values = Vec::new();
     for name in list.split(',').map(str::trim) {
-        let sampling = EnvironmentSampling::from_name(name).ok_or_else(|| {
-            format!(
-                "unknown environment sampling \"{name}\", expected one of {}",
-                EnvironmentSampling::NAMES.join(", ")
-            )
-        })?;
-        if samplings.contains(&sampling) {
-            return Err(format!("environment sampling \"{name}\" is listed twice"));
+        let value = from_name(name)
+            .ok_or_else(|| format!("unknown {what} \"{name}\", expected one of {expected}"))?;
+        if values.contains(&value) {
+            return Err(format!("{what} \"{name}\" is listed twice"));
         }
-        samplings.push(sampling);
+        values.push(value);
     }
-    Ok(samplings)
+    Ok(values)
 }
 
 /// What a bench varies besides the sample patterns; an empty list keeps the

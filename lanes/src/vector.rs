@@ -164,6 +164,25 @@ impl<F: Float> Vector3<F> {
         self.scale(F::ONE / self.dot(self).sqrt())
     }
 
+    /// Two unit vectors that make an orthonormal basis with the unit `self`,
+    /// as glam's `Vec3::any_orthonormal_pair` makes them, bit for bit: the
+    /// branch-free basis of Duff et al., "Building an Orthonormal Basis,
+    /// Revisited" (JCGT 6(1), 2017).
+    #[inline(always)]
+    pub fn any_orthonormal_pair(&self) -> (Self, Self) {
+        let sign = self.z.signum();
+        let a = -(F::ONE / (sign + self.z));
+        let b = self.x * self.y * a;
+        (
+            Self::new(
+                F::ONE + sign * self.x * self.x * a,
+                sign * b,
+                -(sign * self.x),
+            ),
+            Self::new(b, sign + self.y * self.y * a, -self.y),
+        )
+    }
+
     /// The lanes equal to zero in every component (as `Vec3 == Vec3::ZERO`).
     #[inline(always)]
     pub fn is_zero(&self) -> F::Mask {
@@ -192,5 +211,47 @@ impl<F: Float> std::ops::Neg for Vector3<F> {
     #[inline(always)]
     fn neg(self) -> Self {
         Self::new(-self.x, -self.y, -self.z)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{F32Lanes, LANES};
+
+    /// The basis is glam's, bit for bit, in one lane and in many: on every
+    /// axis, either side of z = 0 (the sign's switch, −0 included) and at
+    /// random.
+    #[test]
+    fn orthonormal_pairs_are_glams_in_every_lane() {
+        let normals: [Vec3; LANES] = std::array::from_fn(|k| match k {
+            0 => Vec3::Z,
+            1 => -Vec3::Z,
+            2 => Vec3::X,
+            3 => Vec3::new(0.6, 0.8, -0.0),
+            4 => Vec3::new(0.0, -1.0, -1e-7).normalize(),
+            _ => {
+                let a = 0.9 * k as f32;
+                Vec3::new(a.sin(), (0.4 * k as f32).cos(), a.cos() - 0.3).normalize()
+            }
+        });
+        let lanes = Vector3::new(
+            F32Lanes::new(normals.map(|n| n.x)),
+            F32Lanes::new(normals.map(|n| n.y)),
+            F32Lanes::new(normals.map(|n| n.z)),
+        );
+        let (t, b) = lanes.any_orthonormal_pair();
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        for (k, n) in normals.iter().enumerate() {
+            let (gt, gb) = n.any_orthonormal_pair();
+            let (st, sb) = Vector3::new(n.x, n.y, n.z).any_orthonormal_pair();
+            let lane = |v: &Vector3<F32Lanes>| {
+                Vec3::new(v.x.to_array()[k], v.y.to_array()[k], v.z.to_array()[k])
+            };
+            assert_eq!(bits(Vec3::new(st.x, st.y, st.z)), bits(gt), "{n}");
+            assert_eq!(bits(Vec3::new(sb.x, sb.y, sb.z)), bits(gb), "{n}");
+            assert_eq!(bits(lane(&t)), bits(gt), "lane {k}");
+            assert_eq!(bits(lane(&b)), bits(gb), "lane {k}");
+        }
     }
 }

@@ -386,19 +386,15 @@ fn cube_jacobian(st: Vec2) -> f32 {
 /// bits in each. Malley's method (pbrt-v4 §A.5.3): a uniform point on the
 /// unit disk at radius `√u` and angle `2πv − π` (within [−π, π), where
 /// [`sin_cos_approx`] holds), raised to the hemisphere, `cos θ = √(1 − u)`;
-/// the disk's axes are the frame of Duff et al., "Building an Orthonormal
-/// Basis, Revisited" (JCGT 6(1), 2017), which has no branch.
+/// the disk's axes are [`Vector3::any_orthonormal_pair`] (glam's, with no
+/// branch).
 #[inline(always)]
 pub(crate) fn cosine_direction_of<F: Float>(n: &Vector3<F>, u: F, v: F) -> (Vector3<F>, F) {
     let r = u.sqrt();
     let (sin_phi, cos_phi) = sin_cos_approx(v * F::splat(2.0 * PI) - F::splat(PI));
     let (x, y) = (r * cos_phi, r * sin_phi);
     let cos_theta = (F::ONE - u).max(F::ZERO).sqrt();
-    let sign = n.z.signum();
-    let a = -(F::ONE / (sign + n.z));
-    let b = n.x * n.y * a;
-    let tangent = Vector3::new(F::ONE + sign * n.x * n.x * a, sign * b, -(sign * n.x));
-    let bitangent = Vector3::new(b, sign + n.y * n.y * a, -n.y);
+    let (tangent, bitangent) = n.any_orthonormal_pair();
     let direction = Vector3::new(
         tangent.x * x + bitangent.x * y + n.x * cos_theta,
         tangent.y * x + bitangent.y * y + n.y * cos_theta,

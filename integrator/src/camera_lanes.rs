@@ -49,7 +49,7 @@ use glint_geometry::{
 };
 use glint_lighting::{
     AreaLight, AreaLightSampler, EnvironmentLight, Light, PhongLanes, PhongMaterial, PointLight,
-    ShadingModel, UvTransform,
+    ShadingModel, SphereLight, UvTransform,
 };
 use glint_texture::{Checkerboard, TexCoord, Texture};
 
@@ -69,7 +69,7 @@ impl DirectIntegrator {
                         && lights(|l| matches!(l, Light::Area(_) | Light::Point(_)))
                 }
                 ShadingModel::Physical => {
-                    lights(|l| matches!(l, Light::Area(_) | Light::Point(_)))
+                    lights(|l| matches!(l, Light::Area(_) | Light::Point(_) | Light::Sphere(_)))
                         && self.physical_in_lanes(scene)
                 }
             }
@@ -185,12 +185,13 @@ impl DirectIntegrator {
         let mut pairs = PairAllocation::new(0);
         let physical = scene.shading == ShadingModel::Physical;
         for (index, light) in scene.lights.iter().enumerate() {
+            // The dimensions `light_pair` gives a light that samples.
+            let own = DimensionPair::Light {
+                light: index as u32,
+                depth: 0,
+            };
             let term = match light {
                 Light::Area(area) => {
-                    let own = DimensionPair::Light {
-                        light: index as u32,
-                        depth: 0,
-                    };
                     let pair = pairs.take(own, self.light_samples);
                     let points = (samples, pair, &mut rngs);
                     if physical {
@@ -208,8 +209,10 @@ impl DirectIntegrator {
                         Vec3Lanes::scaled_splat_lanes(point.color, &reflected)
                     }
                 }
-                Light::Sphere(_) => {
-                    unreachable!("shades_first_hits_in_lanes admits no sphere lights")
+                Light::Sphere(sphere) => {
+                    debug_assert!(physical, "the course's model admits no sphere lights");
+                    let pair = pairs.take(own, self.light_samples);
+                    self.physical_sphere_light_term(scene, shaded, sphere, (samples, pair), ctx)
                 }
             };
             radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
@@ -499,14 +502,7 @@ impl DirectIntegrator {
         };
         let mut sum = Vec3Lanes::default();
         for j in 0..n {
-            let (ux, uy) = match (&grid, &sequences) {
-                (Some(grid), _) => {
-                    let p = grid.get(j as usize);
-                    (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
-                }
-                (None, Some(sequences)) => sequences.points(j, n),
-                (None, None) => unreachable!("physical_in_lanes admits grid and Sobol points"),
-            };
+            let (ux, uy) = light_points_at(&grid, &sequences, j, n);
             let (position, pdf) = if by_area {
                 let (position, pdf) = area.sample_by_area_lanes(&shaded.point, (ux, uy));
                 let lit = lanes::from_bits(lit);
@@ -528,6 +524,55 @@ impl DirectIntegrator {
             ctx.light_points = grid;
         }
         Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(n as f32)
+    }
+
+    /// `physical_sphere_light`'s `L · Σ (kd/π · cos θ / p · V) / n` for sphere
+    /// light `light` at every lane's diffuse point, each lane summing its own
+    /// `n` directions uniform over its cone ([`SphereLight::sample_lanes`]) at
+    /// the points of `pair` for the lanes' camera samples. A lane inside the
+    /// sphere takes no sample: its term is +0, as `li_at` adds `Vec3::ZERO`.
+    fn physical_sphere_light_term<T: Tracer>(
+        &self,
+        scene: &Scene,
+        shaded: &ShadedLanes,
+        light: &SphereLight,
+        (samples, pair): (&LaneSamples, DimensionPair),
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let n = self.light_samples;
+        let (lit, _, _) = light.sample_lanes(&shaded.point, (F32Lanes::ZERO, F32Lanes::ZERO));
+        let lit = lit & shaded.lanes;
+        let counters = &mut ctx.counters;
+        counters.light_samples += u64::from(n) * u64::from(shaded.lanes.count_ones());
+        counters.light_skips.behind_light +=
+            u64::from(n) * u64::from((shaded.lanes & !lit).count_ones());
+        if lit == 0 {
+            return Vec3Lanes::default();
+        }
+        let grid = self.grid_points(pair, ctx);
+        let sequences = (self.light_pattern == SamplePattern::Sobol)
+            .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
+        let at = DiffusePoints {
+            point: &shaded.point,
+            ng: &shaded.ng,
+            n: shaded.phong.normals(),
+            kd: shaded.phong.kd(),
+        };
+        let mut sum = Vec3Lanes::default();
+        for j in 0..n {
+            let u = light_points_at(&grid, &sequences, j, n);
+            let (_, [point, error, normal], pdf) = light.sample_lanes(&shaded.point, u);
+            let (values, traced) = at.light_samples(&point, pdf, lit, &mut ctx.counters);
+            let towards = point - shaded.point;
+            let ends = offset_ray_origins(&point, &error, &normal);
+            let visible = traced & !shaded.blocked(scene, &Occluders::ALL, &ends, &towards, traced);
+            let zero = Vec3Lanes::default();
+            sum = sum + Vec3Lanes::select(lanes::from_bits(visible), &values, &zero);
+        }
+        if let Some(grid) = grid {
+            ctx.light_points = grid;
+        }
+        Vec3Lanes::scaled_splat_lanes(light.color, &sum).div_splat(n as f32)
     }
 
     /// The grid pattern's points for `pair` (the same for every camera sample),
@@ -696,6 +741,24 @@ impl<'a> FirstHits<'a> {
     }
 }
 
+/// Light sample `j` of `n` in every lane: the grid's point `j` in all of
+/// them, or each lane's Sobol point.
+fn light_points_at(
+    grid: &Option<SamplePoints>,
+    sequences: &Option<RunSequences>,
+    j: u32,
+    n: u32,
+) -> (F32Lanes, F32Lanes) {
+    match (grid, sequences) {
+        (Some(grid), _) => {
+            let p = grid.get(j as usize);
+            (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
+        }
+        (None, Some(sequences)) => sequences.points(j, n),
+        (None, None) => unreachable!("physical_in_lanes admits grid and Sobol points"),
+    }
+}
+
 /// Each lit lane's point on the light and its density, drawn by its own
 /// sampler at its `(ux, uy)`; the other lanes keep their shading point and a
 /// zero density.
@@ -791,8 +854,7 @@ impl<'a> ShadedLanes<'a> {
                 continue;
             };
             match scene.surface_of(&hit) {
-                SurfaceKind::Emitter(Light::Area(area)) => radiance.set_lane(k, area.color),
-                SurfaceKind::Emitter(_) => {}
+                SurfaceKind::Emitter(light) => radiance.set_lane(k, light.emitted()),
                 SurfaceKind::Material(material) if material.uses_footprint() => {
                     let Some(hit) = scene.shapes.surface_record(&ray, found) else {
                         continue;

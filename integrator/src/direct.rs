@@ -892,11 +892,7 @@ struct SurfaceHit<'a> {
 
 /// The radiance of a light's surface seen directly: its color.
 fn emitted<T: Tracer>(light: &Light, ctx: &mut SampleContext<T>) -> Vec3 {
-    let radiance = match light {
-        Light::Area(area) => area.color,
-        Light::Sphere(sphere) => sphere.color,
-        _ => Vec3::ZERO,
-    };
+    let radiance = light.emitted();
     ctx.tracer.record(|| Event::Emitter { radiance });
     radiance
 }

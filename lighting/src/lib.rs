@@ -54,6 +54,18 @@ pub enum Light {
     Sphere(SphereLight),
 }
 
+impl Light {
+    /// The radiance a ray that meets the light's surface sees (a point
+    /// light has none).
+    pub fn emitted(&self) -> glam::Vec3 {
+        match self {
+            Light::Area(area) => area.color,
+            Light::Sphere(sphere) => sphere.color,
+            Light::Point(_) => glam::Vec3::ZERO,
+        }
+    }
+}
+
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;

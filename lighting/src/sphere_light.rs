@@ -11,8 +11,10 @@
 //! `sin²θ_max / (1 + cos θ_max)`, which keeps its digits.
 
 use glam::{Vec2, Vec3};
+use glint_geometry::error_bounds::gamma;
+use glint_geometry::lanes::{sin_cos_approx, F32Lanes, Float, Mask, Vec3Lanes, Vector3};
 use glint_geometry::{RayTarget, Sphere};
-use std::f32::consts::TAU;
+use std::f32::consts::{PI, TAU};
 
 /// A sphere emitting radiance `color` (W/(sr·m²) per channel) outwards from
 /// every point of its surface.
@@ -50,18 +52,29 @@ impl SphereLight {
     /// there).
     #[inline]
     fn cone(&self, x: Vec3) -> Option<(Vec3, f32, f32)> {
-        let to_centre = self.surface.center() - x;
-        let d2 = to_centre.length_squared();
+        let (outside, axis, d, one_minus_cos) = self.cone_of(&Vector3::new(x.x, x.y, x.z));
+        outside.then(|| (Vec3::new(axis.x, axis.y, axis.z), d, one_minus_cos))
+    }
+
+    /// [`Self::cone`] in one lane or in many, the same bits in each: whether
+    /// `x` is outside the sphere (false for a NaN distance too), and the cone.
+    #[inline(always)]
+    fn cone_of<F: Float>(&self, x: &Vector3<F>) -> (F::Mask, Vector3<F>, F, F) {
+        let c = self.surface.center();
+        let to_centre = Vector3::new(
+            F::splat(c.x) - x.x,
+            F::splat(c.y) - x.y,
+            F::splat(c.z) - x.z,
+        );
+        let d2 = to_centre.dot(&to_centre);
         let r = self.surface.radius();
-        // Also refuses a NaN distance.
-        if d2.partial_cmp(&(r * r)) != Some(std::cmp::Ordering::Greater) {
-            return None;
-        }
-        let sin2 = (r * r / d2).min(1.0);
-        let cos_max = (1.0 - sin2).max(0.0).sqrt();
-        let one_minus_cos = sin2 / (1.0 + cos_max);
+        let r2 = F::splat(r * r);
+        let sin2 = (r2 / d2).min(F::ONE);
+        let cos_max = (F::ONE - sin2).max(F::ZERO).sqrt();
+        let one_minus_cos = sin2 / (F::ONE + cos_max);
         let d = d2.sqrt();
-        Some((to_centre / d, d, one_minus_cos))
+        let axis = Vector3::new(to_centre.x / d, to_centre.y / d, to_centre.z / d);
+        (d2.gt(r2), axis, d, one_minus_cos)
     }
 
     /// The density per unit solid angle with which [`Self::sample`] draws
@@ -77,33 +90,133 @@ impl SphereLight {
     /// A direction from `x` uniform over the light's cone for `u` ∈ [0, 1)²,
     /// as the point of the sphere it meets first; `None` inside the sphere.
     pub fn sample(&self, x: Vec3, u: Vec2) -> Option<SphereLightSample> {
-        let (axis, d, one_minus_cos) = self.cone(x)?;
+        let (outside, [point, error, normal], pdf) =
+            self.sample_of(&Vector3::new(x.x, x.y, x.z), u.x, u.y);
+        let at = |v: Vector3<f32>| Vec3::new(v.x, v.y, v.z);
+        outside.then(|| SphereLightSample {
+            target: RayTarget {
+                point: at(point),
+                error: at(error),
+                normal: at(normal),
+            },
+            pdf,
+        })
+    }
+
+    /// [`Self::sample`] from each lane's point `x` at its `(u, v)`, each
+    /// lane's bits the scalar sample's: the lanes outside the sphere (bit k
+    /// for lane k; the others hold no sample), and the targets' points, error
+    /// bounds and normals, and the densities.
+    pub fn sample_lanes(
+        &self,
+        x: &Vec3Lanes,
+        (u, v): (F32Lanes, F32Lanes),
+    ) -> (u32, [Vec3Lanes; 3], F32Lanes) {
+        let (outside, target, pdf) = self.sample_of(x, u, v);
+        (outside.bits(), target, pdf)
+    }
+
+    /// [`Self::sample`] in one lane or in many: whether `x` is outside the
+    /// sphere, the target's point, error bound and normal, and the density.
+    /// φ is drawn as `2πv` through [`sin_cos_approx`] of `2πv − π`, negated.
+    #[inline(always)]
+    fn sample_of<F: Float>(&self, x: &Vector3<F>, u: F, v: F) -> (F::Mask, [Vector3<F>; 3], F) {
+        let (outside, axis, d, one_minus_cos) = self.cone_of(x);
         // cos θ = 1 − u·(1 − cos θ_max), and sin²θ from 1 − cos θ without
         // cancellation: sin²θ = (1 − cos θ)(1 + cos θ).
-        let one_minus_cos_theta = u.x * one_minus_cos;
-        let cos_theta = 1.0 - one_minus_cos_theta;
-        let sin2_theta = (one_minus_cos_theta * (2.0 - one_minus_cos_theta)).max(0.0);
+        let one_minus_cos_theta = u * one_minus_cos;
+        let cos_theta = F::ONE - one_minus_cos_theta;
+        let sin2_theta = (one_minus_cos_theta * (F::splat(2.0) - one_minus_cos_theta)).max(F::ZERO);
         // Distance along the direction to the near side of the sphere.
         let r = self.surface.radius();
-        let near = d * cos_theta - (r * r - d * d * sin2_theta).max(0.0).sqrt();
-        let (sin_phi, cos_phi) = (TAU * u.y).sin_cos();
+        let near = d * cos_theta - (F::splat(r * r) - d * d * sin2_theta).max(F::ZERO).sqrt();
+        let (minus_sin_phi, minus_cos_phi) = sin_cos_approx(F::splat(TAU) * v - F::splat(PI));
+        let (sin_phi, cos_phi) = (-minus_sin_phi, -minus_cos_phi);
         let (t, b) = axis.any_orthonormal_pair();
         let sin_theta = sin2_theta.sqrt();
-        let direction = sin_theta * cos_phi * t + sin_theta * sin_phi * b + cos_theta * axis;
-        let point = x + near * direction;
+        let (a, c) = (sin_theta * cos_phi, sin_theta * sin_phi);
+        let direction = Vector3::new(
+            a * t.x + c * b.x + cos_theta * axis.x,
+            a * t.y + c * b.y + cos_theta * axis.y,
+            a * t.z + c * b.z + cos_theta * axis.z,
+        );
+        let point = Vector3::new(
+            x.x + near * direction.x,
+            x.y + near * direction.y,
+            x.z + near * direction.z,
+        );
         // The normal of the point met, projected back onto the sphere; at the
         // cone's rim it faces across the direction, never away from `x`.
-        let normal = (point - self.surface.center()).normalize();
-        Some(SphereLightSample {
-            target: self.surface.target_at(normal),
-            pdf: 1.0 / (TAU * one_minus_cos),
-        })
+        let center = self.surface.center();
+        let normal = point.sub_splat(center).normalize();
+        let target = self.target_of(&normal);
+        let pdf = F::ONE / (F::splat(TAU) * one_minus_cos);
+        (outside, target, pdf)
+    }
+
+    /// The sphere's point with unit normal `n`, its error bound and `n`, as
+    /// [`Sphere::target_at`] gives them, in one lane or in many.
+    #[inline(always)]
+    fn target_of<F: Float>(&self, n: &Vector3<F>) -> [Vector3<F>; 3] {
+        let (c, r) = (self.surface.center(), self.surface.radius());
+        let point = Vector3::new(
+            F::splat(c.x) + F::splat(r) * n.x,
+            F::splat(c.y) + F::splat(r) * n.y,
+            F::splat(c.z) + F::splat(r) * n.z,
+        );
+        let (centre_error, r_error) = (gamma(2) * c.abs(), F::splat(gamma(6) * r));
+        let error = Vector3::new(
+            F::splat(centre_error.x) + n.x.abs() * r_error,
+            F::splat(centre_error.y) + n.y.abs() * r_error,
+            F::splat(centre_error.z) + n.z.abs() * r_error,
+        );
+        [point, error, *n]
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Samples in lanes are each lane's scalar sample, bit for bit, from
+    /// points near, far, on the axis and inside the sphere (no sample).
+    #[test]
+    fn samples_in_lanes_are_each_lanes_sample() {
+        use glint_geometry::lanes::{self, LANES};
+        let light = SphereLight::new(Vec3::new(0.3, 2.0, -0.5), 0.7, Vec3::ONE).unwrap();
+        let points: [Vec3; LANES] = std::array::from_fn(|k| match k {
+            0 => Vec3::new(0.3, 2.1, -0.5),
+            1 => Vec3::new(0.3, 0.0, -0.5),
+            2 => Vec3::new(40.0, -3.0, 7.0),
+            3 => Vec3::new(0.3, 2.0, 0.2000001),
+            _ => Vec3::new(0.5 * k as f32 - 4.0, (0.7 * k as f32).sin(), 0.2 * k as f32),
+        });
+        let x = Vec3Lanes::from_lanes(points);
+        for i in 0..32 {
+            let u: [Vec2; LANES] = std::array::from_fn(|k| {
+                Vec2::new(
+                    ((i * LANES + k) as f32 * 0.618_034).fract(),
+                    (i as f32 + 0.5) / 32.0,
+                )
+            });
+            let us = (lanes::from_fn(|k| u[k].x), lanes::from_fn(|k| u[k].y));
+            let (outside, [point, error, normal], pdf) = light.sample_lanes(&x, us);
+            assert_eq!(outside & 1, 0, "inside the sphere");
+            for k in 0..LANES {
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                match light.sample(points[k], u[k]) {
+                    None => assert_eq!(outside >> k & 1, 0, "lane {k}"),
+                    Some(s) => {
+                        assert_eq!(outside >> k & 1, 1, "lane {k}");
+                        assert_eq!(bits(point.lane(k)), bits(s.target.point), "lane {k}, {i}");
+                        assert_eq!(bits(error.lane(k)), bits(s.target.error), "lane {k}, {i}");
+                        assert_eq!(bits(normal.lane(k)), bits(s.target.normal), "lane {k}, {i}");
+                        assert_eq!(pdf.to_array()[k].to_bits(), s.pdf.to_bits(), "lane {k}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn samples_lie_on_the_near_side_and_integrate_the_solid_angle() {

@@ -11,6 +11,7 @@ use glint_integrator::{
 };
 use glint_scene::load;
 use glint_tests::scene_path;
+use glint_texture::Texture;
 
 /// A shipped scene at `size`, with its settings changed by `tweak`.
 fn scene(
@@ -91,11 +92,19 @@ fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
             scene("physical-environment", size, few),
         ),
         ("cornell-physical", scene("cornell-physical", size, few)),
-        // A point light under physical shading, in the camera-sample lanes.
+        // Point and sphere lights under physical shading, in the
+        // camera-sample lanes.
         (
             "analytic-point-light",
             scene("analytic-point-light", size, few),
         ),
+        ("analytic-sphere-light, every material diffuse", {
+            let (mut scene, settings) = scene("analytic-sphere-light", size, few);
+            for m in &mut scene.materials {
+                m.specular = Some(Texture::Constant(Vec3::ZERO));
+            }
+            (scene, settings)
+        }),
         // Environment directions by the cosine about each point's normal:
         // in lanes at first hits, a point's own in the scalar path.
         ("physical-environment, by the cosine", {

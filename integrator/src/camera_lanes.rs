@@ -713,8 +713,8 @@ fn reflected_gathered(
 
 /// What a chunk's hit lanes landed on, as far as shading them together goes.
 enum FirstHits<'a> {
-    /// All on one sphere or parallelogram (its object index) of a material
-    /// whose textures need no footprint.
+    /// All on one sphere, parallelogram or plane (its object index) of a
+    /// material whose textures need no footprint.
     OnOneObject(u32, &'a Shape, &'a PhongMaterial),
     /// All on one emitter: an area light's colour, or nothing.
     OnOneEmitter(&'a AreaLight),
@@ -728,7 +728,9 @@ impl<'a> FirstHits<'a> {
             return Self::Several;
         };
         let shape = match scene.shapes.object(object) {
-            ObjectRef::Shape(shape @ (Shape::Sphere(_) | Shape::Parallelogram(_))) => shape,
+            ObjectRef::Shape(
+                shape @ (Shape::Sphere(_) | Shape::Parallelogram(_) | Shape::Plane(_)),
+            ) => shape,
             _ => return Self::Several,
         };
         match scene.surface_of_primitive(object, 0) {
@@ -921,7 +923,8 @@ impl<'a> ShadedLanes<'a> {
         let surface = match shape {
             Shape::Sphere(s) => s.surface_points_lanes(rays, closest.t, uv_lanes),
             Shape::Parallelogram(p) => p.surface_points_lanes(rays, closest.t),
-            _ => unreachable!("FirstHits::of admits spheres and parallelograms"),
+            Shape::Plane(p) => p.surface_points_lanes(rays, closest.t),
+            _ => unreachable!("FirstHits::of admits spheres, parallelograms and planes"),
         };
         let (kd, ks) = match &checks {
             Some(checks) => checks.reflectances_lanes(material, &surface.normal, hit_lanes),

@@ -92,6 +92,11 @@ fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
             scene("physical-environment", size, few),
         ),
         ("cornell-physical", scene("cornell-physical", size, few)),
+        // A plane's points made in lanes.
+        (
+            "analytic-area-light",
+            scene("analytic-area-light", size, few),
+        ),
         // Point and sphere lights under physical shading, in the
         // camera-sample lanes.
         (

@@ -1,8 +1,9 @@
 //! Infinite planes: the ray–plane test and the planar uv mapping that tiles
 //! texture to the horizon.
 
+use super::SurfaceLanes;
 use crate::error_bounds::gamma;
-use crate::lanes::{F32Lanes, Float, Mask, Vector3};
+use crate::lanes::{F32Lanes, Float, Mask, Vec3Lanes, Vector3};
 use crate::{Hit, Ray, RayLanes};
 use glam::{Vec2, Vec3};
 
@@ -121,6 +122,74 @@ impl Plane {
             front_face: self.normal.dot(ray.direction) < 0.0,
             shape: 0,
             primitive: 0,
+        }
+    }
+}
+
+impl Plane {
+    /// [`Self::surface_at`] of each lane at its distance `t`, without the
+    /// derivatives (the tangents, the same in every lane).
+    #[inline]
+    pub fn surface_points_lanes(&self, rays: &RayLanes, t: F32Lanes) -> SurfaceLanes {
+        let hit_point = rays.at(t);
+        let local = hit_point.sub_splat(self.point);
+        // Projected onto the plane, as `surface_at` removes the error along
+        // the normal.
+        let point = hit_point - Vec3Lanes::scaled_splat(self.normal, local.dot_splat(self.normal));
+        let error =
+            (point.abs() + Vec3Lanes::splat(self.point.abs())).scale(F32Lanes::splat(gamma(5)));
+        let tile = F32Lanes::splat(self.tile);
+        SurfaceLanes {
+            point,
+            error,
+            normal: Vec3Lanes::splat(self.normal),
+            u: local.dot_splat(self.tangent) / tile,
+            v: local.dot_splat(self.bitangent) / tile,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lanes::LANES;
+
+    /// Every lane's surface point, error bound, normal and uv are the scalar
+    /// `surface_at`'s, bit for bit, on tilted and tiled planes, from rays
+    /// near and far, steep and grazing.
+    #[test]
+    fn surface_points_in_lanes_are_the_scalar_ones() {
+        let planes = [
+            Plane::new(Vec3::ZERO, Vec3::Y, false).unwrap(),
+            Plane::new(Vec3::new(1.5, -2.0, 0.3), Vec3::new(0.3, 1.0, -0.2), true)
+                .unwrap()
+                .with_tile_size(2.5)
+                .unwrap(),
+        ];
+        for plane in planes {
+            let origin = plane.point + 3.0 * plane.normal + Vec3::new(0.4, 0.1, -0.2);
+            let rays: [Ray; LANES] = std::array::from_fn(|k| {
+                let a = 0.7 * k as f32;
+                let spread = Vec3::new(a.cos(), 0.0, a.sin()) * (0.2 + k as f32);
+                Ray::new(origin, spread - plane.normal)
+            });
+            let t: [f32; LANES] = std::array::from_fn(|k| {
+                let ray = &rays[k];
+                (plane.point - ray.origin).dot(plane.normal) / ray.direction.dot(plane.normal)
+            });
+            let lanes = plane.surface_points_lanes(&RayLanes::new(rays), F32Lanes::new(t));
+            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+            for k in 0..LANES {
+                let hit = plane.surface_at(&rays[k], t[k]);
+                assert_eq!(bits(lanes.point.lane(k)), bits(hit.point), "lane {k}");
+                assert_eq!(bits(lanes.error.lane(k)), bits(hit.error), "lane {k}");
+                assert_eq!(bits(lanes.normal.lane(k)), bits(hit.geometric_normal));
+                let uv = Vec2::new(lanes.u.to_array()[k], lanes.v.to_array()[k]);
+                assert_eq!(
+                    uv.to_array().map(f32::to_bits),
+                    hit.uv.to_array().map(f32::to_bits)
+                );
+            }
         }
     }
 }

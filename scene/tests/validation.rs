@@ -43,6 +43,7 @@ fn each_kind_of_bad_input_has_its_own_message() {
         ("unknown sampler", format!("{CAMERA}[render]\npixel_sampler = \"halton\"\n")),
         ("grid environment sampler, set count not square", format!("{CAMERA}[render]\nenvironment_samples = 8\nenvironment_sampler = \"grid\"\n")),
         ("unknown environment sampler", format!("{CAMERA}[render]\nenvironment_sampler = \"sobel\"\n")),
+        ("unknown environment sampling", format!("{CAMERA}[render]\nenvironment_sampling = \"uniform\"\n")),
         ("NaN", format!("ambient = [0, nan, 0]\n{CAMERA}")),
         ("infinity", format!("{CAMERA}{MATERIAL}[[sphere]]\ncenter = [0, 0, -inf]\nradius = 1\nmaterial = \"m\"\n")),
         ("string for a number", format!("{CAMERA}{MATERIAL}[[sphere]]\ncenter = [0, 0, 0]\nradius = \"big\"\nmaterial = \"m\"\n")),

@@ -531,6 +531,7 @@ impl DirectIntegrator {
     /// `n` directions uniform over its cone ([`SphereLight::sample_lanes`]) at
     /// the points of `pair` for the lanes' camera samples. A lane inside the
     /// sphere takes no sample: its term is +0, as `li_at` adds `Vec3::ZERO`.
+    #[inline(never)]
     fn physical_sphere_light_term<T: Tracer>(
         &self,
         scene: &Scene,
@@ -1034,6 +1035,7 @@ impl<'a> ShadedLanes<'a> {
     /// `light` at a diffuse point, or zero where it is below the surface or
     /// blocked: the scalar path's `point_light`, bit for bit, with its counts
     /// (but the samples', which the caller counts).
+    #[inline(never)]
     fn physical_point_light<T: Tracer>(
         &self,
         scene: &Scene,

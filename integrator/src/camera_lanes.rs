@@ -40,7 +40,7 @@ use crate::sampling::{
 };
 use crate::texture_lookup::texture_footprint;
 use crate::trace::Tracer;
-use crate::{DirectIntegrator, Scene, SurfaceKind};
+use crate::{DirectIntegrator, Scene, ShadingCounters, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, LANES};
 use glint_geometry::{
@@ -481,48 +481,28 @@ impl DirectIntegrator {
                 samplers[k] = Some(area.sampler(points[k], self.area_sampling));
             }
         }
-        let counters = &mut ctx.counters;
-        counters.light_samples += u64::from(n) * u64::from(shaded.lanes.count_ones());
-        counters.light_skips.behind_light +=
-            u64::from(n) * u64::from((shaded.lanes & !lit).count_ones());
+        count_light_samples(&mut ctx.counters, n, shaded.lanes, lit);
         if lit == 0 {
             return Vec3Lanes::default();
         }
         let by_area =
             (samplers.iter().flatten()).all(|s| matches!(s, AreaLightSampler::Area { .. }));
-        let grid = self.grid_points(pair, ctx);
-        let sequences = (self.light_pattern == SamplePattern::Sobol)
-            .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
         let occluders = shaded.occluders(scene, index, area, ctx);
-        let at = DiffusePoints {
-            point: &shaded.point,
-            ng: &shaded.ng,
-            n: shaded.phong.normals(),
-            kd: shaded.phong.kd(),
-        };
-        let mut sum = Vec3Lanes::default();
-        for j in 0..n {
-            let (ux, uy) = light_points_at(&grid, &sequences, j, n);
+        let draw = |u: (F32Lanes, F32Lanes)| {
             let (position, pdf) = if by_area {
-                let (position, pdf) = area.sample_by_area_lanes(&shaded.point, (ux, uy));
+                let (position, pdf) = area.sample_by_area_lanes(&shaded.point, u);
                 let lit = lanes::from_bits(lit);
                 (
                     Vec3Lanes::select(lit, &position, &shaded.point),
                     F32Lanes::select(lit, pdf, F32Lanes::ZERO),
                 )
             } else {
-                each_lanes_sample(&samplers, &points, lit, (ux, uy))
+                each_lanes_sample(&samplers, &points, lit, u)
             };
-            let (values, traced) = at.light_samples(&position, pdf, lit, &mut ctx.counters);
-            let towards = position - shaded.point;
-            let ends = area.shadow_ends(&position);
-            let visible = traced & !shaded.blocked(scene, &occluders, &ends, &towards, traced);
-            let zero = Vec3Lanes::default();
-            sum = sum + Vec3Lanes::select(lanes::from_bits(visible), &values, &zero);
-        }
-        if let Some(grid) = grid {
-            ctx.light_points = grid;
-        }
+            (position, pdf, area.shadow_ends(&position))
+        };
+        let sum =
+            self.diffuse_light_sum(scene, shaded, (lit, &occluders), (samples, pair), draw, ctx);
         Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(n as f32)
     }
 
@@ -543,13 +523,35 @@ impl DirectIntegrator {
         let n = self.light_samples;
         let (lit, _, _) = light.sample_lanes(&shaded.point, (F32Lanes::ZERO, F32Lanes::ZERO));
         let lit = lit & shaded.lanes;
-        let counters = &mut ctx.counters;
-        counters.light_samples += u64::from(n) * u64::from(shaded.lanes.count_ones());
-        counters.light_skips.behind_light +=
-            u64::from(n) * u64::from((shaded.lanes & !lit).count_ones());
+        count_light_samples(&mut ctx.counters, n, shaded.lanes, lit);
         if lit == 0 {
             return Vec3Lanes::default();
         }
+        let draw = |u: (F32Lanes, F32Lanes)| {
+            let (_, [point, error, normal], pdf) = light.sample_lanes(&shaded.point, u);
+            (point, pdf, offset_ray_origins(&point, &error, &normal))
+        };
+        let all = (lit, &Occluders::ALL);
+        let sum = self.diffuse_light_sum(scene, shaded, all, (samples, pair), draw, ctx);
+        Vec3Lanes::scaled_splat_lanes(light.color, &sum).div_splat(n as f32)
+    }
+
+    /// `Σ_j kd/π · cos θ / p · V` over a light's `light_samples` samples at
+    /// every lane of `lit`, each lane summing its own in order: sample `j`'s
+    /// points (the grid's, or each lane's Sobol points of `pair`) drawn by
+    /// `draw` into light points, their densities and their shadow rays' ends,
+    /// tested against `occluders`. A blocked sample adds +0 where `li_at`
+    /// adds nothing: the same, as the sum is never −0.
+    fn diffuse_light_sum<T: Tracer>(
+        &self,
+        scene: &Scene,
+        shaded: &ShadedLanes,
+        (lit, occluders): (u32, &Occluders),
+        (samples, pair): (&LaneSamples, DimensionPair),
+        mut draw: impl FnMut((F32Lanes, F32Lanes)) -> (Vec3Lanes, F32Lanes, Vec3Lanes),
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let n = self.light_samples;
         let grid = self.grid_points(pair, ctx);
         let sequences = (self.light_pattern == SamplePattern::Sobol)
             .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
@@ -561,19 +563,17 @@ impl DirectIntegrator {
         };
         let mut sum = Vec3Lanes::default();
         for j in 0..n {
-            let u = light_points_at(&grid, &sequences, j, n);
-            let (_, [point, error, normal], pdf) = light.sample_lanes(&shaded.point, u);
-            let (values, traced) = at.light_samples(&point, pdf, lit, &mut ctx.counters);
-            let towards = point - shaded.point;
-            let ends = offset_ray_origins(&point, &error, &normal);
-            let visible = traced & !shaded.blocked(scene, &Occluders::ALL, &ends, &towards, traced);
+            let (position, pdf, ends) = draw(light_points_at(&grid, &sequences, j, n));
+            let (values, traced) = at.light_samples(&position, pdf, lit, &mut ctx.counters);
+            let towards = position - shaded.point;
+            let visible = traced & !shaded.blocked(scene, occluders, &ends, &towards, traced);
             let zero = Vec3Lanes::default();
             sum = sum + Vec3Lanes::select(lanes::from_bits(visible), &values, &zero);
         }
         if let Some(grid) = grid {
             ctx.light_points = grid;
         }
-        Vec3Lanes::scaled_splat_lanes(light.color, &sum).div_splat(n as f32)
+        sum
     }
 
     /// The grid pattern's points for `pair` (the same for every camera sample),
@@ -742,6 +742,13 @@ impl<'a> FirstHits<'a> {
             SurfaceKind::Emitter(_) => Self::Several,
         }
     }
+}
+
+/// Counts `n` samples of one light at each lane of `shaded`, those of the
+/// lanes outside `lit` as skipped behind the light, as `li_at` counts them.
+fn count_light_samples(counters: &mut ShadingCounters, n: u32, shaded: u32, lit: u32) {
+    counters.light_samples += u64::from(n) * u64::from(shaded.count_ones());
+    counters.light_skips.behind_light += u64::from(n) * u64::from((shaded & !lit).count_ones());
 }
 
 /// Light sample `j` of `n` in every lane: the grid's point `j` in all of

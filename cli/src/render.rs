@@ -456,13 +456,10 @@ impl SceneArgs {
             glint_scene::load(&self.scene).map_err(|e| Failure::Input(e.to_string()))?;
         self.apply_overrides(&mut description.settings);
         let scene = &mut description.scene;
-        let settings = &description.settings;
-        if let (Some(env), 1..) = (&scene.environment, settings.environment_samples) {
-            // The map's distribution is part of loading it, not of the render.
-            let start = std::time::Instant::now();
-            env.prepare(settings.environment_sampling);
-            description.timings.assets += start.elapsed();
-        }
+        // The map's distribution is part of loading it, not of the render.
+        let start = std::time::Instant::now();
+        scene.prepare(&description.settings);
+        description.timings.assets += start.elapsed();
         if let Some(filter) = self.texture_filter {
             scene.override_texture_filter(filter);
         }

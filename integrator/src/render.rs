@@ -130,9 +130,7 @@ pub fn render_with(
             return Err(SettingsError::ResumeResolution { film, camera });
         }
     }
-    if let (Some(env), 1..) = (&scene.environment, settings.environment_samples) {
-        env.prepare(settings.environment_sampling);
-    }
+    scene.prepare(settings);
     let run = || render_on_current_pool(scene, settings, on_tile_done, control, window);
     match settings.threads {
         None => Ok(run()),

@@ -49,6 +49,15 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Builds what a render with `settings` will read and the scene makes
+    /// on first use (the environment's luminance distribution, where its
+    /// samples are drawn from it), so that no render thread waits on it.
+    pub fn prepare(&self, settings: &crate::RenderSettings) {
+        if let (Some(env), 1..) = (&self.environment, settings.environment_samples) {
+            env.prepare(settings.environment_sampling);
+        }
+    }
+
     /// Whether anything reads a ray's differentials: a material whose textures
     /// filter over a footprint, or the environment (filtered by the ray's
     /// angular width in Phong shading; physical shading reads it unfiltered).

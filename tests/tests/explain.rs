@@ -92,6 +92,8 @@ fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
             scene("physical-environment", size, few),
         ),
         ("cornell-physical", scene("cornell-physical", size, few)),
+        // A constant sky, sampled by the cosine in lanes.
+        ("analytic-sky", scene("analytic-sky", size, few)),
         // A plane's points made in lanes.
         (
             "analytic-area-light",

@@ -472,13 +472,12 @@ impl DirectIntegrator {
     ) -> Vec3Lanes {
         let n = self.light_samples;
         let center = area.surface().center();
-        let points: [Vec3; LANES] = lanes::array_from_fn(|k| shaded.point.lane(k));
         let lit = area.illuminates_lanes(&Vec3Lanes::splat(center), &shaded.point);
         let lit = shaded.lanes & lanes::bits(lit);
         let mut samplers: [Option<AreaLightSampler>; LANES] = std::array::from_fn(|_| None);
         if lit & area.by_solid_angle_lanes(&shaded.point, self.area_sampling) != 0 {
             for k in lanes::each_set(lit) {
-                samplers[k] = Some(area.sampler(points[k], self.area_sampling));
+                samplers[k] = Some(area.sampler(shaded.point.lane(k), self.area_sampling));
             }
         }
         count_light_samples(&mut ctx.counters, n, shaded.lanes, lit);
@@ -497,7 +496,7 @@ impl DirectIntegrator {
                     F32Lanes::select(lit, pdf, F32Lanes::ZERO),
                 )
             } else {
-                each_lanes_sample(&samplers, &points, lit, u)
+                each_lanes_sample(&samplers, &shaded.point, lit, u)
             };
             (position, pdf, area.shadow_ends(&position))
         };
@@ -521,8 +520,7 @@ impl DirectIntegrator {
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let n = self.light_samples;
-        let (lit, _, _) = light.sample_lanes(&shaded.point, (F32Lanes::ZERO, F32Lanes::ZERO));
-        let lit = lit & shaded.lanes;
+        let lit = shaded.lanes & light.outside_lanes(&shaded.point);
         count_light_samples(&mut ctx.counters, n, shaded.lanes, lit);
         if lit == 0 {
             return Vec3Lanes::default();
@@ -774,7 +772,7 @@ fn light_points_at(
 /// zero density.
 fn each_lanes_sample(
     samplers: &[Option<AreaLightSampler>; LANES],
-    points: &[Vec3; LANES],
+    points: &Vec3Lanes,
     lit: u32,
     (ux, uy): (F32Lanes, F32Lanes),
 ) -> (Vec3Lanes, F32Lanes) {
@@ -786,9 +784,10 @@ fn each_lanes_sample(
             .as_ref()
             .expect("a lit lane")
             .sample(Vec2::new(ux[k], uy[k]));
-        (positions[k], pdfs[k]) = (s.point, s.pdf);
+        positions.set_lane(k, s.point);
+        pdfs[k] = s.pdf;
     }
-    (Vec3Lanes::from_lanes(positions), F32Lanes::new(pdfs))
+    (positions, F32Lanes::new(pdfs))
 }
 
 /// The shading points of up to [`LANES`] lanes: all at once where the lanes hit

@@ -103,6 +103,12 @@ impl SphereLight {
         })
     }
 
+    /// The lanes of the points `x` (bit k for lane k) outside the sphere,
+    /// where [`Self::pdf`] is not 0: those the light lights.
+    pub fn outside_lanes(&self, x: &Vec3Lanes) -> u32 {
+        self.cone_of(x).0.bits()
+    }
+
     /// [`Self::sample`] from each lane's point `x` at its `(u, v)`, each
     /// lane's bits the scalar sample's: the lanes outside the sphere (bit k
     /// for lane k; the others hold no sample), and the targets' points, error
@@ -202,6 +208,7 @@ mod tests {
             let us = (lanes::from_fn(|k| u[k].x), lanes::from_fn(|k| u[k].y));
             let (outside, [point, error, normal], pdf) = light.sample_lanes(&x, us);
             assert_eq!(outside & 1, 0, "inside the sphere");
+            assert_eq!(light.outside_lanes(&x), outside);
             for k in 0..LANES {
                 let bits = |v: Vec3| v.to_array().map(f32::to_bits);
                 match light.sample(points[k], u[k]) {

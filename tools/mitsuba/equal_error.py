@@ -78,7 +78,7 @@ class Config:
     pattern: str  # Glint's pixel, light and environment pattern, or Mitsuba's sampler
     samples: int  # Glint's light and environment samples; Mitsuba's emitter and/or BSDF samples
     # Glint's environment sampling (GLINT_STRATEGIES); Mitsuba's techniques (MITSUBA_STRATEGIES)
-    strategy: str = ""
+    strategy: str
 
     @property
     def label(self) -> str:
@@ -163,7 +163,7 @@ class Glint:
         ]
         if scene.has_environment:
             args += ["--environment-samples", str(cfg.samples), "--environment-sampler", cfg.pattern,
-                     "--environment-sampling", cfg.strategy or "luminance"]
+                     "--environment-sampling", cfg.strategy]
         t0 = time.perf_counter()
         r = self.run(args, f"{scene.name}: glint render")
         wall = time.perf_counter() - t0

@@ -39,14 +39,10 @@ fn offset_origin<F: Float>(
     let d = normal.abs().dot(error);
     let offset = normal.scale(d);
     let moved = *point + offset;
-    let away = |p: F, o: F| {
-        let down = F::select(o.lt(F::ZERO), p.next_down(), p);
-        F::select(o.gt(F::ZERO), p.next_up(), down)
-    };
     Vector3 {
-        x: away(moved.x, offset.x),
-        y: away(moved.y, offset.y),
-        z: away(moved.z, offset.z),
+        x: moved.x.next_away(offset.x),
+        y: moved.y.next_away(offset.y),
+        z: moved.z.next_away(offset.z),
     }
 }
 

@@ -52,6 +52,7 @@ use glint_lighting::{
     ShadingModel, SphereLight, UvTransform,
 };
 use glint_texture::{Checkerboard, TexCoord, Texture};
+use std::cell::OnceCell;
 
 impl DirectIntegrator {
     /// Whether the first hits of `scene`'s camera samples can be shaded [`LANES`] at
@@ -406,7 +407,7 @@ impl DirectIntegrator {
             ctx.counters.environment_shadow_rays += u64::from(traced.count_ones());
             let lit = Vec3Lanes::new(radiance.x * f.x, radiance.y * f.y, radiance.z * f.z);
             let value = Vec3Lanes::new(lit.x / pdf, lit.y / pdf, lit.z / pdf);
-            let origin = shaded.origins_towards(&direction);
+            let origin = shaded.origins_towards(&direction, traced);
             let rays = RayLanes { origin, direction };
             let blocked =
                 (scene.shapes).any_hits_among(&Occluders::ALL, &rays, f32::INFINITY, traced);
@@ -670,10 +671,10 @@ fn reflected_in_place(
     let n = Vec3Lanes::select(lanes::gt(g.dot(d), F32Lanes::ZERO), &-*g, g);
     let wo = -d.normalize();
     let wi = n.scale(F32Lanes::splat(2.0) * wo.dot(&n)) - wo;
-    let origins = ShadowOrigins::of(&surface.point, &surface.error, g);
     let from_back = lanes::lt(wi.dot(g), F32Lanes::ZERO);
+    let outgoing = Vec3Lanes::select(from_back, &-*g, g);
     Some(RayLanes {
-        origin: Vec3Lanes::select(from_back, &origins.back, &origins.front),
+        origin: offset_ray_origins(&surface.point, &surface.error, &outgoing),
         direction: wi,
     })
 }
@@ -810,21 +811,13 @@ struct ShadedLanes<'a> {
 }
 
 /// The points of [`ShadedLanes`] offset to either side of their surfaces, the
-/// origins of their shadow rays, made once for all their light samples.
+/// origins of their shadow rays: each side made when a shadow ray first
+/// leaves on it, once for all the light samples. Most points' shadow rays
+/// all leave on the viewer's side.
 #[derive(Default)]
 struct ShadowOrigins {
-    front: Vec3Lanes,
-    back: Vec3Lanes,
-}
-
-impl ShadowOrigins {
-    #[inline]
-    fn of(point: &Vec3Lanes, error: &Vec3Lanes, g: &Vec3Lanes) -> Self {
-        Self {
-            front: offset_ray_origins(point, error, g),
-            back: offset_ray_origins(point, error, &-*g),
-        }
-    }
+    front: OnceCell<Vec3Lanes>,
+    back: OnceCell<Vec3Lanes>,
 }
 
 impl<'a> ShadedLanes<'a> {
@@ -839,7 +832,6 @@ impl<'a> ShadedLanes<'a> {
     ) -> Self {
         let mut shaded = Self::default();
         shaded.set_one_by_one(scene, hits, hit_lanes, radiance, ctx);
-        shaded.origins = ShadowOrigins::of(&shaded.point, &shaded.error, &shaded.geometric_normal);
         shaded
     }
 
@@ -949,7 +941,7 @@ impl<'a> ShadedLanes<'a> {
         *radiance = Vec3Lanes::select(lanes::from_bits(hit_lanes), &ambient, radiance);
         Self {
             lanes: hit_lanes,
-            origins: ShadowOrigins::of(&surface.point, &surface.error, &surface.normal),
+            origins: ShadowOrigins::default(),
             point: surface.point,
             error: surface.error,
             geometric_normal: surface.normal,
@@ -1102,7 +1094,7 @@ impl<'a> ShadedLanes<'a> {
         towards: &Vec3Lanes,
         traced: u32,
     ) -> u32 {
-        let origin = self.origins_towards(towards);
+        let origin = self.origins_towards(towards, traced);
         let rays = RayLanes {
             origin,
             direction: *end - origin,
@@ -1110,13 +1102,22 @@ impl<'a> ShadedLanes<'a> {
         scene.shapes.any_hits_among(occluders, &rays, 1.0, traced)
     }
 
-    /// Each lane's shadow-ray origin: its point offset to the side of its
-    /// surface that `towards` leaves on, as `spawn_ray` and `spawn_ray_to`
-    /// choose it.
+    /// Each lane's shadow-ray origin (of the lanes `traced`; the others'
+    /// are any): its point offset to the side of its surface that `towards`
+    /// leaves on, as `spawn_ray` and `spawn_ray_to` choose it.
     #[inline]
-    fn origins_towards(&self, towards: &Vec3Lanes) -> Vec3Lanes {
-        let from_back = lanes::lt(towards.dot(&self.geometric_normal), F32Lanes::ZERO);
-        Vec3Lanes::select(from_back, &self.origins.back, &self.origins.front)
+    fn origins_towards(&self, towards: &Vec3Lanes, traced: u32) -> Vec3Lanes {
+        let g = &self.geometric_normal;
+        let from_back = lanes::lt(towards.dot(g), F32Lanes::ZERO);
+        let offset = |side: &OnceCell<Vec3Lanes>, normal: &Vec3Lanes| {
+            *side.get_or_init(|| offset_ray_origins(&self.point, &self.error, normal))
+        };
+        let (front, back) = (&self.origins.front, &self.origins.back);
+        match lanes::bits(from_back) & traced {
+            0 => offset(front, g),
+            leave_back if leave_back == traced => offset(back, &-*g),
+            _ => Vec3Lanes::select(from_back, &offset(back, &-*g), &offset(front, g)),
+        }
     }
 }
 

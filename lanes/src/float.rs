@@ -69,6 +69,19 @@ pub trait Float:
     fn next_down(self) -> Self {
         -(-self).next_up()
     }
+    /// `self` times the sign of `sign`, as Dr.Jit's `mulsign`: `self` with
+    /// its sign bit flipped where `sign`'s is set (so `−0` and `−NaN` count
+    /// as negative), exact for every value.
+    fn mulsign(self, sign: Self) -> Self;
+    /// The next float from `self` the way `direction` points: `next_up`
+    /// where it is positive, `next_down` where negative, `self` where it is
+    /// zero or NaN. One step up between two sign flips, since
+    /// `next_down(x) = −next_up(−x)`.
+    #[inline(always)]
+    fn next_away(self, direction: Self) -> Self {
+        let away = self.mulsign(direction).next_up().mulsign(direction);
+        Self::select(direction.abs().gt(Self::ZERO), away, self)
+    }
     /// `self` in `(0, t_max)`, the open range of a ray's valid distances.
     #[inline(always)]
     fn in_ray_range(self, t_max: Self) -> Self::Mask {
@@ -168,7 +181,14 @@ impl Float for f32 {
             self
         }
     }
+    #[inline(always)]
+    fn mulsign(self, sign: Self) -> Self {
+        f32::from_bits(self.to_bits() ^ (sign.to_bits() & SIGN_BIT))
+    }
 }
+
+/// The sign bit of an `f32`.
+const SIGN_BIT: u32 = 1 << 31;
 
 /// [`Float`] and [`Mask`] for a `wide` vector of f32: its masks are the same
 /// register type, each lane all ones (true) or all zeros (false).
@@ -250,14 +270,20 @@ macro_rules! lanes_of_f32 {
             }
             #[inline(always)]
             fn next_up(self) -> Self {
-                // As for `f32`, lane by lane.
+                // As for `f32`, lane by lane; the step, +1 or −1 as the sign
+                // bit is clear or set, is the bits shifted arithmetically
+                // (0 or −1), or'ed with 1.
                 let zeroed = self + <$t>::ZERO;
                 let bits: $i = bytemuck::cast(zeroed);
-                let one = <$i>::splat(1);
-                let non_negative: $i = bytemuck::cast(zeroed.simd_ge(<$t>::ZERO));
-                let stepped: $t = bytemuck::cast(non_negative.select(bits + one, bits - one));
+                let stepped: $t = bytemuck::cast(bits + ((bits >> 31) | <$i>::splat(1)));
                 self.simd_lt(<$t>::splat(f32::INFINITY))
                     .select(stepped, self)
+            }
+            #[inline(always)]
+            fn mulsign(self, sign: Self) -> Self {
+                let sign_bit = <$i>::splat(SIGN_BIT as i32);
+                let bits: $i = bytemuck::cast(self);
+                bytemuck::cast(bits ^ (bytemuck::cast::<_, $i>(sign) & sign_bit))
             }
         }
     };
@@ -290,31 +316,60 @@ mod tests {
         3e38,
     ];
 
-    /// `F`'s `next_up` and `next_down` of `values` lane by lane, as `f32`s.
+    /// `F`'s `next_up`, `next_down`, and `next_away` and `mulsign` against
+    /// every value as the direction or sign, lane by lane, as `f32`s.
     fn stepped<F: Float>(
         values: &[f32],
         lanes: impl Fn(&[f32]) -> F,
         array: impl Fn(F) -> Vec<f32>,
     ) {
+        let bits = |v: Vec<f32>| v.into_iter().map(f32::to_bits).collect::<Vec<_>>();
         for chunk in values.chunks(F::WIDTH) {
             let mut v = chunk.to_vec();
             v.resize(F::WIDTH, 0.0);
-            let (up, down) = (array(lanes(&v).next_up()), array(lanes(&v).next_down()));
-            for (k, x) in chunk.iter().enumerate() {
+            let x = lanes(&v);
+            let up: Vec<f32> = chunk.iter().map(|x| x.next_up()).collect();
+            let down: Vec<f32> = chunk.iter().map(|x| x.next_down()).collect();
+            let n = chunk.len();
+            assert_eq!(
+                bits(array(x.next_up()))[..n],
+                bits(up),
+                "up, {} lanes",
+                F::WIDTH
+            );
+            let got = bits(array(x.next_down()));
+            assert_eq!(got[..n], bits(down), "down, {} lanes", F::WIDTH);
+            for turn in 0..values.len() {
+                let d: Vec<f32> = (0..F::WIDTH)
+                    .map(|k| values[(k + turn) % values.len()])
+                    .collect();
+                let (away, signed) = (x.next_away(lanes(&d)), x.mulsign(lanes(&d)));
+                let away_of = |(x, d): (&f32, &f32)| match () {
+                    _ if *d > 0.0 => x.next_up(),
+                    _ if *d < 0.0 => x.next_down(),
+                    _ => *x,
+                };
+                let signed_of = |(x, d): (&f32, &f32)| if d.is_sign_negative() { -x } else { *x };
+                let want = chunk.iter().zip(&d).map(away_of).collect();
                 assert_eq!(
-                    up[k].to_bits(),
-                    x.next_up().to_bits(),
-                    "up {x}, {} lanes",
+                    bits(array(away))[..n],
+                    bits(want),
+                    "away {d:?}, {} lanes",
                     F::WIDTH
                 );
-                let scalar = x.next_down().to_bits();
-                assert_eq!(down[k].to_bits(), scalar, "down {x}, {} lanes", F::WIDTH);
+                let want = chunk.iter().zip(&d).map(signed_of).collect();
+                assert_eq!(
+                    bits(array(signed))[..n],
+                    bits(want),
+                    "mulsign {d:?}, {} lanes",
+                    F::WIDTH
+                );
             }
         }
     }
 
     #[test]
-    fn next_up_and_down_are_the_library_functions_bit_for_bit_at_every_width() {
+    fn next_up_down_and_away_are_the_library_functions_bit_for_bit_at_every_width() {
         stepped::<f32>(&VALUES, |v| v[0], |f| vec![f]);
         stepped::<wide::f32x4>(
             &VALUES,

@@ -42,7 +42,7 @@ use crate::texture_lookup::texture_footprint;
 use crate::trace::Tracer;
 use crate::{DirectIntegrator, Scene, ShadingCounters, SurfaceKind};
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, LANES};
+use glint_geometry::lanes::{self, F32Lanes, Float, I32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{
     offset_ray_origins, reflect, spawn_ray, ClosestLanes, ObjectRef, Occluders, RayDifferential,
     RayLanes, Shape, Sphere, SurfaceLanes, SPHERE_UV_APPROX_ERROR,
@@ -1186,7 +1186,7 @@ impl<'a> SphereChecks<'a> {
     const MAX_DENSITY: f32 = 64.0;
 
     /// `material.reflectances_at` each lane's uv on a sphere whose unit
-    /// normals are `normal` (lanes of `hit_lanes`; the others zero).
+    /// normals are `normal` (lanes of `hit_lanes`; the others' are any).
     fn reflectances_lanes(
         &self,
         material: &PhongMaterial,
@@ -1196,28 +1196,25 @@ impl<'a> SphereChecks<'a> {
         let (u, v) = Sphere::uv_of_normals_approx(normal);
         let UvTransform { scale, offset } = material.uv_transform;
         let n = F32Lanes::splat(self.board.checks as f32);
-        let cells = |c: F32Lanes, s: f32, o: f32| {
-            ((c * F32Lanes::splat(s) + F32Lanes::splat(o)) * n).to_array()
-        };
+        let cells = |c: F32Lanes, s: f32, o: f32| (c * F32Lanes::splat(s) + F32Lanes::splat(o)) * n;
         let (x, y) = (cells(u, scale.x, offset.x), cells(v, scale.y, offset.y));
-        let error = 2.0 * self.density * SPHERE_UV_APPROX_ERROR;
+        let error = F32Lanes::splat(2.0 * self.density * SPHERE_UV_APPROX_ERROR);
         // Away from every edge by more than the error (and the rounding of
         // `c`, a few of its ulps): the exact coordinate is in the same check.
-        let clear = |c: f32| {
-            let margin = error + c.abs() * 1e-6;
+        // A clear `c` has a fraction, so its floor is an exact `i32`.
+        let clear = |c: F32Lanes| {
+            let margin = error + c.abs() * F32Lanes::splat(1e-6);
             let f = c - c.floor();
-            f > margin && f < 1.0 - margin
+            lanes::bits(lanes::gt(f, margin) & lanes::lt(f, F32Lanes::ONE - margin))
         };
-        let (mut kd, mut ks) = (Vec3Lanes::default(), Vec3Lanes::default());
-        for k in lanes::each_set(hit_lanes) {
-            let (d, s) = if clear(x[k]) && clear(y[k]) {
-                let odd = (x[k].floor() as i64 ^ y[k].floor() as i64) & 1;
-                let d = self.board.colors[odd as usize];
-                (d, self.ks.unwrap_or(d))
-            } else {
-                let (uv, _, _) = Sphere::uv_of_normal(normal.lane(k));
-                material.reflectances_at(uv)
-            };
+        let parity = (x.floor().trunc_int() ^ y.floor().trunc_int()) & I32Lanes::splat(1);
+        let odd = lanes::gt(parity.round_float(), F32Lanes::ZERO);
+        let [even_color, odd_color] = self.board.colors.map(Vec3Lanes::splat);
+        let mut kd = Vec3Lanes::select(odd, &odd_color, &even_color);
+        let mut ks = self.ks.map_or(kd, Vec3Lanes::splat);
+        for k in lanes::each_set(hit_lanes & !(clear(x) & clear(y))) {
+            let (uv, _, _) = Sphere::uv_of_normal(normal.lane(k));
+            let (d, s) = material.reflectances_at(uv);
             kd.set_lane(k, d);
             ks.set_lane(k, s);
         }

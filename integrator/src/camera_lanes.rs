@@ -18,13 +18,19 @@
 //! ([`DirectIntegrator::shades_first_hits_in_lanes`]): light points that each
 //! sample can draw alone (not a stratified pattern of several), and either
 //! the course's model with area and point lights, no environment and no
-//! mirrors, or physical shading of diffuse materials under area lights and an
-//! environment map, whose lanes on a mirror are each traced alone by `li_at`. Physical shading draws each lane's light samples
-//! with its own point's sampler (by area or solid angle) and takes them
-//! through the diffuse kernel a point's light samples share
-//! ([`crate::physical::DiffusePoints`]); its environment samples are drawn
-//! together across the lanes ([`glint_lighting::EnvironmentLight::sample_each`]),
-//! and the lanes that miss read the map. Textures
+//! mirrors, or physical shading under area, point and sphere lights and an
+//! environment map (glossy materials only where the map is not sampled),
+//! whose lanes on a partial mirror are each traced alone by `li_at` and whose
+//! perfect mirrors reflect their lanes as a next wave. Physical shading draws
+//! each lane's light samples with its own point's sampler (by area or solid
+//! angle) and takes them through the diffuse kernel a point's light samples
+//! share ([`crate::physical::DiffusePoints`]), or on glossy points through
+//! the BRDF with its lobe in lanes ([`PhongLanes::brdf_cos`]), weighted by
+//! multiple importance against as many directions drawn from each lane's
+//! lobe, whose rays are traced together ([`DirectIntegrator::lobe_sum`]); its
+//! environment samples are drawn together across the lanes
+//! ([`glint_lighting::EnvironmentLight::sample_each`]), and the lanes that
+//! miss read the map. Textures
 //! filtered over a footprint are looked up lane by lane, from each lane's ray
 //! differentials. Every lane
 //! repeats the scalar path's operations in its order, and its random numbers
@@ -34,7 +40,7 @@
 
 use crate::direct::{PairAllocation, SampleContext, ShadingPoint, CULL_REACH};
 use crate::light_samples::{count_lanes, LightSampleLanes};
-use crate::physical::DiffusePoints;
+use crate::physical::{power_heuristic, DiffusePoints};
 use crate::sampling::{
     DimensionPair, LaneSamples, Pcg32Lanes, SamplePattern, SamplePoints, SobolSequence,
 };
@@ -58,8 +64,9 @@ impl DirectIntegrator {
     /// Whether the first hits of `scene`'s camera samples can be shaded [`LANES`] at
     /// a time (`li_first_hits`): light points each sample can draw alone, and
     /// either the course's shading model with area and point lights, no
-    /// environment and no mirrors, or physical shading with area and point
-    /// lights as [`Self::physical_in_lanes`] admits it.
+    /// environment and no mirrors, or physical shading with area, point and
+    /// sphere lights where its light points are drawn from no random stream
+    /// and its glossy materials are under no sampled environment.
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
         let lights = |admitted: fn(&Light) -> bool| scene.lights.iter().all(admitted);
         self.light_samples_in_lanes()
@@ -76,29 +83,30 @@ impl DirectIntegrator {
             }
     }
 
-    /// Whether physical shading's first hits can take the lanes: materials
+    /// Whether physical shading's first hits can take the lanes: light
+    /// points no random stream draws (a point behind a light draws none,
+    /// which would shift a stream's later draws), and either no environment
+    /// samples, or an environment map sampled at Sobol points with materials
     /// that are diffuse (a zero specular color, so no lobe and no MIS) or
-    /// mirrors (reflected as a next wave, or traced alone: `mirrored`), an
-    /// environment map sampled at Sobol points or none, and light points no
-    /// random stream draws (a point behind a light draws none, which would
-    /// shift a stream's later draws).
+    /// mirrors (reflected as a next wave, or traced alone: `mirrored`).
     fn physical_in_lanes(&self, scene: &Scene) -> bool {
         let diffuse = |m: &PhongMaterial| {
             m.reflectivity > 0.0
                 || m.specular.as_ref().and_then(Texture::as_constant) == Some(Vec3::ZERO)
         };
         let environment = match &scene.environment {
-            None => true,
-            // Drawn at Sobol points, which no stream draws.
-            Some(_) => {
-                self.environment_samples == 0 || self.environment_pattern == SamplePattern::Sobol
+            Some(_) if self.environment_samples > 0 => {
+                // Drawn at Sobol points, which no stream draws; their term
+                // in lanes is the diffuse one.
+                self.environment_pattern == SamplePattern::Sobol
+                    && scene.materials.iter().all(diffuse)
             }
+            _ => true,
         };
         matches!(
             self.light_pattern,
             SamplePattern::Sobol | SamplePattern::Grid
-        ) && scene.materials.iter().all(diffuse)
-            && environment
+        ) && environment
     }
 
     /// Whether each camera sample's light points can be drawn lane by lane, the
@@ -213,6 +221,7 @@ impl DirectIntegrator {
                 Light::Sphere(sphere) => {
                     debug_assert!(physical, "the course's model admits no sphere lights");
                     let pair = pairs.take(own, self.light_samples);
+                    let sphere = (index, sphere);
                     self.physical_sphere_light_term(scene, shaded, sphere, (samples, pair), ctx)
                 }
             };
@@ -457,12 +466,14 @@ impl DirectIntegrator {
         Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(self.light_samples as f32)
     }
 
-    /// `physical_area_light`'s `L · Σ (kd/π · cos θ / p · V) / n` for area
-    /// light `index` at every lane's diffuse point, each lane summing its own
-    /// `n` samples in order, drawn by its own point's sampler (by area or
-    /// solid angle, as `light.sampler` chooses for it) at the points of
-    /// `pair` for the lanes' camera samples. A lane behind the light takes no
-    /// sample: its term is +0, as `li_at` adds `Vec3::ZERO`.
+    /// `physical_area_light`'s `L · Σ (f · cos θ / p · V · w) / n` for area
+    /// light `index` at every lane's point, each lane summing its own `n`
+    /// samples in order, drawn by its own point's sampler (by area or solid
+    /// angle, as `light.sampler` chooses for it) at the points of `pair` for
+    /// the lanes' camera samples; on a glossy point, plus as many samples of
+    /// its lobe ([`Self::lobe_sum`]), the two combined by the power
+    /// heuristic. A lane behind the light takes no sample: its term is +0, as
+    /// `li_at` adds `Vec3::ZERO`.
     fn physical_area_light_term<T: Tracer>(
         &self,
         scene: &Scene,
@@ -501,22 +512,34 @@ impl DirectIntegrator {
             };
             (position, pdf, area.shadow_ends(&position))
         };
-        let sum =
-            self.diffuse_light_sum(scene, shaded, (lit, &occluders), (samples, pair), draw, ctx);
+        let mis = self.mis_lanes(shaded, lit);
+        let shadowed = (lit, mis, &occluders);
+        let mut sum = self.light_sum(scene, shaded, shadowed, (samples, pair), draw, ctx);
+        if mis != 0 {
+            let light_pdf = |k: usize, y: Vec3| match &samplers[k] {
+                Some(sampler) => sampler.pdf(y),
+                None => area
+                    .sampler(shaded.point.lane(k), self.area_sampling)
+                    .pdf(y),
+            };
+            sum = sum + self.lobe_sum(scene, shaded, (mis, index), light_pdf, samples, ctx);
+        }
         Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(n as f32)
     }
 
-    /// `physical_sphere_light`'s `L · Σ (kd/π · cos θ / p · V) / n` for sphere
-    /// light `light` at every lane's diffuse point, each lane summing its own
+    /// `physical_sphere_light`'s `L · Σ (f · cos θ / p · V · w) / n` for
+    /// sphere light `index` at every lane's point, each lane summing its own
     /// `n` directions uniform over its cone ([`SphereLight::sample_lanes`]) at
-    /// the points of `pair` for the lanes' camera samples. A lane inside the
-    /// sphere takes no sample: its term is +0, as `li_at` adds `Vec3::ZERO`.
+    /// the points of `pair` for the lanes' camera samples; on a glossy point,
+    /// plus as many samples of its lobe ([`Self::lobe_sum`]). A lane inside
+    /// the sphere takes no sample: its term is +0, as `li_at` adds
+    /// `Vec3::ZERO`.
     #[inline(never)]
     fn physical_sphere_light_term<T: Tracer>(
         &self,
         scene: &Scene,
         shaded: &ShadedLanes,
-        light: &SphereLight,
+        (index, light): (usize, &SphereLight),
         (samples, pair): (&LaneSamples, DimensionPair),
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
@@ -530,22 +553,28 @@ impl DirectIntegrator {
             let (_, [point, error, normal], pdf) = light.sample_lanes(&shaded.point, u);
             (point, pdf, offset_ray_origins(&point, &error, &normal))
         };
-        let all = (lit, &Occluders::ALL);
-        let sum = self.diffuse_light_sum(scene, shaded, all, (samples, pair), draw, ctx);
+        let mis = self.mis_lanes(shaded, lit);
+        let all = (lit, mis, &Occluders::ALL);
+        let mut sum = self.light_sum(scene, shaded, all, (samples, pair), draw, ctx);
+        if mis != 0 {
+            let light_pdf = |k: usize, _: Vec3| light.pdf(shaded.point.lane(k));
+            sum = sum + self.lobe_sum(scene, shaded, (mis, index), light_pdf, samples, ctx);
+        }
         Vec3Lanes::scaled_splat_lanes(light.color, &sum).div_splat(n as f32)
     }
 
-    /// `Σ_j kd/π · cos θ / p · V` over a light's `light_samples` samples at
+    /// `Σ_j f · cos θ / p · V · w` over a light's `light_samples` samples at
     /// every lane of `lit`, each lane summing its own in order: sample `j`'s
     /// points (the grid's, or each lane's Sobol points of `pair`) drawn by
     /// `draw` into light points, their densities and their shadow rays' ends,
-    /// tested against `occluders`. A blocked sample adds +0 where `li_at`
-    /// adds nothing: the same, as the sum is never −0.
-    fn diffuse_light_sum<T: Tracer>(
+    /// tested against `occluders`; `w` the power heuristic's weight against
+    /// the lobe in the lanes `mis`, else 1. A blocked sample adds +0 where
+    /// `li_at` adds nothing: the same, as the sum is never −0.
+    fn light_sum<T: Tracer>(
         &self,
         scene: &Scene,
         shaded: &ShadedLanes,
-        (lit, occluders): (u32, &Occluders),
+        (lit, mis, occluders): (u32, u32, &Occluders),
         (samples, pair): (&LaneSamples, DimensionPair),
         mut draw: impl FnMut((F32Lanes, F32Lanes)) -> (Vec3Lanes, F32Lanes, Vec3Lanes),
         ctx: &mut SampleContext<T>,
@@ -554,20 +583,96 @@ impl DirectIntegrator {
         let grid = self.grid_points(pair, ctx);
         let sequences = (self.light_pattern == SamplePattern::Sobol)
             .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
-        let at = DiffusePoints {
-            point: &shaded.point,
-            ng: &shaded.ng,
-            n: shaded.phong.normals(),
-            kd: shaded.phong.kd(),
-        };
+        let glossy = lit & shaded.phong.specular_lanes() != 0;
+        let at = shaded.diffuse_points();
         let mut sum = Vec3Lanes::default();
         for j in 0..n {
             let (position, pdf, ends) = draw(light_points_at(&grid, &sequences, j, n));
-            let (values, traced) = at.light_samples(&position, pdf, lit, &mut ctx.counters);
+            let (values, traced) = match glossy {
+                true => shaded.glossy_light_samples(&position, pdf, (lit, mis), &mut ctx.counters),
+                false => at.light_samples(&position, pdf, lit, &mut ctx.counters),
+            };
             let towards = position - shaded.point;
             let visible = traced & !shaded.blocked(scene, occluders, &ends, &towards, traced);
             let zero = Vec3Lanes::default();
             sum = sum + Vec3Lanes::select(lanes::from_bits(visible), &values, &zero);
+        }
+        if let Some(grid) = grid {
+            ctx.light_points = grid;
+        }
+        sum
+    }
+
+    /// The lanes of `lit` whose light samples are weighted against their
+    /// lobe's: glossy points, when the integrator combines the two.
+    fn mis_lanes(&self, shaded: &ShadedLanes, lit: u32) -> u32 {
+        match self.mis {
+            true => lit & shaded.phong.specular_lanes(),
+            false => 0,
+        }
+    }
+
+    /// `lobe_samples`' `Σ_j f · cos θ / p · w` at the glossy points of the
+    /// lanes `mis` towards light `index`: each lane's `light_samples`
+    /// directions drawn from its own lobe at the points of the light's BRDF
+    /// pair, in order, the rays along them traced together, and a direction
+    /// counted where its ray meets the light's surface first, weighted by
+    /// the power heuristic against `light_pdf(k, y)`, lane k's density of
+    /// drawing the light's point `y`. Each lane's sum and counts are
+    /// `lobe_samples`' bit for bit; the other lanes' sums are +0.
+    #[inline(never)]
+    fn lobe_sum<T: Tracer>(
+        &self,
+        scene: &Scene,
+        shaded: &ShadedLanes,
+        (mis, index): (u32, usize),
+        light_pdf: impl Fn(usize, Vec3) -> f32,
+        samples: &LaneSamples,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let n = self.light_samples;
+        let pair = DimensionPair::Brdf {
+            light: index as u32,
+            depth: 0,
+        };
+        let grid = self.grid_points(pair, ctx);
+        let sequences = (self.light_pattern == SamplePattern::Sobol)
+            .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
+        ctx.counters.lobe_samples += u64::from(n) * u64::from(mis.count_ones());
+        let object = scene.light_objects[index];
+        let mut sum = Vec3Lanes::default();
+        for j in 0..n {
+            let u = light_points_at(&grid, &sequences, j, n);
+            let (l, pdf, drawn) = shaded.lobe_directions(u, mis, &mut ctx.counters);
+            let (f, traced) = shaded.lobe_reflections(&l, drawn, &mut ctx.counters);
+            if traced == 0 {
+                continue;
+            }
+            let pdf = pdf.to_array();
+            let rays = RayLanes {
+                origin: shaded.origins_towards(&l, traced),
+                direction: l,
+            };
+            let closest = scene.shapes.closest_lanes(&rays, LANES);
+            let mut weights = [0.0; LANES];
+            let mut reached = 0;
+            for k in lanes::each_set(traced) {
+                let ray = rays.lane(k);
+                let found = match &closest {
+                    Some(closest) => closest.hit(k),
+                    None => scene.shapes.closest_primitive(&ray, f32::INFINITY),
+                };
+                // The light's surface is one-sided: a hit on it is a hit on its front.
+                let on_light = found.filter(|found| found.object == object);
+                if let Some(hit) =
+                    on_light.and_then(|found| scene.shapes.surface_point(&ray, found))
+                {
+                    weights[k] = power_heuristic(pdf[k], light_pdf(k, hit.point)) / pdf[k];
+                    reached |= 1 << k;
+                }
+            }
+            let value = f.scale(F32Lanes::new(weights));
+            sum = sum + Vec3Lanes::select(lanes::from_bits(reached), &value, &Vec3Lanes::default());
         }
         if let Some(grid) = grid {
             ctx.light_points = grid;
@@ -954,7 +1059,7 @@ impl<'a> ShadedLanes<'a> {
     /// The shapes that may block the lanes' shadow rays to area light `index`,
     /// as [`DirectIntegrator::occluders`] culls them for one point: from a
     /// centre, widened by a reach that holds every lane's point, where the
-    /// lanes lie on one object; every shape otherwise.
+    /// lanes lie on one object; every shape but the light's otherwise.
     fn occluders<T: Tracer>(
         &self,
         scene: &Scene,
@@ -962,8 +1067,12 @@ impl<'a> ShadedLanes<'a> {
         light: &AreaLight,
         ctx: &mut SampleContext<T>,
     ) -> Occluders {
+        let light_object = scene.light_objects[index];
         let Some(object) = self.object else {
-            return Occluders::ALL;
+            // Lanes on several surfaces: only the light's own is left out,
+            // which a far grazing ray may meet by rounding (each lane's own
+            // surface lies behind its offset origin).
+            return scene.shapes.occluders_but([light_object, light_object]);
         };
         let farthest_from = |center: Vec3| {
             let offsets = self.point.sub_splat(center);
@@ -986,7 +1095,7 @@ impl<'a> ShadedLanes<'a> {
             center,
             reach,
             &light.surface().corners(),
-            [object, scene.light_objects[index]],
+            [object, light_object],
         );
         ctx.lane_occluders = Some(LaneOccluders {
             light: index,
@@ -1041,20 +1150,134 @@ impl<'a> ShadedLanes<'a> {
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let position = Vec3Lanes::splat(light.position);
-        let at = DiffusePoints {
-            point: &self.point,
-            ng: &self.ng,
-            n: self.phong.normals(),
-            kd: self.phong.kd(),
-        };
-        // A density of 1 leaves each lane's `kd/π · cos θ` as it is.
-        let (f, traced) = at.light_samples(&position, F32Lanes::ONE, self.lanes, &mut ctx.counters);
+        // A density of 1 leaves each lane's `f · cos θ` as it is.
+        let (f, traced) = self.light_samples(&position, F32Lanes::ONE, (self.lanes, 0), ctx);
         let towards = position - self.point;
         let visible = traced & !self.blocked(scene, &Occluders::ALL, &position, &towards, traced);
         let distance2 = towards.dot(&towards);
         let lit = Vec3Lanes::scaled_splat_lanes(light.color, &f);
         let value = Vec3Lanes::new(lit.x / distance2, lit.y / distance2, lit.z / distance2);
         Vec3Lanes::select(lanes::from_bits(visible), &value, &Vec3Lanes::default())
+    }
+
+    /// The light samples at `position` with solid-angle densities `pdf`, one
+    /// a lane, in the lanes `used`, short of their shadow rays: each lane's
+    /// `f · cos θ · w / p` ([`ShadingPoint::light_sample_unshadowed`] bit for
+    /// bit, `w` the power heuristic's weight in the lanes `mis`, else 1) and
+    /// the lanes that need a shadow ray, the others counted as skipped.
+    #[inline(always)]
+    fn light_samples<T: Tracer>(
+        &self,
+        position: &Vec3Lanes,
+        pdf: F32Lanes,
+        (used, mis): (u32, u32),
+        ctx: &mut SampleContext<T>,
+    ) -> (Vec3Lanes, u32) {
+        if used & self.phong.specular_lanes() != 0 {
+            return self.glossy_light_samples(position, pdf, (used, mis), &mut ctx.counters);
+        }
+        (self.diffuse_points()).light_samples(position, pdf, used, &mut ctx.counters)
+    }
+
+    /// The lanes' points as diffuse ones, for their kernel.
+    #[inline(always)]
+    fn diffuse_points(&self) -> DiffusePoints<'_> {
+        DiffusePoints {
+            point: &self.point,
+            ng: &self.ng,
+            n: self.phong.normals(),
+            kd: self.phong.kd(),
+        }
+    }
+
+    /// [`Self::light_samples`] where some lanes of `used` are glossy.
+    #[inline(never)]
+    fn glossy_light_samples(
+        &self,
+        position: &Vec3Lanes,
+        pdf: F32Lanes,
+        (used, mis): (u32, u32),
+        counters: &mut ShadingCounters,
+    ) -> (Vec3Lanes, u32) {
+        let glossy = used & self.phong.specular_lanes();
+        let dense = used & lanes::bits(lanes::gt(pdf, F32Lanes::ZERO) & pdf.is_finite());
+        let (l, normalized) = (*position - self.point).try_normalize();
+        let above = lanes::bits(normalized & lanes::gt(l.dot(&self.ng), F32Lanes::ZERO));
+        let f = self.phong.brdf_cos(&l);
+        let reflects = dense & above & !lanes::bits(f.is_zero());
+        let skips = &mut counters.light_skips;
+        skips.zero_density += u64::from((used & !dense).count_ones());
+        skips.below_surface += u64::from((dense & !above).count_ones());
+        skips.zero_brdf += u64::from((dense & above & !reflects).count_ones());
+        counters.specular_lobes += u64::from((dense & above & glossy).count_ones());
+        counters.light_shadow_rays += u64::from(reflects.count_ones());
+        let mut weights = [1.0; LANES];
+        let pdfs = pdf.to_array();
+        for k in lanes::each_set(reflects & mis) {
+            let lobe_pdf = self.lobe_pdf(k, l.lane(k));
+            weights[k] = power_heuristic(pdfs[k], lobe_pdf);
+        }
+        (f.scale(F32Lanes::new(weights) / pdf), reflects)
+    }
+
+    /// Lane `k`'s lobe's density of drawing the unit direction `l`.
+    fn lobe_pdf(&self, k: usize, l: Vec3) -> f32 {
+        let material = self.phong.material(k).expect("a glossy lane holds a point");
+        let (n, v) = (self.phong.normals().lane(k), self.phong.viewers().lane(k));
+        material.specular_pdf(n, l, v)
+    }
+
+    /// One direction drawn from each lane's lobe, of the glossy lanes `mis`,
+    /// at its point of `u`: the unit directions, their densities and the
+    /// lanes that drew one with a positive, finite density (the others
+    /// counted as the lobe's zero-density skips).
+    fn lobe_directions(
+        &self,
+        (ux, uy): (F32Lanes, F32Lanes),
+        mis: u32,
+        counters: &mut ShadingCounters,
+    ) -> (Vec3Lanes, F32Lanes, u32) {
+        let (ux, uy) = (ux.to_array(), uy.to_array());
+        let (mut directions, mut pdfs, mut drawn) = ([Vec3::ZERO; LANES], [0.0; LANES], 0);
+        for k in lanes::each_set(mis) {
+            let material = self.phong.material(k).expect("a glossy lane holds a point");
+            let (n, v) = (self.phong.normals().lane(k), self.phong.viewers().lane(k));
+            let Some(l) = material.sample_specular(n, v, Vec2::new(ux[k], uy[k])) else {
+                counters.lobe_skips.zero_density += 1;
+                continue;
+            };
+            let pdf = material.specular_pdf(n, l, v);
+            if !(pdf > 0.0 && pdf.is_finite()) {
+                counters.lobe_skips.zero_density += 1;
+                continue;
+            }
+            (directions[k], pdfs[k], drawn) = (l, pdf, drawn | 1 << k);
+        }
+        (
+            Vec3Lanes::from_lanes(directions),
+            F32Lanes::new(pdfs),
+            drawn,
+        )
+    }
+
+    /// Each lane's `f · cos θ` towards its lobe direction `l`, and the
+    /// lanes of `drawn` that need a ray along it: above the geometric
+    /// surface, with a reflection (the others counted as the lobe's skips),
+    /// counted.
+    fn lobe_reflections(
+        &self,
+        l: &Vec3Lanes,
+        drawn: u32,
+        counters: &mut ShadingCounters,
+    ) -> (Vec3Lanes, u32) {
+        let above = drawn & lanes::bits(lanes::gt(l.dot(&self.ng), F32Lanes::ZERO));
+        let f = self.phong.brdf_cos(l);
+        let traced = above & !lanes::bits(f.is_zero());
+        counters.lobe_skips.below_surface += u64::from((drawn & !above).count_ones());
+        counters.lobe_skips.zero_brdf += u64::from((above & !traced).count_ones());
+        counters.specular_lobes += u64::from(above.count_ones());
+        counters.brdf_rays += u64::from(traced.count_ones());
+        (f, traced)
     }
 
     /// The reflections of light samples `s` where their shadow rays, ending at
@@ -1238,6 +1461,11 @@ mod tests {
     /// lights: one facing down into the room, one facing the back wall from
     /// in front of the camera's view, so that each is behind some points.
     fn room() -> Scene {
+        room_with(|_| {})
+    }
+
+    /// [`room`] with what `more` adds to it.
+    fn room_with(more: impl FnOnce(&mut SceneBuilder)) -> Scene {
         let mut b = SceneBuilder::new();
         let checks = b.material(PhongMaterial::new(
             Checkerboard::new(Vec3::new(0.9, 0.2, 0.1), Vec3::new(0.1, 0.3, 0.8), 4),
@@ -1319,6 +1547,7 @@ mod tests {
         .facing(-Vec3::Z);
         b.area_light(down).area_light(back);
         b.ambient(Vec3::splat(0.05));
+        more(&mut b);
         let camera = Camera::new(
             Vec3::new(0.0, 1.0, 3.0),
             Vec3::new(0.0, 0.0, -5.0),
@@ -1604,30 +1833,53 @@ mod tests {
             let map = glint_texture::Environment::LatLong(glint_texture::LatLongMap::new(image));
             glint_lighting::EnvironmentLight::new(map, 0.3, 1.5)
         };
-        for (pattern, light_samples, footprints, area_sampling, environment_samples, mirrors) in [
-            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 0, false),
-            (SamplePattern::Sobol, 5, false, AreaSampling::Auto, 0, false),
-            (SamplePattern::Grid, 4, false, AreaSampling::Area, 0, false),
-            (
-                SamplePattern::Sobol,
-                4,
-                true,
-                AreaSampling::SolidAngle,
-                0,
-                false,
-            ),
-            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 1, false),
-            (SamplePattern::Sobol, 4, true, AreaSampling::Auto, 3, false),
-            (SamplePattern::Grid, 1, false, AreaSampling::Area, 17, false),
-            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 4, true),
-            (SamplePattern::Sobol, 4, true, AreaSampling::Auto, 1, true),
-        ] {
-            let mut scene = room();
+        // Glossy rooms also hold a point light and a sphere light; their
+        // materials take every kind of lobe (Phong's with integral and
+        // fractional exponents, Blinn–Phong's) against every kind of light.
+        let glossy_room = || {
+            room_with(|b| {
+                b.point_light(glint_lighting::PointLight {
+                    position: Vec3::new(-2.0, 3.0, -3.0),
+                    color: Vec3::new(0.5, 0.4, 0.3),
+                });
+                let sphere = SphereLight::new(Vec3::new(2.0, 2.5, -3.0), 0.5, Vec3::splat(2.0));
+                b.sphere_light(sphere.unwrap());
+            })
+        };
+        // (light pattern, light samples, footprints, area sampling,
+        // environment samples, mirrors, glossy)
+        #[rustfmt::skip]
+        let cases = [
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 0, false, false),
+            (SamplePattern::Sobol, 5, false, AreaSampling::Auto, 0, false, false),
+            (SamplePattern::Grid, 4, false, AreaSampling::Area, 0, false, false),
+            (SamplePattern::Sobol, 4, true, AreaSampling::SolidAngle, 0, false, false),
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 1, false, false),
+            (SamplePattern::Sobol, 4, true, AreaSampling::Auto, 3, false, false),
+            (SamplePattern::Grid, 1, false, AreaSampling::Area, 17, false, false),
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 4, true, false),
+            (SamplePattern::Sobol, 4, true, AreaSampling::Auto, 1, true, false),
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 0, false, true),
+            (SamplePattern::Sobol, 5, false, AreaSampling::SolidAngle, 0, false, true),
+            (SamplePattern::Grid, 4, true, AreaSampling::Area, 0, false, true),
+            (SamplePattern::Sobol, 3, false, AreaSampling::Auto, 0, true, true),
+        ];
+        for (
+            pattern,
+            light_samples,
+            footprints,
+            area_sampling,
+            environment_samples,
+            mirrors,
+            glossy,
+        ) in cases
+        {
+            let mut scene = if glossy { glossy_room() } else { room() };
             scene.shading = ShadingModel::Physical;
             if environment_samples > 0 {
                 scene.environment = Some(sky());
             }
-            for material in &mut scene.materials {
+            for material in scene.materials.iter_mut().filter(|_| !glossy) {
                 material.specular = Some(Texture::Constant(Vec3::ZERO));
             }
             if mirrors {
@@ -1664,10 +1916,14 @@ mod tests {
         assert!(total.light_skips.zero_brdf > 0, "{total:?}");
         assert!(total.light_shadow_rays > 0, "{total:?}");
         assert!(total.footprints > 0, "{total:?}");
-        // A glossy material, or light points drawn from random streams, keep
-        // the one-by-one route.
+        assert!(total.lobe_samples > 0 && total.brdf_rays > 0, "{total:?}");
+        assert!(total.lobe_skips.below_surface > 0, "{total:?}");
+        assert!(total.specular_lobes > 0, "{total:?}");
+        // A glossy material under an environment drawn from, or light points
+        // drawn from random streams, keep the one-by-one route.
         let mut glossy = room();
         glossy.shading = ShadingModel::Physical;
+        glossy.environment = Some(sky());
         let sobol = DirectIntegrator {
             light_samples: 4,
             light_pattern: SamplePattern::Sobol,
@@ -1679,6 +1935,9 @@ mod tests {
             mis: true,
         };
         assert!(!sobol.shades_first_hits_in_lanes(&glossy));
+        let sky_drawn_from = glossy.environment.take();
+        assert!(sobol.shades_first_hits_in_lanes(&glossy));
+        glossy.environment = sky_drawn_from;
         for material in &mut glossy.materials {
             material.specular = Some(Texture::Constant(Vec3::ZERO));
         }

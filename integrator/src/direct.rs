@@ -232,9 +232,11 @@ impl DirectIntegrator {
     }
 
     /// The shapes that may block `point`'s shadow rays to area light `index`:
-    /// every shape below [`CULL_FROM_SAMPLES`] samples per light, where culling
-    /// costs more than it saves; else the culling found for an earlier sample of
-    /// the pixel on the same surface within its reach, or a new one.
+    /// every shape but its own and the light's flat surfaces
+    /// ([`ShapeList::occluders_but`](glint_geometry::ShapeList::occluders_but))
+    /// below [`CULL_FROM_SAMPLES`] samples per light, where culling costs more
+    /// than it saves; else the culling found for an earlier sample of the pixel
+    /// on the same surface within its reach, or a new one.
     pub(crate) fn occluders<T: Tracer>(
         &self,
         scene: &Scene,
@@ -243,10 +245,12 @@ impl DirectIntegrator {
         light: &AreaLight,
         ctx: &mut SampleContext<T>,
     ) -> Occluders {
-        if self.light_samples < CULL_FROM_SAMPLES {
-            return Occluders::ALL;
-        }
         let (p, shape, pixel) = (point.hit.point, point.hit.shape, ctx.sample.pixel);
+        if self.light_samples < CULL_FROM_SAMPLES {
+            return scene
+                .shapes
+                .occluders_but([shape, scene.light_objects[index]]);
+        }
         if let Some(cached) = &ctx.occluders {
             let same = (cached.pixel, cached.light, cached.shape) == (pixel, index, shape);
             if same && p.distance(cached.center) <= cached.reach {

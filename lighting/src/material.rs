@@ -105,12 +105,20 @@ impl PhongMaterial {
         if n_dot_l <= 0.0 {
             return Vec3::ZERO;
         }
-        let norm = match self.lobe {
-            SpecularLobe::Phong => (self.shininess + 2.0) / (2.0 * std::f32::consts::PI),
-            SpecularLobe::BlinnPhong => blinn_phong_normalisation(self.shininess),
-        };
+        let norm = self.lobe_normalisation();
         (kd * std::f32::consts::FRAC_1_PI + ks * norm * self.specular_lobe(n, l, v, n_dot_l))
             * n_dot_l
+    }
+
+    /// The factor that makes the specular lobe conserve energy in
+    /// [`Self::brdf_cos`]: `(s + 2)/2π` for Phong's, and
+    /// [`blinn_phong_normalisation`] for Blinn–Phong's.
+    #[inline]
+    pub fn lobe_normalisation(&self) -> f32 {
+        match self.lobe {
+            SpecularLobe::Phong => (self.shininess + 2.0) / (2.0 * std::f32::consts::PI),
+            SpecularLobe::BlinnPhong => blinn_phong_normalisation(self.shininess),
+        }
     }
 
     /// [`Self::brdf_cos`] for `ks = 0`, without the specular lobe: the same value.

@@ -135,6 +135,37 @@ impl<'a> PhongLanes<'a> {
         phong_reflection(&self.kd, &self.ks, specular, &self.n, l, lobe)
     }
 
+    /// Per lane, the physical BRDF times the cosine for light from the unit
+    /// direction `l`: [`PhongMaterial::brdf_cos`] where the lane has a
+    /// specular term, [`PhongMaterial::brdf_cos_diffuse`] elsewhere, bit for
+    /// bit; zero where `n·l ≤ 0`.
+    #[inline]
+    pub fn brdf_cos(&self, l: &Vec3Lanes) -> Vec3Lanes {
+        let n_dot_l = self.n.dot(l);
+        let diffuse = self.kd.scale(F32Lanes::splat(std::f32::consts::FRAC_1_PI));
+        let f = if self.specular == 0 {
+            diffuse
+        } else {
+            let lobe = self.specular_lobe(&self.n, l, n_dot_l);
+            let norm =
+                lanes::from_fn(|k| self.materials[k].map_or(0.0, |m| m.lobe_normalisation()));
+            let glossy = diffuse + self.ks.scale(norm).scale(lobe);
+            Vec3Lanes::select(lanes::from_bits(self.specular), &glossy, &diffuse)
+        };
+        let zero = Vec3Lanes::default();
+        Vec3Lanes::select(lanes::le(n_dot_l, F32Lanes::ZERO), &zero, &f.scale(n_dot_l))
+    }
+
+    /// Lane `k`'s material, if the lane is set.
+    pub fn material(&self, k: usize) -> Option<&'a PhongMaterial> {
+        self.materials[k]
+    }
+
+    /// Each lane's unit direction to the viewer.
+    pub fn viewers(&self) -> &Vec3Lanes {
+        &self.v
+    }
+
     /// [`PhongMaterial::specular_lobe`] per lane.
     #[inline]
     fn specular_lobe(&self, n: &Vec3Lanes, l: &Vec3Lanes, n_dot_l: F32Lanes) -> F32Lanes {

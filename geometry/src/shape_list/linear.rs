@@ -32,6 +32,11 @@ pub(super) struct LinearShapes {
 }
 
 impl LinearShapes {
+    /// The sphere and parallelogram packets.
+    pub(super) fn packets(&self) -> usize {
+        self.sphere_bounds.len() + self.parallelogram_corners.len()
+    }
+
     /// The packets of `list`'s spheres and parallelograms, and with `others`
     /// its other objects to be tested one by one (without, a BVH holds them).
     pub(super) fn new(list: &ShapeList, with_others: bool) -> Self {

@@ -30,6 +30,9 @@ use wide::f32x4;
 pub struct Occluders {
     lanes: u64,
     others: u32,
+    /// Whether the shapes were culled for one point's segments (else the
+    /// rays may still be culled as a batch, by their segments' bounds).
+    culled: bool,
 }
 
 impl Occluders {
@@ -37,6 +40,7 @@ impl Occluders {
     pub const ALL: Occluders = Occluders {
         lanes: u64::MAX,
         others: u32::MAX,
+        culled: false,
     };
 
     /// Whether the linear loop's other object `i` is kept (past 32, always).
@@ -87,15 +91,12 @@ impl ShapeList {
         light: &[Vec3; 4],
         exclude: [u32; 2],
     ) -> Occluders {
-        let Some(linear) = &self.linear else {
+        let Some(linear) = self.linear.as_ref().filter(|l| l.packets() <= MAX_PACKETS) else {
             return Occluders::ALL;
         };
         let Some(planes) = pyramid_planes(from, light, reach) else {
-            return Occluders::ALL;
+            return self.occluders_but(exclude);
         };
-        if linear.sphere_bounds.len() + linear.parallelogram_corners.len() > MAX_PACKETS {
-            return Occluders::ALL;
-        }
         let mut lanes = 0u64;
         let mut bit = 0;
         for (center, radius) in &linear.sphere_bounds {
@@ -137,15 +138,37 @@ impl ShapeList {
             lanes |= ((used & !outside).bitmask() as u64 & !facing_away) << bit;
             bit += 4;
         }
-        // A flat shape never blocks a ray leaving its own surface, nor one that
-        // ends (short of) on it.
-        for object in exclude {
-            if let Some(Some(flat)) = linear.flat_bits.get(object as usize) {
-                lanes &= !(1u64 << flat);
+        let others = self.planes_kept(linear, from, light, planes[0].margin, exclude);
+        Occluders {
+            lanes: lanes & !flat_lanes(linear, exclude),
+            others,
+            culled: true,
+        }
+    }
+
+    /// Every shape but the flat ones `exclude` names (the surface shadow rays
+    /// leave, the light's own), which [`Self::occluders_towards`] leaves out
+    /// however little else it culls: they never block such a segment, but a
+    /// ray from far away at a grazing angle may meet its light's surface by
+    /// rounding, just short of its end. [`Occluders::ALL`] outside the linear
+    /// loop's layout.
+    pub fn occluders_but(&self, exclude: [u32; 2]) -> Occluders {
+        let Some(linear) = self.linear.as_ref().filter(|l| l.packets() <= MAX_PACKETS) else {
+            return Occluders::ALL;
+        };
+        let mut others = u32::MAX;
+        for (i, &object) in linear.others.iter().enumerate().take(32) {
+            if exclude.contains(&object)
+                && matches!(self.object(object), ObjectRef::Shape(Shape::Plane(_)))
+            {
+                others &= !(1 << i);
             }
         }
-        let others = self.planes_kept(linear, from, light, planes[0].margin, exclude);
-        Occluders { lanes, others }
+        Occluders {
+            lanes: !flat_lanes(linear, exclude),
+            others,
+            culled: false,
+        }
     }
 
     /// The linear loop's other objects that may block the segments of
@@ -229,7 +252,7 @@ impl ShapeList {
         // Rays from several points, not culled for one point (`Occluders::ALL`):
         // only the shapes near their segments. After a point's own culling
         // this would cost more than it saves.
-        let reach = (occluders.lanes == u64::MAX).then(|| segments_bounds(rays, t_max, active));
+        let reach = (!occluders.culled).then(|| segments_bounds(rays, t_max, active));
         let spheres = linear.spheres.iter().map(|(_, objects)| objects);
         let parallelograms = linear.parallelograms.iter().map(|(_, objects)| objects);
         for (k, objects) in spheres.chain(parallelograms).enumerate() {
@@ -340,6 +363,16 @@ impl Face {
             + x[2] * Vec4::splat(self.normal.z)
             - Vec4::splat(self.offset)
     }
+}
+
+/// The bits of the flat shapes among `objects`: a flat shape never blocks a
+/// ray leaving its own surface, nor one that ends (short of) on it.
+fn flat_lanes(linear: &LinearShapes, objects: [u32; 2]) -> u64 {
+    let flat = |object: u32| linear.flat_bits.get(object as usize).copied().flatten();
+    objects
+        .into_iter()
+        .filter_map(flat)
+        .fold(0, |bits, flat| bits | 1 << flat)
 }
 
 /// The outward faces of the pyramid with apex `apex` over the convex polygon
@@ -484,9 +517,26 @@ mod tests {
             under,
             Occluders {
                 lanes: 1 << 1,
-                others: u32::MAX
+                others: u32::MAX,
+                culled: true,
             }
         );
+    }
+
+    /// From a point so far away along the floor that the pyramid over the
+    /// light degenerates, nothing is culled but the flat surfaces named: the
+    /// floor the rays leave and the light's own, which a grazing ray from
+    /// there may meet by rounding.
+    #[test]
+    fn a_point_too_far_to_cull_from_still_leaves_out_its_own_and_the_lights_surface() {
+        let (list, light) = cornell();
+        let far = list.occluders_towards(Vec3::new(4.0e7, -6.0, 0.0), 0.0, &light, [3, 9]);
+        assert_eq!(far, list.occluders_but([3, 9]));
+        assert_ne!(far, Occluders::ALL);
+        assert_eq!(far.count(), 64 - 2, "{far:?}");
+        // Near, the same exclusions on top of the pyramid's culling.
+        let near = list.occluders_towards(Vec3::new(4.0, -6.0, 0.0), 0.0, &light, [3, 9]);
+        assert_eq!(near.count(), 0, "{near:?}");
     }
 
     /// A ground plane, a wall plane, a two-sided plane tilted across the space

@@ -19,8 +19,7 @@
 //! sample can draw alone (not a stratified pattern of several), and either
 //! the course's model with area and point lights, no environment and no
 //! mirrors, or physical shading under area, point and sphere lights and an
-//! environment map (glossy materials only where the map is not sampled),
-//! whose lanes on a partial mirror are each traced alone by `li_at` and whose
+//! environment map, whose lanes on a partial mirror are each traced alone by `li_at` and whose
 //! perfect mirrors reflect their lanes as a next wave. Physical shading draws
 //! each lane's light samples with its own point's sampler (by area or solid
 //! angle) and takes them through the diffuse kernel a point's light samples
@@ -65,8 +64,8 @@ impl DirectIntegrator {
     /// a time (`li_first_hits`): light points each sample can draw alone, and
     /// either the course's shading model with area and point lights, no
     /// environment and no mirrors, or physical shading with area, point and
-    /// sphere lights where its light points are drawn from no random stream
-    /// and its glossy materials are under no sampled environment.
+    /// sphere lights where its light and environment points are drawn from no
+    /// random stream.
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
         let lights = |admitted: fn(&Light) -> bool| scene.lights.iter().all(admitted);
         self.light_samples_in_lanes()
@@ -83,30 +82,18 @@ impl DirectIntegrator {
             }
     }
 
-    /// Whether physical shading's first hits can take the lanes: light
-    /// points no random stream draws (a point behind a light draws none,
-    /// which would shift a stream's later draws), and either no environment
-    /// samples, or an environment map sampled at Sobol points with materials
-    /// that are diffuse (a zero specular color, so no lobe and no MIS) or
-    /// mirrors (reflected as a next wave, or traced alone: `mirrored`).
+    /// Whether physical shading's first hits can take the lanes: light and
+    /// environment points no random stream draws (a point behind a light
+    /// draws none, which would shift a stream's later draws). Mirrors reflect
+    /// as a next wave, or are traced alone (`mirrored`).
     fn physical_in_lanes(&self, scene: &Scene) -> bool {
-        let diffuse = |m: &PhongMaterial| {
-            m.reflectivity > 0.0
-                || m.specular.as_ref().and_then(Texture::as_constant) == Some(Vec3::ZERO)
-        };
-        let environment = match &scene.environment {
-            Some(_) if self.environment_samples > 0 => {
-                // Drawn at Sobol points, which no stream draws; their term
-                // in lanes is the diffuse one.
-                self.environment_pattern == SamplePattern::Sobol
-                    && scene.materials.iter().all(diffuse)
-            }
-            _ => true,
-        };
+        let environment_drawn_from_no_stream = scene.environment.is_none()
+            || self.environment_samples == 0
+            || self.environment_pattern == SamplePattern::Sobol;
         matches!(
             self.light_pattern,
             SamplePattern::Sobol | SamplePattern::Grid
-        ) && environment
+        ) && environment_drawn_from_no_stream
     }
 
     /// Whether each camera sample's light points can be drawn lane by lane, the
@@ -359,11 +346,11 @@ impl DirectIntegrator {
         }
     }
 
-    /// `environment_light` at every lane's diffuse point: each lane's `n`
-    /// samples drawn together across the lanes at its camera sample's points,
-    /// from the map ([`EnvironmentLight::sample_each`]) or about each lane's
-    /// normal ([`EnvironmentLight::sample_cosine_each`]), then
-    /// `L · kd/π · cos θ / p` and the shadow rays in lanes, each lane summing
+    /// `environment_light` at every lane's point: each lane's `n` samples
+    /// drawn together across the lanes at its camera sample's points, from
+    /// the map ([`EnvironmentLight::sample_each`]) or about each lane's normal
+    /// ([`EnvironmentLight::sample_cosine_each`]), then `L · f · cos θ / p`
+    /// (the lobe too on glossy lanes) and the shadow rays in lanes, each lane summing
     /// its own samples in order, bit for bit `add_environment_samples`.
     fn environment_term_lanes<T: Tracer>(
         &self,
@@ -379,10 +366,6 @@ impl DirectIntegrator {
         let pair = self.environment_pair_at_first_hit(scene);
         let sequences = RunSequences::new(samples, shaded.lanes, pair, n, ctx);
         let len = (u32::BITS - shaded.lanes.leading_zeros()) as usize;
-        let kd_over_pi = shaded
-            .phong
-            .kd()
-            .scale(F32Lanes::splat(std::f32::consts::FRAC_1_PI));
         let by_map = self.samples_environment_by_map(scene);
         let mut sum = Vec3Lanes::default();
         for j in 0..n {
@@ -403,12 +386,10 @@ impl DirectIntegrator {
                 & lanes::bits(lanes::gt(pdf, F32Lanes::ZERO))
                 & !lanes::bits(radiance.is_zero());
             let above = lanes::bits(lanes::gt(direction.dot(&shaded.ng), F32Lanes::ZERO));
-            // `brdf_cos_diffuse`: kd/π · n·l, zero where n·l ≤ 0.
-            let n_dot_l = shaded.phong.normals().dot(&direction);
-            let f = kd_over_pi.scale(n_dot_l);
-            let zero = Vec3Lanes::default();
-            let f = Vec3Lanes::select(lanes::le(n_dot_l, F32Lanes::ZERO), &zero, &f);
+            let f = shaded.phong.brdf_cos(&direction);
             let traced = dense & above & !lanes::bits(f.is_zero());
+            let glossy = dense & above & shaded.phong.specular_lanes();
+            ctx.counters.specular_lobes += u64::from(glossy.count_ones());
             let skips = &mut ctx.counters.environment_skips;
             skips.zero_density += u64::from((shaded.lanes & !dense).count_ones());
             skips.below_surface += u64::from((dense & !above).count_ones());
@@ -421,7 +402,7 @@ impl DirectIntegrator {
             let blocked =
                 (scene.shapes).any_hits_among(&Occluders::ALL, &rays, f32::INFINITY, traced);
             let visible = lanes::from_bits(traced & !blocked);
-            sum = sum + Vec3Lanes::select(visible, &value, &zero);
+            sum = sum + Vec3Lanes::select(visible, &value, &Vec3Lanes::default());
         }
         sum.div_splat(n as f32)
     }
@@ -1863,6 +1844,8 @@ mod tests {
             (SamplePattern::Sobol, 5, false, AreaSampling::SolidAngle, 0, false, true),
             (SamplePattern::Grid, 4, true, AreaSampling::Area, 0, false, true),
             (SamplePattern::Sobol, 3, false, AreaSampling::Auto, 0, true, true),
+            (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 4, false, true),
+            (SamplePattern::Grid, 4, true, AreaSampling::Auto, 3, true, true),
         ];
         for (
             pattern,
@@ -1919,8 +1902,8 @@ mod tests {
         assert!(total.lobe_samples > 0 && total.brdf_rays > 0, "{total:?}");
         assert!(total.lobe_skips.below_surface > 0, "{total:?}");
         assert!(total.specular_lobes > 0, "{total:?}");
-        // A glossy material under an environment drawn from, or light points
-        // drawn from random streams, keep the one-by-one route.
+        // Light or environment points drawn from random streams keep the
+        // one-by-one route.
         let mut glossy = room();
         glossy.shading = ShadingModel::Physical;
         glossy.environment = Some(sky());
@@ -1934,19 +1917,19 @@ mod tests {
             area_sampling: AreaSampling::Auto,
             mis: true,
         };
-        assert!(!sobol.shades_first_hits_in_lanes(&glossy));
-        let sky_drawn_from = glossy.environment.take();
-        assert!(sobol.shades_first_hits_in_lanes(&glossy));
-        glossy.environment = sky_drawn_from;
-        for material in &mut glossy.materials {
-            material.specular = Some(Texture::Constant(Vec3::ZERO));
-        }
         assert!(sobol.shades_first_hits_in_lanes(&glossy));
         let random = DirectIntegrator {
             light_pattern: SamplePattern::Random,
             ..sobol
         };
         assert!(!random.shades_first_hits_in_lanes(&glossy));
+        let random_sky = DirectIntegrator {
+            environment_pattern: SamplePattern::Random,
+            ..sobol
+        };
+        assert!(!random_sky.shades_first_hits_in_lanes(&glossy));
+        glossy.environment = None;
+        assert!(random_sky.shades_first_hits_in_lanes(&glossy));
     }
 
     /// Checks read from the normals in lanes are the scalar path's, bit for

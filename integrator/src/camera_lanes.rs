@@ -71,9 +71,8 @@ impl DirectIntegrator {
         self.light_samples_in_lanes()
             && match scene.shading {
                 ShadingModel::Phong => {
-                    scene.environment.is_none()
-                        && scene.materials.iter().all(|m| m.reflectivity == 0.0)
-                        && lights(|l| matches!(l, Light::Area(_) | Light::Point(_)))
+                    lights(|l| matches!(l, Light::Area(_) | Light::Point(_)))
+                        && self.environment_drawn_from_no_stream(scene)
                 }
                 ShadingModel::Physical => {
                     lights(|l| matches!(l, Light::Area(_) | Light::Point(_) | Light::Sphere(_)))
@@ -87,13 +86,18 @@ impl DirectIntegrator {
     /// draws none, which would shift a stream's later draws). Mirrors reflect
     /// as a next wave, or are traced alone (`mirrored`).
     fn physical_in_lanes(&self, scene: &Scene) -> bool {
-        let environment_drawn_from_no_stream = scene.environment.is_none()
-            || self.environment_samples == 0
-            || self.environment_pattern == SamplePattern::Sobol;
         matches!(
             self.light_pattern,
             SamplePattern::Sobol | SamplePattern::Grid
-        ) && environment_drawn_from_no_stream
+        ) && self.environment_drawn_from_no_stream(scene)
+    }
+
+    /// Whether the environment's samples, if any, come from no random
+    /// stream: drawn at Sobol points, in lanes across the camera samples.
+    fn environment_drawn_from_no_stream(&self, scene: &Scene) -> bool {
+        scene.environment.is_none()
+            || self.environment_samples == 0
+            || self.environment_pattern == SamplePattern::Sobol
     }
 
     /// Whether each camera sample's light points can be drawn lane by lane, the
@@ -127,11 +131,24 @@ impl DirectIntegrator {
         let hit_lanes =
             hit_lanes & !self.mirrored(scene, hits, hit_lanes, samples, &mut radiance, ctx);
         if let Some(env) = &scene.environment {
-            // `environment_seen` under physical shading: the map unfiltered.
             let misses = ((1 << used) - 1) & !closest.hits;
             ctx.counters.environment_lookups += u64::from(misses.count_ones());
-            let seen = env.radiance_each(&rays.direction.normalize(), misses);
-            radiance = Vec3Lanes::select(lanes::from_bits(misses), &seen, &radiance);
+            match scene.shading {
+                // `environment_seen` under physical shading: the map unfiltered.
+                ShadingModel::Physical => {
+                    let seen = env.radiance_each(&rays.direction.normalize(), misses);
+                    radiance = Vec3Lanes::select(lanes::from_bits(misses), &seen, &radiance);
+                }
+                // The course's model filters it over each ray's footprint.
+                ShadingModel::Phong => {
+                    for k in lanes::each_set(misses) {
+                        let ray = rays.lane(k);
+                        let diff = diffs.map_or_else(|| RayDifferential::none(&ray), |d| d[k]);
+                        let width = diff.angular_width(ray.direction);
+                        radiance.set_lane(k, env.radiance(ray.direction.normalize(), width));
+                    }
+                }
+            }
         }
         if hit_lanes == 0 {
             return radiance;
@@ -227,10 +244,12 @@ impl DirectIntegrator {
         Vec3Lanes::select(shaded_mask, &(radiance + Vec3Lanes::default()), &radiance)
     }
 
-    /// The lanes of `hit_lanes` on a mirror (physical shading only), their
-    /// radiance put in `radiance`: a perfect mirror's reflected rays as the
-    /// next wave of lanes ([`Self::mirror_wave`]), any other mirror's lanes
-    /// each traced alone by `li_at` for its camera sample.
+    /// The lanes of `hit_lanes` on a mirror, their radiance put in
+    /// `radiance`: under physical shading a perfect mirror's reflected rays
+    /// as the next wave of lanes ([`Self::mirror_wave`]); any other mirror's
+    /// lanes, and every mirror's in the course's model (whose reflections
+    /// carry differentials for filtered lookups), each traced alone by
+    /// `li_at` for its camera sample.
     fn mirrored<T: Tracer>(
         &self,
         scene: &Scene,
@@ -241,14 +260,15 @@ impl DirectIntegrator {
         ctx: &mut SampleContext<T>,
     ) -> u32 {
         let reflects = |m: &PhongMaterial| m.reflectivity > 0.0;
-        if scene.shading == ShadingModel::Phong || !scene.materials.iter().any(reflects) {
+        if !scene.materials.iter().any(reflects) {
             return 0;
         }
+        let waves = self.max_depth > 0 && scene.shading == ShadingModel::Physical;
         let (mut perfect, mut partial) = (0, 0);
         for k in lanes::each_set(hit_lanes) {
             if let SurfaceKind::Material(m) = scene.surface_of_primitive(hits.2.object[k], 0) {
                 match m.reflectivity {
-                    1.0 if self.max_depth > 0 => perfect |= 1 << k,
+                    1.0 if waves => perfect |= 1 << k,
                     r if r > 0.0 => partial |= 1 << k,
                     _ => {}
                 }
@@ -1445,6 +1465,25 @@ mod tests {
         room_with(|_| {})
     }
 
+    /// A lat-long map with a bright patch, sampled by luminance.
+    fn sky() -> EnvironmentLight {
+        sky_of(1)
+    }
+
+    /// [`sky`] at `scale` times its 32 × 16 texels, the patch striped across
+    /// its texels so that a lookup filtered over a footprint differs from
+    /// the texel's own.
+    fn sky_of(scale: u32) -> EnvironmentLight {
+        let image = glint_texture::Image::from_fn(32 * scale, 16 * scale, |x, y| {
+            let (x, stripe) = (x / scale, (x + y) % 2 == 0);
+            let bright = (10..14).contains(&x) && (3..6).contains(&(y / scale));
+            let shade = if stripe { 1.0 } else { 0.25 };
+            Vec3::new(0.2 + 0.01 * x as f32, 0.3, 0.4 * shade) * if bright { 40.0 } else { 1.0 }
+        });
+        let map = glint_texture::Environment::LatLong(glint_texture::LatLongMap::new(image));
+        EnvironmentLight::new(map, 0.3, 1.5)
+    }
+
     /// [`room`] with what `more` adds to it.
     fn room_with(more: impl FnOnce(&mut SceneBuilder)) -> Scene {
         let mut b = SceneBuilder::new();
@@ -1652,18 +1691,38 @@ mod tests {
         let mut total = ShadingCounters::default();
         // Chunks whose lanes hit several objects, one shape, one light.
         let mut common = [0; 3];
-        for (pattern, light_samples, footprints) in [
-            (SamplePattern::Random, 1, false),
-            (SamplePattern::Stratified, 1, false),
-            (SamplePattern::Sobol, 1, false),
-            (SamplePattern::Grid, 1, false),
-            (SamplePattern::Random, 3, false),
-            (SamplePattern::Sobol, 5, false),
-            (SamplePattern::Grid, 4, false),
-            (SamplePattern::Sobol, 1, true),
-            (SamplePattern::Random, 4, true),
+        // The last cases put the room under the sky, with a mirror, a half
+        // mirror and a box: each miss's lookup filtered over its footprint,
+        // each mirror lane traced alone.
+        for (pattern, light_samples, footprints, sky_and_mirrors) in [
+            (SamplePattern::Random, 1, false, false),
+            (SamplePattern::Stratified, 1, false, false),
+            (SamplePattern::Sobol, 1, false, false),
+            (SamplePattern::Grid, 1, false, false),
+            (SamplePattern::Random, 3, false, false),
+            (SamplePattern::Sobol, 5, false, false),
+            (SamplePattern::Grid, 4, false, false),
+            (SamplePattern::Sobol, 1, true, false),
+            (SamplePattern::Random, 4, true, false),
+            (SamplePattern::Random, 1, false, true),
+            (SamplePattern::Sobol, 4, true, true),
         ] {
-            let mut scene = room();
+            let mut scene = match sky_and_mirrors {
+                false => room(),
+                true => room_with(|b| {
+                    let material = b.material(PhongMaterial::new(Vec3::new(0.5, 0.4, 0.7), 8.0));
+                    let aabox = glint_geometry::AaBox::new(
+                        Vec3::new(1.0, -2.0, -8.5),
+                        Vec3::new(3.5, 0.5, -7.0),
+                    );
+                    b.shape(aabox.unwrap(), material);
+                }),
+            };
+            if sky_and_mirrors {
+                scene.environment = Some(sky_of(8));
+                scene.materials[2].reflectivity = 1.0;
+                scene.materials[3].reflectivity = 0.5;
+            }
             if light_samples > 1 {
                 // Two point lights too, after the area light.
                 let point = |position| {
@@ -1689,10 +1748,21 @@ mod tests {
                 mis: true,
             };
             assert!(integrator.shades_first_hits_in_lanes(&scene));
-            let compared =
-                compare_lanes_with_scalar(&scene, &integrator, footprints, &mut total, &mut common);
+            let differentials = footprints || sky_and_mirrors;
+            let compared = compare_lanes_with_scalar(
+                &scene,
+                &integrator,
+                differentials,
+                &mut total,
+                &mut common,
+            );
             assert_eq!(compared, 12 * 10 * (3 * LANES + 3 + 1 + 11));
         }
+        assert!(
+            total.environment_lookups > 0 && total.reflection_rays > 0,
+            "{total:?}"
+        );
+        assert!(total.environment_shadow_rays > 0, "{total:?}");
         // Both ways of gathering the points were taken, and lanes that all see a light.
         assert!(common.iter().all(|&n| n > 0), "{common:?}");
         // Every branch was taken: lanes behind a light, below the horizon, with
@@ -1734,7 +1804,21 @@ mod tests {
             change(&mut scene);
             integrator(1).shades_first_hits_in_lanes(&scene)
         };
-        assert!(!with(|s| s.materials[1].reflectivity = 0.5));
+        // Mirror lanes are traced alone; the environment's points drawn from
+        // random streams are not drawn in lanes.
+        assert!(with(|s| s.materials[1].reflectivity = 0.5));
+        let sky_drawn_from = |pattern| {
+            let mut scene = room();
+            scene.environment = Some(sky());
+            let integrator = DirectIntegrator {
+                environment_samples: 4,
+                environment_pattern: pattern,
+                ..integrator(1)
+            };
+            integrator.shades_first_hits_in_lanes(&scene)
+        };
+        assert!(sky_drawn_from(SamplePattern::Sobol));
+        assert!(!sky_drawn_from(SamplePattern::Random));
         // Footprints are looked up lane by lane.
         assert!(with(|s| {
             s.materials[0].diffuse = Texture::Checkerboard(Checkerboard {
@@ -1805,15 +1889,6 @@ mod tests {
     fn physical_lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
         use glint_lighting::AreaSampling;
         let (mut total, mut common) = (ShadingCounters::default(), [0; 3]);
-        // A lat-long map with a bright patch, sampled by luminance.
-        let sky = || {
-            let image = glint_texture::Image::from_fn(32, 16, |x, y| {
-                let bright = (10..14).contains(&x) && (3..6).contains(&y);
-                Vec3::new(0.2 + 0.01 * x as f32, 0.3, 0.4) * if bright { 40.0 } else { 1.0 }
-            });
-            let map = glint_texture::Environment::LatLong(glint_texture::LatLongMap::new(image));
-            glint_lighting::EnvironmentLight::new(map, 0.3, 1.5)
-        };
         // Glossy rooms also hold a point light and a sphere light; their
         // materials take every kind of lobe (Phong's with integral and
         // fractional exponents, Blinn–Phong's) against every kind of light.

@@ -158,7 +158,7 @@ impl ShapeList {
     }
 
     /// Whether [`ShapeList::closest_lanes`] answers (the linear loop holds every
-    /// object in its packets, but for planes).
+    /// object in its packets, but for planes and boxes).
     pub fn has_closest_lanes(&self) -> bool {
         self.lanes_layout().is_some()
     }
@@ -166,8 +166,12 @@ impl ShapeList {
     pub(super) fn lanes_layout(&self) -> Option<&LinearShapes> {
         self.linear.as_ref().filter(|linear| {
             self.bvh.is_none()
-                && (linear.others.iter())
-                    .all(|&o| matches!(self.object(o), ObjectRef::Shape(Shape::Plane(_))))
+                && (linear.others.iter()).all(|&o| {
+                    matches!(
+                        self.object(o),
+                        ObjectRef::Shape(Shape::Plane(_) | Shape::Box(_))
+                    )
+                })
         })
     }
 
@@ -196,7 +200,8 @@ impl ShapeList {
             .chain(parallelograms)
             .flatten()
             .filter(|&&o| o != u32::MAX && (o >= 64 || candidates >> o & 1 == 1));
-        // Planes, unbounded, are in every pixel's view: always tested.
+        // Planes, unbounded, are in every pixel's view, and boxes are few:
+        // always tested.
         for &object in used.chain(&linear.others) {
             let (hits, t) = match self.object(object) {
                 ObjectRef::Shape(Shape::Sphere(s)) => {
@@ -211,7 +216,13 @@ impl ShapeList {
                     count(|c| c.plane_tests += tested);
                     p.hit_distance_lanes(rays, f32::INFINITY)
                 }
-                _ => unreachable!("the lanes layout holds spheres, parallelograms and planes"),
+                ObjectRef::Shape(Shape::Box(b)) => {
+                    count(|c| c.box_tests += tested);
+                    b.hit_distance_lanes(rays, f32::INFINITY)
+                }
+                _ => {
+                    unreachable!("the lanes layout holds spheres, parallelograms, planes and boxes")
+                }
             };
             if hits == 0 {
                 continue;

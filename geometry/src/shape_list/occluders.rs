@@ -282,12 +282,52 @@ impl ShapeList {
                 }
             }
         }
-        if (0..linear.others.len()).any(|i| occluders.keeps_other(i)) {
+        blocked |= self.others_hits_lanes(linear, occluders, rays, t_max, active & !blocked);
+        blocked | self.bvh_hits_lanes(rays, t_max, active & !blocked)
+    }
+
+    /// The lanes of `active` whose ray meets an object of the linear loop
+    /// outside its packets, kept by `occluders`: planes and boxes against
+    /// all the rays at once, each lane's verdict its ray's alone; meshes
+    /// (where the loop holds them) ray by ray.
+    fn others_hits_lanes(
+        &self,
+        linear: &LinearShapes,
+        occluders: &Occluders,
+        rays: &RayLanes,
+        t_max: f32,
+        active: u32,
+    ) -> u32 {
+        let tested = u64::from(active.count_ones());
+        let mut blocked = 0;
+        let mut meshes = false;
+        let kept = (linear.others.iter().enumerate()).filter(|&(i, _)| occluders.keeps_other(i));
+        for (_, &object) in kept {
+            if blocked == active {
+                return blocked;
+            }
+            blocked |= active
+                & match self.object(object) {
+                    ObjectRef::Shape(Shape::Plane(p)) => {
+                        count(|c| c.plane_tests += tested);
+                        p.hit_distance_lanes(rays, t_max).0
+                    }
+                    ObjectRef::Shape(Shape::Box(b)) => {
+                        count(|c| c.box_tests += tested);
+                        b.hit_distance_lanes(rays, t_max).0
+                    }
+                    _ => {
+                        meshes = true;
+                        0
+                    }
+                };
+        }
+        if meshes {
             blocked |= self.lane_by_lane(active & !blocked, |lane| {
                 self.others_hit(linear, occluders, &rays.lane(lane), t_max)
             });
         }
-        blocked | self.bvh_hits_lanes(rays, t_max, active & !blocked)
+        blocked
     }
 
     /// The lanes of `active` whose ray meets an unbounded plane or a primitive

@@ -372,11 +372,11 @@ mod lanes {
     fn rays_in_a_frustum_find_their_hits_among_the_objects_it_meets() {
         // Narrow frusta of `LANES` rays (a pixel's) from random points, against
         // random spheres and parallelograms, some tiny and some far, some
-        // axis-aligned walls: the objects the frustum can meet hold every hit,
+        // axis-aligned walls, planes and boxes: the objects the frustum can meet hold every hit,
         // and with them the hits are each ray's own. Rays on the frustum's
         // edges and corners are included.
         let mut rng = XorShift(0x7a11_c0de_5eed_0001);
-        let (mut hits, mut culled, mut plane_hits) = (0, 0, 0);
+        let (mut hits, mut culled, mut plane_hits, mut box_hits) = (0, 0, 0, 0);
         for scene in 0..80 {
             let mut list = ShapeList::new();
             let scale = [1.0, 1e-3, 1e3][scene % 3];
@@ -402,6 +402,14 @@ mod lanes {
                     let (p, n) = (rng.vec3(-4.0, 4.0) * scale, rng.vec3(-1.0, 1.0));
                     list.push(crate::Plane::new(p, n, two_sided).unwrap());
                 }
+            }
+            if scene % 4 == 3 {
+                // Boxes, tested in every frustum: one among the objects, and
+                // a sky box around them all, seen from inside.
+                let (c, h) = (rng.vec3(-4.0, 4.0) * scale, rng.vec3(0.2, 2.0) * scale);
+                list.push(crate::AaBox::new(c - h, c + h).unwrap());
+                let sky = Vec3::splat(30.0 * scale);
+                list.push(crate::AaBox::new(-sky, sky).unwrap());
             }
             list.build_acceleration();
             assert!(list.has_closest_lanes());
@@ -431,12 +439,15 @@ mod lanes {
                 for (k, ray) in rays.iter().enumerate() {
                     assert_eq!(found.hit(k), list.closest_primitive(ray, f32::INFINITY));
                     hits += found.hit(k).is_some() as u32;
-                    plane_hits += found.hit(k).is_some_and(|h| h.object >= 12) as u32;
+                    let beyond = found.hit(k).is_some_and(|h| h.object >= 12);
+                    plane_hits += (beyond && scene % 4 == 1) as u32;
+                    box_hits += (beyond && scene % 4 == 3) as u32;
                 }
             }
         }
         assert!(hits > 2000, "only {hits} hits");
         assert!(plane_hits > 200, "only {plane_hits} plane hits");
+        assert!(box_hits > 200, "only {box_hits} box hits");
         assert!(culled > 40_000, "the frusta leave out objects ({culled})");
     }
 
@@ -546,8 +557,8 @@ mod lanes {
             }
         }
         assert!(hits > 3000, "only {hits} hits");
-        // Planes are served beside the packets; a box outside them is not, nor
-        // is a BVH.
+        // Planes and boxes are served beside the packets (tested in every
+        // frustum); a BVH is not.
         let rays = RayLanes::new([Ray::new(Vec3::ZERO, Vec3::X); LANES]);
         let mut list = scene();
         list.build_acceleration();
@@ -555,11 +566,7 @@ mod lanes {
         let mut list = scene();
         list.push(crate::AaBox::new(Vec3::splat(2.0), Vec3::splat(3.0)).unwrap());
         list.build_acceleration();
-        assert!(list.closest_primitives_lanes(&rays, LANES).is_none());
-        assert_eq!(
-            list.objects_in_frustum(Vec3::ZERO, [Vec3::X, Vec3::Y, -Vec3::X, -Vec3::Y]),
-            u64::MAX
-        );
+        assert!(list.closest_primitives_lanes(&rays, LANES).is_some());
         list.build_bvh();
         assert!(list.closest_primitives_lanes(&rays, LANES).is_none());
     }

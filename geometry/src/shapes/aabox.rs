@@ -1,7 +1,8 @@
 //! Axis-aligned boxes: the ray–box test and the per-face uv squares.
 
 use crate::error_bounds::gamma;
-use crate::{Hit, Parallelogram, Ray};
+use crate::lanes::{F32Lanes, Float, Mask, Vec3Lanes, Vector3};
+use crate::{Hit, Parallelogram, Ray, RayLanes};
 use glam::{Vec2, Vec3};
 
 /// An axis-aligned box `[min, max]`, a closed solid seen from outside and inside.
@@ -70,25 +71,21 @@ impl AaBox {
     }
 
     /// Slab test: the entry distance if the ray starts outside, else the exit distance.
-    ///
-    /// An axis the ray runs parallel to (direction component ±0) gives no slab
-    /// interval: the ray is inside that slab for every t, or never. Handling it
-    /// explicitly avoids 0·∞ = NaN when the origin lies on the slab's boundary.
+    #[inline]
     pub fn hit_distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
-        let parallel = ray.direction.cmpeq(Vec3::ZERO);
-        let inside = ray.origin.cmpge(self.min) & ray.origin.cmple(self.max);
-        if (parallel & !inside).any() {
-            return None;
-        }
-        let inv = ray.direction.recip();
-        let t_a = (self.min - ray.origin) * inv;
-        let t_b = (self.max - ray.origin) * inv;
-        let t_near = Vec3::select(parallel, Vec3::NEG_INFINITY, t_a.min(t_b)).max_element();
-        let t_far = Vec3::select(parallel, Vec3::INFINITY, t_a.max(t_b)).min_element();
-        if t_near > t_far {
-            return None;
-        }
-        [t_near, t_far].into_iter().find(|&t| t > 0.0 && t < t_max)
+        let (min, max) = (self.min.into(), self.max.into());
+        let (hit, t) = box_hits(&min, &max, &ray.origin.into(), &ray.direction.into(), t_max);
+        hit.then_some(t)
+    }
+
+    /// [`Self::hit_distance`] for each lane's ray: the lanes that hit (bit k
+    /// for lane k) and their distances, bit for bit the scalar test's.
+    #[inline]
+    pub fn hit_distance_lanes(&self, rays: &RayLanes, t_max: f32) -> (u32, F32Lanes) {
+        let (min, max) = (Vec3Lanes::splat(self.min), Vec3Lanes::splat(self.max));
+        let t_max = F32Lanes::splat(t_max);
+        let (hit, t) = box_hits(&min, &max, &rays.origin, &rays.direction, t_max);
+        (hit.bits(), t)
     }
 
     /// Index into [`FACES`] of the face that holds `p`.
@@ -139,4 +136,47 @@ impl AaBox {
             primitive: 0,
         }
     }
+}
+
+/// The slab test of [`AaBox::hit_distance`] over any [`Float`]: the mask of
+/// the rays that hit `[min, max]` in `(0, t_max)`, and there the entry
+/// distance if the ray starts outside, else the exit distance (Kay and
+/// Kajiya 1986; pbrt-v4 §6.1.2). The minima and maxima are glam's, `a < b ?
+/// a : b`, at every width (so a NaN slab distance is treated alike).
+///
+/// An axis the ray runs parallel to (direction component ±0) gives no slab
+/// interval: the ray is inside that slab for every t, or never. Handling it
+/// explicitly avoids 0·∞ = NaN when the origin lies on the slab's boundary.
+#[inline(always)]
+pub(crate) fn box_hits<F: Float>(
+    min: &Vector3<F>,
+    max: &Vector3<F>,
+    origin: &Vector3<F>,
+    direction: &Vector3<F>,
+    t_max: F,
+) -> (F::Mask, F) {
+    let lesser = |a: F, b: F| F::select(a.lt(b), a, b);
+    let greater = |a: F, b: F| F::select(a.gt(b), a, b);
+    let slab = |o: F, d: F, lo: F, hi: F| {
+        let parallel = d.eq(F::ZERO);
+        let outside = parallel & !(o.ge(lo) & o.le(hi));
+        let inv = F::ONE / d;
+        let (t_a, t_b) = ((lo - o) * inv, (hi - o) * inv);
+        let near = F::select(parallel, F::splat(f32::NEG_INFINITY), lesser(t_a, t_b));
+        let far = F::select(parallel, F::splat(f32::INFINITY), greater(t_a, t_b));
+        (outside, near, far)
+    };
+    let (ox, nx, fx) = slab(origin.x, direction.x, min.x, max.x);
+    let (oy, ny, fy) = slab(origin.y, direction.y, min.y, max.y);
+    let (oz, nz, fz) = slab(origin.z, direction.z, min.z, max.z);
+    let outside = ox | oy | oz;
+    if outside.all() {
+        return (F::Mask::FALSE, F::ZERO);
+    }
+    let t_near = greater(nx, greater(ny, nz));
+    let t_far = lesser(fx, lesser(fy, fz));
+    let crossed = !outside & !t_near.gt(t_far);
+    let near = t_near.in_ray_range(t_max);
+    let hit = crossed & (near | t_far.in_ray_range(t_max));
+    (hit, F::select(near, t_near, t_far))
 }

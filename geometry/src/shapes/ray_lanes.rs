@@ -161,6 +161,54 @@ impl Parallelogram {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A box's slab test in lanes is the scalar one, verdict and distance bit
+    /// for bit: rays from inside, outside and on its faces, along the axes
+    /// (parallel to two slabs, on their boundaries too) and off them, with a
+    /// direction component so small its reciprocal overflows.
+    #[test]
+    fn box_tests_in_lanes_are_the_scalar_tests_bit_for_bit() {
+        let aabox =
+            crate::AaBox::new(Vec3::new(-1.0, -2.0, 0.5), Vec3::new(3.0, 1.0, 2.5)).unwrap();
+        let origins = [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(-1.0, 0.0, 1.0),
+            Vec3::new(3.0, 1.0, 2.5),
+            Vec3::new(-5.0, -0.5, 1.5),
+            Vec3::new(1.0, 4.0, 0.5),
+            Vec3::new(7.0, -3.0, -2.0),
+            // On the top face: with the tiny y below, a slab distance 0·∞ = NaN.
+            Vec3::new(0.0, 1.0, 1.0),
+        ];
+        let directions = [
+            Vec3::X,
+            -Vec3::Y,
+            Vec3::Z,
+            Vec3::new(1.0, 0.0, -0.0),
+            Vec3::new(1.0, 1e-39, 0.0),
+            Vec3::new(0.3, -0.5, 0.8),
+            Vec3::new(-0.6, 0.2, -0.1),
+            Vec3::new(1.0, -1.0, 0.25),
+        ];
+        let rays: Vec<Ray> = origins
+            .iter()
+            .flat_map(|&o| directions.iter().map(move |&d| Ray::new(o, d)))
+            .collect();
+        let mut hits = 0;
+        for chunk in rays.chunks(LANES) {
+            let lanes = RayLanes::new(std::array::from_fn(|k| chunk[k.min(chunk.len() - 1)]));
+            for t_max in [f32::INFINITY, 2.0] {
+                let (hit, t) = aabox.hit_distance_lanes(&lanes, t_max);
+                for (k, ray) in chunk.iter().enumerate() {
+                    let scalar = aabox.hit_distance(ray, t_max);
+                    let lane = (hit >> k & 1 == 1).then(|| t.to_array()[k]);
+                    assert_eq!(lane.map(f32::to_bits), scalar.map(f32::to_bits), "{ray:?}");
+                    hits += usize::from(scalar.is_some());
+                }
+            }
+        }
+        assert!(hits > 20, "{hits} hits");
+    }
     use crate::bvh::test_support::XorShift;
     use crate::{Hit, Ray};
 

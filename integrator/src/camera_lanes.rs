@@ -584,15 +584,10 @@ impl DirectIntegrator {
         let grid = self.grid_points(pair, ctx);
         let sequences = (self.light_pattern == SamplePattern::Sobol)
             .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
-        let glossy = lit & shaded.phong.specular_lanes() != 0;
-        let at = shaded.diffuse_points();
         let mut sum = Vec3Lanes::default();
         for j in 0..n {
             let (position, pdf, ends) = draw(light_points_at(&grid, &sequences, j, n));
-            let (values, traced) = match glossy {
-                true => shaded.glossy_light_samples(&position, pdf, (lit, mis), &mut ctx.counters),
-                false => at.light_samples(&position, pdf, lit, &mut ctx.counters),
-            };
+            let (values, traced) = shaded.light_samples(&position, pdf, (lit, mis), ctx);
             let towards = position - shaded.point;
             let visible = traced & !shaded.blocked(scene, occluders, &ends, &towards, traced);
             let zero = Vec3Lanes::default();
@@ -1200,25 +1195,16 @@ impl<'a> ShadedLanes<'a> {
         (used, mis): (u32, u32),
         counters: &mut ShadingCounters,
     ) -> (Vec3Lanes, u32) {
-        let glossy = used & self.phong.specular_lanes();
-        let dense = used & lanes::bits(lanes::gt(pdf, F32Lanes::ZERO) & pdf.is_finite());
-        let (l, normalized) = (*position - self.point).try_normalize();
-        let above = lanes::bits(normalized & lanes::gt(l.dot(&self.ng), F32Lanes::ZERO));
-        let f = self.phong.brdf_cos(&l);
-        let reflects = dense & above & !lanes::bits(f.is_zero());
-        let skips = &mut counters.light_skips;
-        skips.zero_density += u64::from((used & !dense).count_ones());
-        skips.below_surface += u64::from((dense & !above).count_ones());
-        skips.zero_brdf += u64::from((dense & above & !reflects).count_ones());
-        counters.specular_lobes += u64::from((dense & above & glossy).count_ones());
-        counters.light_shadow_rays += u64::from(reflects.count_ones());
+        let at = self.diffuse_points();
+        let s = at.unshadowed_by(position, pdf, used, counters, |l| self.phong.brdf_cos(l));
+        let glossy = s.evaluated & self.phong.specular_lanes();
+        counters.specular_lobes += u64::from(glossy.count_ones());
         let mut weights = [1.0; LANES];
         let pdfs = pdf.to_array();
-        for k in lanes::each_set(reflects & mis) {
-            let lobe_pdf = self.lobe_pdf(k, l.lane(k));
-            weights[k] = power_heuristic(pdfs[k], lobe_pdf);
+        for k in lanes::each_set(s.reflects & mis) {
+            weights[k] = power_heuristic(pdfs[k], self.lobe_pdf(k, s.l.lane(k)));
         }
-        (f.scale(F32Lanes::new(weights) / pdf), reflects)
+        (s.f_cos.scale(F32Lanes::new(weights) / pdf), s.reflects)
     }
 
     /// Lane `k`'s lobe's density of drawing the unit direction `l`.

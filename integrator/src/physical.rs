@@ -208,28 +208,62 @@ impl DiffusePoints<'_> {
         used: u32,
         counters: &mut ShadingCounters,
     ) -> (Vec3Lanes, u32) {
+        let s = self.unshadowed_by(position, pdf, used, counters, |l| {
+            // `brdf_cos_diffuse`: kd/π · n·l, zero where n·l ≤ 0.
+            let n_dot_l = l.dot(self.n);
+            let f = (self.kd)
+                .scale(F32Lanes::splat(std::f32::consts::FRAC_1_PI))
+                .scale(n_dot_l);
+            let zero = Vec3Lanes::default();
+            Vec3Lanes::select(lanes::le(n_dot_l, F32Lanes::ZERO), &zero, &f)
+        });
+        (s.f_cos.scale(F32Lanes::ONE / pdf), s.reflects)
+    }
+
+    /// The part of [`Self::light_samples`] every BRDF shares: each lane's
+    /// unit direction `l` towards `position` and its `f · cos θ` by
+    /// `brdf_cos`, the lanes with a density and above the surface, and of
+    /// those the lanes that reflect something and need a shadow ray; the
+    /// others counted as skipped, the rays counted.
+    #[inline(always)]
+    pub(crate) fn unshadowed_by(
+        &self,
+        position: &Vec3Lanes,
+        pdf: F32Lanes,
+        used: u32,
+        counters: &mut ShadingCounters,
+        brdf_cos: impl FnOnce(&Vec3Lanes) -> Vec3Lanes,
+    ) -> UnshadowedLanes {
         let dense = used & lanes::bits(lanes::gt(pdf, F32Lanes::ZERO) & pdf.is_finite());
         let (l, normalized) = (*position - *self.point).try_normalize();
         let above = lanes::bits(normalized & lanes::gt(l.dot(self.ng), F32Lanes::ZERO));
-        // `brdf_cos_diffuse`: kd/π · n·l, zero where n·l ≤ 0.
-        let n_dot_l = l.dot(self.n);
-        let f = self
-            .kd
-            .scale(F32Lanes::splat(std::f32::consts::FRAC_1_PI))
-            .scale(n_dot_l);
-        let f = Vec3Lanes::select(
-            lanes::le(n_dot_l, F32Lanes::ZERO),
-            &Vec3Lanes::default(),
-            &f,
-        );
-        let reflects = dense & above & !lanes::bits(f.is_zero());
+        let f_cos = brdf_cos(&l);
+        let reflects = dense & above & !lanes::bits(f_cos.is_zero());
         let skips = &mut counters.light_skips;
         skips.zero_density += u64::from((used & !dense).count_ones());
         skips.below_surface += u64::from((dense & !above).count_ones());
         skips.zero_brdf += u64::from((dense & above & !reflects).count_ones());
         counters.light_shadow_rays += u64::from(reflects.count_ones());
-        (f.scale(F32Lanes::ONE / pdf), reflects)
+        UnshadowedLanes {
+            l,
+            f_cos,
+            evaluated: dense & above,
+            reflects,
+        }
     }
+}
+
+/// Light samples in lanes short of their shadow rays
+/// ([`DiffusePoints::unshadowed_by`]).
+pub(crate) struct UnshadowedLanes {
+    /// Each lane's unit direction towards its light point.
+    pub(crate) l: Vec3Lanes,
+    /// Each lane's `f · cos θ`.
+    pub(crate) f_cos: Vec3Lanes,
+    /// The lanes whose BRDF was evaluated: with a density, above the surface.
+    pub(crate) evaluated: u32,
+    /// The lanes that need a shadow ray.
+    pub(crate) reflects: u32,
 }
 
 /// Veach's power heuristic (β = 2) for a sample drawn with density `a` where

@@ -252,7 +252,7 @@ mod tests {
     /// so is `Auto`'s choice of solid angle.
     #[test]
     fn samples_by_area_in_lanes_are_each_lanes_sample() {
-        use glint_geometry::lanes::{self, LANES};
+        use glint_geometry::lanes::LANES;
         let light = light();
         let points: [Vec3; LANES] = std::array::from_fn(|k| match k {
             0 => Vec3::new(0.1, 1.5, 0.2),
@@ -284,13 +284,7 @@ mod tests {
             assert!(kept || by_area, "lane {k}");
         }
         for i in 0..32 {
-            let u: [Vec2; LANES] = std::array::from_fn(|k| {
-                Vec2::new(
-                    ((i * LANES + k) as f32 * 0.618_034).fract(),
-                    (i as f32 + 0.5) / 32.0,
-                )
-            });
-            let us = (lanes::from_fn(|k| u[k].x), lanes::from_fn(|k| u[k].y));
+            let (u, us) = crate::lane_points(i, 32);
             let (y, pdf) = light.sample_by_area_lanes(&x, us);
             for k in 0..LANES {
                 let s = light.sampler(points[k], AreaSampling::Area).sample(u[k]);

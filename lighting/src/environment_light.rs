@@ -738,11 +738,7 @@ mod tests {
         });
         let light = EnvironmentLight::new(hot_spot_latlong(), 0.4, 1.5);
         for i in 0..64 {
-            let u: [Vec2; LANES] = std::array::from_fn(|k| {
-                let x = ((i * LANES + k) as f32 * 0.618_034).fract();
-                Vec2::new(x, (i as f32 + 0.5) / 64.0)
-            });
-            let us = (lanes::from_fn(|k| u[k].x), lanes::from_fn(|k| u[k].y));
+            let (u, us) = crate::lane_points(i, 64);
             let (d, radiance, pdf) =
                 light.sample_cosine_each(&Vec3Lanes::from_lanes(normals), us, (1 << LANES) - 1);
             for k in 0..LANES {

@@ -45,6 +45,28 @@ pub use shading_model::ShadingModel;
 pub use sphere_light::{SphereLight, SphereLightSample};
 pub use spherical_rectangle::SphericalRectangle;
 
+/// Round `i` of `rounds` of test points for lanes: x along the golden ratio's
+/// sequence, y the round's, as points and as the two coordinates' lanes.
+#[cfg(test)]
+pub(crate) fn lane_points(
+    i: usize,
+    rounds: usize,
+) -> (
+    [glam::Vec2; glint_geometry::lanes::LANES],
+    (
+        glint_geometry::lanes::F32Lanes,
+        glint_geometry::lanes::F32Lanes,
+    ),
+) {
+    use glint_geometry::lanes::{self, LANES};
+    let u: [glam::Vec2; LANES] = std::array::from_fn(|k| {
+        let x = ((i * LANES + k) as f32 * 0.618_034).fract();
+        glam::Vec2::new(x, (i as f32 + 0.5) / rounds as f32)
+    });
+    let us = (lanes::from_fn(|k| u[k].x), lanes::from_fn(|k| u[k].y));
+    (u, us)
+}
+
 /// Every kind of light, as one enum (no virtual calls in the shading loop).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {

@@ -188,7 +188,7 @@ mod tests {
     /// points near, far, on the axis and inside the sphere (no sample).
     #[test]
     fn samples_in_lanes_are_each_lanes_sample() {
-        use glint_geometry::lanes::{self, LANES};
+        use glint_geometry::lanes::LANES;
         let light = SphereLight::new(Vec3::new(0.3, 2.0, -0.5), 0.7, Vec3::ONE).unwrap();
         let points: [Vec3; LANES] = std::array::from_fn(|k| match k {
             0 => Vec3::new(0.3, 2.1, -0.5),
@@ -199,13 +199,7 @@ mod tests {
         });
         let x = Vec3Lanes::from_lanes(points);
         for i in 0..32 {
-            let u: [Vec2; LANES] = std::array::from_fn(|k| {
-                Vec2::new(
-                    ((i * LANES + k) as f32 * 0.618_034).fract(),
-                    (i as f32 + 0.5) / 32.0,
-                )
-            });
-            let us = (lanes::from_fn(|k| u[k].x), lanes::from_fn(|k| u[k].y));
+            let (u, us) = crate::lane_points(i, 32);
             let (outside, [point, error, normal], pdf) = light.sample_lanes(&x, us);
             assert_eq!(outside & 1, 0, "inside the sphere");
             assert_eq!(light.outside_lanes(&x), outside);

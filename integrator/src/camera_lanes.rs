@@ -17,10 +17,12 @@
 //! This is only done where a scene needs nothing else at a first hit
 //! ([`DirectIntegrator::shades_first_hits_in_lanes`]): light points that each
 //! sample can draw alone (not a stratified pattern of several), and either
-//! the course's model with area and point lights, no environment and no
-//! mirrors, or physical shading under area, point and sphere lights and an
-//! environment map, whose lanes on a partial mirror are each traced alone by `li_at` and whose
-//! perfect mirrors reflect their lanes as a next wave. Physical shading draws
+//! the course's model with area and point lights and an environment whose
+//! points are Sobol's, or physical shading under area, point and sphere
+//! lights and an environment map. Lanes on mirrors reflect their rays as the
+//! next wave of lanes, one reflection deeper ([`DirectIntegrator::li_wave`]),
+//! with their differentials where the scene reads footprints; lanes not in a
+//! wave are masked, not traced apart. Physical shading draws
 //! each lane's light samples with its own point's sampler (by area or solid
 //! angle) and takes them through the diffuse kernel a point's light samples
 //! share ([`crate::physical::DiffusePoints`]), or on glossy points through
@@ -37,7 +39,7 @@
 //! Sobol sequence, so each sample's radiance and the shading counts are those
 //! of [`DirectIntegrator::li_at`], bit for bit (the tests compare).
 
-use crate::direct::{PairAllocation, SampleContext, ShadingPoint, CULL_REACH};
+use crate::direct::{mirror_ray, PairAllocation, SampleContext, ShadingPoint, CULL_REACH};
 use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::physical::{power_heuristic, DiffusePoints};
 use crate::sampling::{
@@ -61,11 +63,11 @@ use std::cell::OnceCell;
 
 impl DirectIntegrator {
     /// Whether the first hits of `scene`'s camera samples can be shaded [`LANES`] at
-    /// a time (`li_first_hits`): light points each sample can draw alone, and
-    /// either the course's shading model with area and point lights, no
-    /// environment and no mirrors, or physical shading with area, point and
-    /// sphere lights where its light and environment points are drawn from no
-    /// random stream.
+    /// a time (`li_first_hits`), mirrors and all: light points each sample
+    /// can draw alone, and either the course's shading model with area and
+    /// point lights and environment points drawn from no random stream, or
+    /// physical shading with area, point and sphere lights where its light
+    /// and environment points are drawn from no random stream.
     pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
         let lights = |admitted: fn(&Light) -> bool| scene.lights.iter().all(admitted);
         self.light_samples_in_lanes()
@@ -83,8 +85,7 @@ impl DirectIntegrator {
 
     /// Whether physical shading's first hits can take the lanes: light and
     /// environment points no random stream draws (a point behind a light
-    /// draws none, which would shift a stream's later draws). Mirrors reflect
-    /// as a next wave, or are traced alone (`mirrored`).
+    /// draws none, which would shift a stream's later draws).
     fn physical_in_lanes(&self, scene: &Scene) -> bool {
         matches!(
             self.light_pattern,
@@ -125,67 +126,6 @@ impl DirectIntegrator {
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         debug_assert!(self.shades_first_hits_in_lanes(scene));
-        let mut radiance = Vec3Lanes::default();
-        let hit_lanes = closest.hits & ((1 << used) - 1);
-        let hits = (rays, diffs, closest);
-        let hit_lanes =
-            hit_lanes & !self.mirrored(scene, hits, hit_lanes, samples, &mut radiance, ctx);
-        if let Some(env) = &scene.environment {
-            let misses = ((1 << used) - 1) & !closest.hits;
-            ctx.counters.environment_lookups += u64::from(misses.count_ones());
-            match scene.shading {
-                // `environment_seen` under physical shading: the map unfiltered.
-                ShadingModel::Physical => {
-                    let seen = env.radiance_each(&rays.direction.normalize(), misses);
-                    radiance = Vec3Lanes::select(lanes::from_bits(misses), &seen, &radiance);
-                }
-                // The course's model filters it over each ray's footprint.
-                ShadingModel::Phong => {
-                    for k in lanes::each_set(misses) {
-                        let ray = rays.lane(k);
-                        let diff = diffs.map_or_else(|| RayDifferential::none(&ray), |d| d[k]);
-                        let width = diff.angular_width(ray.direction);
-                        radiance.set_lane(k, env.radiance(ray.direction.normalize(), width));
-                    }
-                }
-            }
-        }
-        if hit_lanes == 0 {
-            return radiance;
-        }
-        // Each arm builds the lanes in place: made over a default, or moved
-        // out of an `Option`, their kilobytes cost a zeroing or a copy a chunk.
-        let shaded = match FirstHits::of(scene, closest, hit_lanes) {
-            FirstHits::OnOneObject(object, shape, material) => {
-                let on = (object, shape, material);
-                ShadedLanes::on_one_object(scene, rays, closest, hit_lanes, on, &mut radiance, ctx)
-            }
-            FirstHits::OnOneEmitter(area) => {
-                let color = Vec3Lanes::splat(area.color);
-                return Vec3Lanes::select(lanes::from_bits(hit_lanes), &color, &radiance);
-            }
-            FirstHits::Several => {
-                ShadedLanes::one_by_one(scene, hits, hit_lanes, &mut radiance, ctx)
-            }
-        };
-        if shaded.lanes == 0 {
-            return radiance;
-        }
-        self.with_direct_lighting(scene, &shaded, samples, radiance, ctx)
-    }
-
-    /// `radiance` plus, in the lanes of `shaded`, each light's term and the
-    /// environment's, added in `li_at`'s order, for the camera samples
-    /// `samples`.
-    fn with_direct_lighting<T: Tracer>(
-        &self,
-        scene: &Scene,
-        shaded: &ShadedLanes,
-        samples: &LaneSamples,
-        mut radiance: Vec3Lanes,
-        ctx: &mut SampleContext<T>,
-    ) -> Vec3Lanes {
-        let shaded_mask = lanes::from_bits(shaded.lanes);
         // Each lane's own stream, as `SampleContext::begin_sample` makes it. The
         // random pattern draws a point as two uniforms; so does the stratified
         // one for a single point (its one cell is the whole square, and
@@ -195,18 +135,159 @@ impl DirectIntegrator {
             SamplePattern::Random | SamplePattern::Stratified
         )
         .then(|| Pcg32Lanes::new(samples.stream_seeds()));
-        let mut pairs = PairAllocation::new(0);
+        let wave = Wave {
+            rays,
+            diffs,
+            closest,
+            lanes: (1 << used) - 1,
+            depth: 0,
+        };
+        self.li_wave(scene, wave, samples, &mut rngs, ctx)
+    }
+
+    /// `li_at` for every lane of `wave`, `wave.depth` reflections deep, for
+    /// the lanes' camera samples `samples` (whose streams are `rngs`, where
+    /// the pattern draws): misses read the environment, emitters give their
+    /// radiance, and surfaces their local shading and, on a mirror, the
+    /// radiance of the next wave ([`Self::mirror_wave`]), in `li_at`'s
+    /// order and operations. The other lanes are zero.
+    fn li_wave<T: Tracer>(
+        &self,
+        scene: &Scene,
+        wave: Wave,
+        samples: &LaneSamples,
+        rngs: &mut Option<Pcg32Lanes>,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let hit_lanes = wave.closest.hits & wave.lanes;
+        let mut radiance = self.environment_seen_lanes(scene, &wave, wave.lanes & !hit_lanes, ctx);
+        if hit_lanes == 0 {
+            return radiance;
+        }
+        let mirrors = Mirrors::of(scene, wave.closest, hit_lanes);
+        let local = hit_lanes & !mirrors.perfect;
+        let shaded = match local {
+            0 => 0,
+            _ => self.local_shading_lanes(scene, &wave, local, samples, rngs, &mut radiance, ctx),
+        };
+        // `li_at`'s `(1 − r)·local + r·mirror` on every surface: a zero
+        // mirror term on all but mirrors (which turns a −0 to +0 there too),
+        // and no local term on a perfect mirror.
+        let traced = match wave.depth < self.max_depth {
+            true => mirrors.lanes,
+            false => 0,
+        };
+        let mirror = match traced {
+            0 => Vec3Lanes::default(),
+            _ => self.mirror_wave(scene, &wave, traced, samples, rngs, ctx) * mirrors.tint,
+        };
+        let r = mirrors.reflectivity;
+        let value = radiance.scale(F32Lanes::splat(1.0) - r) + mirror.scale(r);
+        let surfaces = lanes::from_bits(shaded | mirrors.perfect);
+        Vec3Lanes::select(surfaces, &value, &radiance)
+    }
+
+    /// The environment's radiance along the rays of `wave` in the lanes
+    /// `misses`, which hit nothing (zero elsewhere, and without one): the map
+    /// unfiltered under physical shading, filtered over each ray's footprint
+    /// in the course's model, as `li_at`'s `environment_seen` reads it.
+    fn environment_seen_lanes<T: Tracer>(
+        &self,
+        scene: &Scene,
+        wave: &Wave,
+        misses: u32,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let mut radiance = Vec3Lanes::default();
+        let Some(env) = scene.environment.as_ref().filter(|_| misses != 0) else {
+            return radiance;
+        };
+        ctx.counters.environment_lookups += u64::from(misses.count_ones());
+        match scene.shading {
+            ShadingModel::Physical => {
+                let seen = env.radiance_each(&wave.rays.direction.normalize(), misses);
+                radiance = Vec3Lanes::select(lanes::from_bits(misses), &seen, &radiance);
+            }
+            ShadingModel::Phong => {
+                for k in lanes::each_set(misses) {
+                    let ray = wave.rays.lane(k);
+                    let diff = wave
+                        .diffs
+                        .map_or_else(|| RayDifferential::none(&ray), |d| d[k]);
+                    let width = diff.angular_width(ray.direction);
+                    radiance.set_lane(k, env.radiance(ray.direction.normalize(), width));
+                }
+            }
+        }
+        radiance
+    }
+
+    /// The lanes of `local`, on surfaces, shaded: an emitter's radiance, or
+    /// a material's ambient term, lights and environment (`li_at`'s local
+    /// shading), put in `radiance`. The lanes shaded on a material are
+    /// returned.
+    #[allow(clippy::too_many_arguments)]
+    fn local_shading_lanes<T: Tracer>(
+        &self,
+        scene: &Scene,
+        wave: &Wave,
+        local: u32,
+        samples: &LaneSamples,
+        rngs: &mut Option<Pcg32Lanes>,
+        radiance: &mut Vec3Lanes,
+        ctx: &mut SampleContext<T>,
+    ) -> u32 {
+        let (rays, closest) = (wave.rays, wave.closest);
+        // Each arm builds the lanes in place: made over a default, or moved
+        // out of an `Option`, their kilobytes cost a zeroing or a copy a chunk.
+        let mut shaded = match FirstHits::of(scene, closest, local) {
+            FirstHits::OnOneObject(object, shape, material) => {
+                let on = (object, shape, material);
+                ShadedLanes::on_one_object(scene, rays, closest, local, on, radiance, ctx)
+            }
+            FirstHits::OnOneEmitter(area) => {
+                let color = Vec3Lanes::splat(area.color);
+                *radiance = Vec3Lanes::select(lanes::from_bits(local), &color, radiance);
+                return 0;
+            }
+            FirstHits::Several => {
+                let hits = (rays, wave.diffs, closest);
+                ShadedLanes::one_by_one(scene, hits, local, radiance, ctx)
+            }
+        };
+        shaded.depth = wave.depth;
+        if shaded.lanes != 0 {
+            *radiance = self.with_direct_lighting(scene, &shaded, samples, rngs, *radiance, ctx);
+        }
+        shaded.lanes
+    }
+
+    /// `radiance` plus, in the lanes of `shaded`, each light's term and the
+    /// environment's, added in `li_at`'s order, for the camera samples
+    /// `samples`. Only the shaded lanes draw from their streams `rngs`.
+    fn with_direct_lighting<T: Tracer>(
+        &self,
+        scene: &Scene,
+        shaded: &ShadedLanes,
+        samples: &LaneSamples,
+        rngs: &mut Option<Pcg32Lanes>,
+        mut radiance: Vec3Lanes,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
+        let shaded_mask = lanes::from_bits(shaded.lanes);
+        let streams_before = *rngs;
+        let mut pairs = PairAllocation::new(shaded.depth);
         let physical = scene.shading == ShadingModel::Physical;
         for (index, light) in scene.lights.iter().enumerate() {
             // The dimensions `light_pair` gives a light that samples.
             let own = DimensionPair::Light {
                 light: index as u32,
-                depth: 0,
+                depth: shaded.depth,
             };
             let term = match light {
                 Light::Area(area) => {
                     let pair = pairs.take(own, self.light_samples);
-                    let points = (samples, pair, &mut rngs);
+                    let points = (samples, pair, &mut *rngs);
                     if physical {
                         self.physical_area_light_term(scene, shaded, (index, area), points, ctx)
                     } else {
@@ -239,131 +320,42 @@ impl DirectIntegrator {
             let term = self.environment_term_lanes(scene, env, shaded, samples, ctx);
             radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
         }
-        // `li_at` adds the absent mirror term, a zero: a −0 component becomes
-        // +0 there, so it must here too.
-        Vec3Lanes::select(shaded_mask, &(radiance + Vec3Lanes::default()), &radiance)
+        // The other lanes' streams stay where they were: a lane on a
+        // perfect mirror draws its first points in the next wave.
+        if let (Some(streams), Some(before)) = (rngs.as_mut(), streams_before) {
+            *streams = Pcg32Lanes::select(shaded.lanes, streams, &before);
+        }
+        radiance
     }
 
-    /// The lanes of `hit_lanes` on a mirror, their radiance put in
-    /// `radiance`: under physical shading a perfect mirror's reflected rays
-    /// as the next wave of lanes ([`Self::mirror_wave`]); any other mirror's
-    /// lanes, and every mirror's in the course's model (whose reflections
-    /// carry differentials for filtered lookups), each traced alone by
-    /// `li_at` for its camera sample.
-    fn mirrored<T: Tracer>(
-        &self,
-        scene: &Scene,
-        hits: (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
-        hit_lanes: u32,
-        samples: &LaneSamples,
-        radiance: &mut Vec3Lanes,
-        ctx: &mut SampleContext<T>,
-    ) -> u32 {
-        let reflects = |m: &PhongMaterial| m.reflectivity > 0.0;
-        if !scene.materials.iter().any(reflects) {
-            return 0;
-        }
-        let waves = self.max_depth > 0 && scene.shading == ShadingModel::Physical;
-        let (mut perfect, mut partial) = (0, 0);
-        for k in lanes::each_set(hit_lanes) {
-            if let SurfaceKind::Material(m) = scene.surface_of_primitive(hits.2.object[k], 0) {
-                match m.reflectivity {
-                    1.0 if waves => perfect |= 1 << k,
-                    r if r > 0.0 => partial |= 1 << k,
-                    _ => {}
-                }
-            }
-        }
-        let alone = partial | self.mirror_wave(scene, hits, perfect, radiance, ctx);
-        self.traced_alone(scene, hits, alone, samples, radiance, ctx);
-        perfect | partial
-    }
-
-    /// The lanes `wave`, on perfect mirrors (no local shading), reflected as
-    /// `li_at` reflects them: their rays made in their own lanes where they
-    /// lie on one sphere or wall, else gathered into the first lanes, and
-    /// their closest hits found together (lanes outside the wave hold rays
-    /// whose answers are not read). Where a reflected ray
-    /// leaves the scene, its lane's radiance is the mirror's tint times the
-    /// map (unfiltered, as physical shading reads it), in `li_at`'s
-    /// operations; the lanes whose rays meet a surface are returned, to be
-    /// traced alone.
+    /// The radiance along the rays the lanes `traced` of `wave` reflect
+    /// into, on mirrors, found as the next wave one reflection deeper: the
+    /// rays made in their own lanes ([`reflected_rays`]), their closest hits
+    /// found together, and their radiance by [`Self::li_wave`].
     fn mirror_wave<T: Tracer>(
         &self,
         scene: &Scene,
-        (rays, _, closest): (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
-        wave: u32,
-        radiance: &mut Vec3Lanes,
-        ctx: &mut SampleContext<T>,
-    ) -> u32 {
-        if wave == 0 {
-            return 0;
-        }
-        let in_place = reflected_in_place(scene, rays, closest, wave);
-        let (reflected, from, used, mut alone) = match in_place {
-            Some(reflected) => {
-                let from = lanes::array_from_fn(|k| k);
-                (
-                    reflected,
-                    from,
-                    (u32::BITS - wave.leading_zeros()) as usize,
-                    0,
-                )
-            }
-            None => reflected_gathered(scene, rays, closest, wave),
-        };
-        // The lanes of `reflected` that hold a wave's ray.
-        let held = match in_place {
-            Some(_) => wave,
-            None => (1u32 << used) - 1,
-        };
-        let Some(next) = scene.shapes.closest_lanes(&reflected, used) else {
-            return wave;
-        };
-        let leaving = held & !next.hits;
-        let seen = (scene.environment.as_ref())
-            .map(|env| env.radiance_each(&reflected.direction.normalize(), leaving));
-        for (j, &k) in from.iter().enumerate().take(used) {
-            if held >> j & 1 == 0 {
-                continue;
-            }
-            if leaving >> j & 1 == 0 {
-                alone |= 1 << k;
-                continue;
-            }
-            ctx.counters.reflection_rays += 1;
-            ctx.counters.environment_lookups += u64::from(seen.is_some());
-            let material = match scene.surface_of_primitive(closest.object[k], 0) {
-                SurfaceKind::Material(material) => material,
-                SurfaceKind::Emitter(_) => unreachable!("a mirror's lane"),
-            };
-            let environment = seen.as_ref().map_or(Vec3::ZERO, |seen| seen.lane(j));
-            let (r, mirror) = (material.reflectivity, material.mirror_tint * environment);
-            radiance.set_lane(k, (1.0 - r) * Vec3::ZERO + r * mirror);
-        }
-        alone
-    }
-
-    /// The lanes `alone`, each traced by `li_at` for its camera sample.
-    fn traced_alone<T: Tracer>(
-        &self,
-        scene: &Scene,
-        (rays, diffs, closest): (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
-        alone: u32,
+        wave: &Wave,
+        traced: u32,
         samples: &LaneSamples,
-        radiance: &mut Vec3Lanes,
+        rngs: &mut Option<Pcg32Lanes>,
         ctx: &mut SampleContext<T>,
-    ) {
-        for k in lanes::each_set(alone) {
-            let sample = samples.lane(k);
-            ctx.begin_sample(sample.seed, sample.pixel, sample.sample);
-            let ray = rays.lane(k);
-            let diff = diffs.map_or_else(|| RayDifferential::none(&ray), |d| d[k]);
-            let hit = closest
-                .hit(k)
-                .and_then(|found| scene.shapes.surface_record(&ray, found));
-            radiance.set_lane(k, self.li_at(scene, &ray, &diff, hit, 0, ctx));
-        }
+    ) -> Vec3Lanes {
+        let (rays, diffs, traced) = reflected_rays(scene, wave, traced);
+        ctx.counters.reflection_rays += u64::from(traced.count_ones());
+        let used = (u32::BITS - traced.leading_zeros()) as usize;
+        // The scene's first hits were found in lanes: so are the next.
+        let Some(closest) = scene.shapes.closest_lanes(&rays, used) else {
+            unreachable!("a scene's hits in lanes at the first hit are in lanes at every depth");
+        };
+        let next = Wave {
+            rays: &rays,
+            diffs: diffs.as_ref(),
+            closest: &closest,
+            lanes: traced,
+            depth: wave.depth + 1,
+        };
+        self.li_wave(scene, next, samples, rngs, ctx)
     }
 
     /// `environment_light` at every lane's point: each lane's `n` samples
@@ -383,7 +375,7 @@ impl DirectIntegrator {
         let n = self.environment_samples;
         let count = u64::from(shaded.lanes.count_ones());
         ctx.counters.environment_samples += u64::from(n) * count;
-        let pair = self.environment_pair_at_first_hit(scene);
+        let pair = self.environment_pair(scene, shaded.depth);
         let sequences = RunSequences::new(samples, shaded.lanes, pair, n, ctx);
         let len = (u32::BITS - shaded.lanes.leading_zeros()) as usize;
         let by_map = self.samples_environment_by_map(scene);
@@ -415,7 +407,7 @@ impl DirectIntegrator {
             skips.below_surface += u64::from((dense & !above).count_ones());
             skips.zero_brdf += u64::from((dense & above & !traced).count_ones());
             ctx.counters.environment_shadow_rays += u64::from(traced.count_ones());
-            let lit = Vec3Lanes::new(radiance.x * f.x, radiance.y * f.y, radiance.z * f.z);
+            let lit = radiance * f;
             let value = Vec3Lanes::new(lit.x / pdf, lit.y / pdf, lit.z / pdf);
             let origin = shaded.origins_towards(&direction, traced);
             let rays = RayLanes { origin, direction };
@@ -629,7 +621,7 @@ impl DirectIntegrator {
         let n = self.light_samples;
         let pair = DimensionPair::Brdf {
             light: index as u32,
-            depth: 0,
+            depth: shaded.depth,
         };
         let grid = self.grid_points(pair, ctx);
         let sequences = (self.light_pattern == SamplePattern::Sobol)
@@ -780,36 +772,98 @@ fn reflected_in_place(
     })
 }
 
-/// The reflected rays of the lanes `wave`, each made as `li_at` makes it
-/// and gathered into the first lanes: the rays, the lane each came from,
-/// their number, and the lanes without a surface record (left alone).
-fn reflected_gathered(
+/// The rays the lanes `traced` of `wave` reflect into, each in its own lane
+/// as `li_at` makes it ([`mirror_ray`]), and the lanes that hold one. With
+/// differentials where the wave carries them and the scene reads footprints;
+/// without, all at once where the lanes lie on one sphere or wall
+/// ([`reflected_in_place`]), else lane by lane. The other lanes hold the
+/// wave's own rays, whose answers are not read.
+fn reflected_rays(
     scene: &Scene,
-    rays: &RayLanes,
-    closest: &ClosestLanes,
-    wave: u32,
-) -> (RayLanes, [usize; LANES], usize, u32) {
-    let (mut origins, mut directions) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-    let (mut from, mut used, mut alone) = ([0; LANES], 0, 0);
-    for k in lanes::each_set(wave) {
-        let ray = rays.lane(k);
-        let found = closest.hit(k).expect("a hit lane");
-        let Some(hit) = scene.shapes.surface_point(&ray, found) else {
-            alone |= 1 << k;
-            continue;
-        };
-        // `reflect_differential`'s direction, and `spawn_ray`'s origin.
-        let wi = reflect(-ray.direction.normalize(), hit.facing_normal(ray.direction));
-        let reflected = spawn_ray(&hit, wi);
-        (origins[used], directions[used]) = (reflected.origin, reflected.direction);
-        from[used] = k;
-        used += 1;
+    wave: &Wave,
+    traced: u32,
+) -> (RayLanes, Option<[RayDifferential; LANES]>, u32) {
+    let with_differentials = wave.diffs.filter(|_| scene.needs_differentials());
+    if with_differentials.is_none() {
+        if let Some(rays) = reflected_in_place(scene, wave.rays, wave.closest, traced) {
+            return (rays, None, traced);
+        }
     }
-    let reflected = RayLanes {
-        origin: Vec3Lanes::from_lanes(origins),
-        direction: Vec3Lanes::from_lanes(directions),
-    };
-    (reflected, from, used, alone)
+    let (mut rays, mut diffs, mut reflected) = (*wave.rays, with_differentials.copied(), 0);
+    for k in lanes::each_set(traced) {
+        let ray = wave.rays.lane(k);
+        let found = wave.closest.hit(k).expect("a hit lane");
+        let made = match &mut diffs {
+            Some(diffs) => scene.shapes.surface_record(&ray, found).map(|hit| {
+                let (reflected, diff) = mirror_ray(&hit, &ray, &diffs[k]);
+                diffs[k] = diff;
+                reflected
+            }),
+            // `mirror_ray`'s ray, without the derivatives a sphere's full
+            // record costs.
+            None => scene.shapes.surface_point(&ray, found).map(|hit| {
+                let wi = reflect(-ray.direction.normalize(), hit.facing_normal(ray.direction));
+                spawn_ray(&hit, wi)
+            }),
+        };
+        if let Some(made) = made {
+            rays.origin.set_lane(k, made.origin);
+            rays.direction.set_lane(k, made.direction);
+            reflected |= 1 << k;
+        }
+    }
+    (rays, diffs, reflected)
+}
+
+/// A wave of rays in [`LANES`], `depth` reflections deep: the lanes
+/// `lanes` hold one, with its differentials where the scene reads
+/// footprints, and its closest hit.
+struct Wave<'a> {
+    rays: &'a RayLanes,
+    diffs: Option<&'a [RayDifferential; LANES]>,
+    closest: &'a ClosestLanes,
+    lanes: u32,
+    depth: u32,
+}
+
+/// The hit lanes of a wave on mirrors: each one's reflectivity `r` (zero
+/// elsewhere) and tint, and those that reflect all (`r = 1`, with no local
+/// shading).
+struct Mirrors {
+    reflectivity: F32Lanes,
+    tint: Vec3Lanes,
+    lanes: u32,
+    perfect: u32,
+}
+
+impl Mirrors {
+    fn of(scene: &Scene, closest: &ClosestLanes, hit_lanes: u32) -> Self {
+        let mut mirrors = Self {
+            reflectivity: F32Lanes::ZERO,
+            tint: Vec3Lanes::default(),
+            lanes: 0,
+            perfect: 0,
+        };
+        if !scene.materials.iter().any(|m| m.reflectivity > 0.0) {
+            return mirrors;
+        }
+        let mut r = [0.0; LANES];
+        for k in lanes::each_set(hit_lanes) {
+            let SurfaceKind::Material(m) = scene.surface_of_primitive(closest.object[k], 0) else {
+                continue;
+            };
+            if m.reflectivity > 0.0 {
+                r[k] = m.reflectivity;
+                mirrors.tint.set_lane(k, m.mirror_tint);
+                mirrors.lanes |= 1 << k;
+                if !m.has_local_shading() {
+                    mirrors.perfect |= 1 << k;
+                }
+            }
+        }
+        mirrors.reflectivity = F32Lanes::new(r);
+        mirrors
+    }
 }
 
 /// What a chunk's hit lanes landed on, as far as shading them together goes.
@@ -909,6 +963,8 @@ struct ShadedLanes<'a> {
     origins: ShadowOrigins,
     /// The one object every lane is on, where set together.
     object: Option<u32>,
+    /// The reflections the camera rays took to the points.
+    depth: u32,
 }
 
 /// The points of [`ShadedLanes`] offset to either side of their surfaces, the
@@ -1049,6 +1105,7 @@ impl<'a> ShadedLanes<'a> {
             ng,
             phong: PhongLanes::of_lanes(hit_lanes, material, &kd, &ks, &n, &v, specular),
             object: Some(object),
+            depth: 0,
         }
     }
 
@@ -1679,19 +1736,22 @@ mod tests {
         let mut common = [0; 3];
         // The last cases put the room under the sky, with a mirror, a half
         // mirror and a box: each miss's lookup filtered over its footprint,
-        // each mirror lane traced alone.
-        for (pattern, light_samples, footprints, sky_and_mirrors) in [
-            (SamplePattern::Random, 1, false, false),
-            (SamplePattern::Stratified, 1, false, false),
-            (SamplePattern::Sobol, 1, false, false),
-            (SamplePattern::Grid, 1, false, false),
-            (SamplePattern::Random, 3, false, false),
-            (SamplePattern::Sobol, 5, false, false),
-            (SamplePattern::Grid, 4, false, false),
-            (SamplePattern::Sobol, 1, true, false),
-            (SamplePattern::Random, 4, true, false),
-            (SamplePattern::Random, 1, false, true),
-            (SamplePattern::Sobol, 4, true, true),
+        // each mirror's reflections, with their differentials, the next wave.
+        // With mirrors, reflections are followed four deep, or one (a
+        // mirror seen in a mirror is then black).
+        for (pattern, light_samples, footprints, sky_and_mirrors, max_depth) in [
+            (SamplePattern::Random, 1, false, false, 4),
+            (SamplePattern::Stratified, 1, false, false, 4),
+            (SamplePattern::Sobol, 1, false, false, 4),
+            (SamplePattern::Grid, 1, false, false, 4),
+            (SamplePattern::Random, 3, false, false, 4),
+            (SamplePattern::Sobol, 5, false, false, 4),
+            (SamplePattern::Grid, 4, false, false, 4),
+            (SamplePattern::Sobol, 1, true, false, 4),
+            (SamplePattern::Random, 4, true, false, 4),
+            (SamplePattern::Random, 1, false, true, 4),
+            (SamplePattern::Sobol, 4, true, true, 4),
+            (SamplePattern::Random, 3, false, true, 1),
         ] {
             let mut scene = match sky_and_mirrors {
                 false => room(),
@@ -1729,7 +1789,7 @@ mod tests {
                 environment_samples: 4,
                 environment_pattern: SamplePattern::Sobol,
                 environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
-                max_depth: 4,
+                max_depth,
                 area_sampling: glint_lighting::AreaSampling::Auto,
                 mis: true,
             };
@@ -1790,7 +1850,7 @@ mod tests {
             change(&mut scene);
             integrator(1).shades_first_hits_in_lanes(&scene)
         };
-        // Mirror lanes are traced alone; the environment's points drawn from
+        // Mirror lanes reflect as the next wave; the environment's points drawn from
         // random streams are not drawn in lanes.
         assert!(with(|s| s.materials[1].reflectivity = 0.5));
         let sky_drawn_from = |pattern| {
@@ -1820,14 +1880,14 @@ mod tests {
         ))));
     }
 
-    /// The reflected rays made in place for lanes on one sphere or wall are
-    /// those made lane by lane, origins and directions bit for bit (the
-    /// origin only decides which lanes meet a surface, so the radiance test
-    /// cannot see it).
+    /// The reflected rays made in place for lanes on one sphere or wall, and
+    /// those made lane by lane without differentials, are `mirror_ray`'s,
+    /// origins and directions bit for bit (the origin only decides which
+    /// lanes meet a surface, so the radiance test cannot see it).
     #[test]
-    fn reflected_rays_in_place_are_those_made_one_by_one() {
+    fn reflected_rays_are_mirror_rays() {
         let scene = room();
-        let mut checked = [0usize; 2];
+        let mut checked = [0usize; 3];
         for i in 0..64u32 {
             let rays = RayLanes {
                 origin: Vec3Lanes::splat(Vec3::new(0.3, 0.5, 1.0)),
@@ -1845,28 +1905,40 @@ mod tests {
                 continue;
             }
             let object = closest.object[closest.hits.trailing_zeros() as usize];
-            let wave = lanes::each_set(closest.hits)
+            let on_one = lanes::each_set(closest.hits)
                 .filter(|&k| closest.object[k] == object)
                 .fold(0, |wave, k| wave | 1 << k);
-            let Some(in_place) = reflected_in_place(&scene, &rays, &closest, wave) else {
-                continue;
-            };
-            let (gathered, from, used, alone) = reflected_gathered(&scene, &rays, &closest, wave);
-            assert_eq!((alone, used), (0, wave.count_ones() as usize));
-            for (j, &k) in from.iter().enumerate().take(used) {
-                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-                assert_eq!(bits(in_place.origin.lane(k)), bits(gathered.origin.lane(j)));
-                assert_eq!(
-                    bits(in_place.direction.lane(k)),
-                    bits(gathered.direction.lane(j))
+            for traced in [closest.hits, on_one] {
+                let wave = Wave {
+                    rays: &rays,
+                    diffs: None,
+                    closest: &closest,
+                    lanes: traced,
+                    depth: 0,
+                };
+                let (reflected, diffs, made) = reflected_rays(&scene, &wave, traced);
+                assert_eq!((made, diffs), (traced, None));
+                let in_place = reflected_in_place(&scene, &rays, &closest, traced).is_some();
+                for k in lanes::each_set(traced) {
+                    let ray = rays.lane(k);
+                    let hit = closest
+                        .hit(k)
+                        .and_then(|f| scene.shapes.surface_record(&ray, f));
+                    let (expected, _) =
+                        mirror_ray(&hit.unwrap(), &ray, &RayDifferential::none(&ray));
+                    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                    assert_eq!(bits(reflected.origin.lane(k)), bits(expected.origin));
+                    assert_eq!(bits(reflected.direction.lane(k)), bits(expected.direction));
+                }
+                let sphere = matches!(
+                    scene.shapes.object(object),
+                    ObjectRef::Shape(Shape::Sphere(_))
                 );
+                let kind = if in_place { usize::from(sphere) } else { 2 };
+                checked[kind] += traced.count_ones() as usize;
             }
-            let sphere = matches!(
-                scene.shapes.object(object),
-                ObjectRef::Shape(Shape::Sphere(_))
-            );
-            checked[usize::from(sphere)] += used;
         }
+        // On a wall, on a sphere, and lane by lane.
         assert!(checked.iter().all(|&n| n > 0), "{checked:?}");
     }
 
@@ -1929,8 +2001,8 @@ mod tests {
                 material.specular = Some(Texture::Constant(Vec3::ZERO));
             }
             if mirrors {
-                // A mirror, reflected as a next wave of lanes, and a half
-                // mirror, with local shading, traced alone.
+                // A mirror and a half mirror (with local shading), both
+                // reflected as the next wave of lanes.
                 scene.materials[2].reflectivity = 1.0;
                 scene.materials[3].reflectivity = 0.5;
             }

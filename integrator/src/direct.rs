@@ -346,15 +346,12 @@ impl DirectIntegrator {
         depth: u32,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let surface = at.hit.differentials(at.diff);
-        let (wi, reflected_diff) =
-            reflect_differential(at.hit, at.ray.direction, at.diff, &surface);
-        let reflected = spawn_ray(at.hit, wi);
+        let (reflected, reflected_diff) = mirror_ray(at.hit, at.ray, at.diff);
         ctx.counters.reflection_rays += 1;
         ctx.tracer.record(|| Event::Mirror {
             reflectivity: at.material.reflectivity,
             tint: at.material.mirror_tint,
-            direction: wi,
+            direction: reflected.direction,
         });
         at.material.mirror_tint * self.li(scene, &reflected, &reflected_diff, depth + 1, ctx)
     }
@@ -892,6 +889,15 @@ struct SurfaceHit<'a> {
     material: &'a PhongMaterial,
     ray: &'a Ray,
     diff: &'a RayDifferential,
+}
+
+/// The ray `ray` reflects into at `hit` by a perfect mirror, and its
+/// differentials ([`reflect_differential`]), leaving from an origin offset
+/// to its side ([`spawn_ray`]).
+pub(crate) fn mirror_ray(hit: &Hit, ray: &Ray, diff: &RayDifferential) -> (Ray, RayDifferential) {
+    let surface = hit.differentials(diff);
+    let (wi, reflected_diff) = reflect_differential(hit, ray.direction, diff, &surface);
+    (spawn_ray(hit, wi), reflected_diff)
 }
 
 /// The radiance of a light's surface seen directly: its color.

@@ -68,10 +68,11 @@ impl DirectIntegrator {
             && self.samples_environment_by_map(scene)
     }
 
-    /// The dimension pair of the environment's samples at a first hit: the
-    /// one `shade_with` gives it after the lights that sample take theirs.
-    pub(crate) fn environment_pair_at_first_hit(&self, scene: &Scene) -> DimensionPair {
-        let mut pairs = PairAllocation::new(0);
+    /// The dimension pair of the environment's samples at a point `depth`
+    /// reflections deep: the one `shade_with` gives it after the lights that
+    /// sample take theirs.
+    pub(crate) fn environment_pair(&self, scene: &Scene, depth: u32) -> DimensionPair {
+        let mut pairs = PairAllocation::new(depth);
         for (index, light) in scene.lights.iter().enumerate() {
             let samples = match light {
                 Light::Area(_) => true,
@@ -79,10 +80,10 @@ impl DirectIntegrator {
                 Light::Point(_) => false,
             };
             if samples {
-                self.light_pair(&mut pairs, index, 0);
+                self.light_pair(&mut pairs, index, depth);
             }
         }
-        let own = DimensionPair::Environment { depth: 0 };
+        let own = DimensionPair::Environment { depth };
         pairs.take(own, self.environment_samples)
     }
 
@@ -98,7 +99,7 @@ impl DirectIntegrator {
         ctx: &mut SampleContext<T>,
     ) {
         let env = scene.environment.as_ref().expect("draws_environment_ahead");
-        let pair = self.environment_pair_at_first_hit(scene);
+        let pair = self.environment_pair(scene, 0);
         let mut ahead = std::mem::take(&mut ctx.drawn_ahead);
         let mut points = std::mem::take(&mut ctx.environment_points);
         ahead.pair = Some(pair);

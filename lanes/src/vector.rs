@@ -206,6 +206,15 @@ impl<F: Float> std::ops::Sub for Vector3<F> {
     }
 }
 
+/// Component by component, as glam's `Vec3 * Vec3` (a colour's filter).
+impl<F: Float> std::ops::Mul for Vector3<F> {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        Self::new(self.x * o.x, self.y * o.y, self.z * o.z)
+    }
+}
+
 impl<F: Float> std::ops::Neg for Vector3<F> {
     type Output = Self;
     #[inline(always)]

@@ -184,6 +184,18 @@ impl Pcg32Lanes {
         let uniforms = |states: [u64; LANES]| lanes::from_fn(|k| unit(output(states[k])));
         (uniforms(first), uniforms(second))
     }
+
+    /// Lane k from `if_set` where bit k of `lanes` is set, else from
+    /// `if_clear`: the streams of the lanes that drew, the others as they were.
+    #[inline]
+    pub fn select(lanes: u32, if_set: &Self, if_clear: &Self) -> Self {
+        Self {
+            state: std::array::from_fn(|k| match lanes >> k & 1 {
+                1 => if_set.state[k],
+                _ => if_clear.state[k],
+            }),
+        }
+    }
 }
 
 /// Two draws' step: the state after `uniform2`.

@@ -14,15 +14,15 @@
 //! no light samples for [`crate::light_samples`]' lanes to batch; with more,
 //! this is the wavefront form of the same sums.
 //!
-//! This is only done where a scene needs nothing else at a first hit
-//! ([`DirectIntegrator::shades_first_hits_in_lanes`]): light points that each
-//! sample can draw alone (not a stratified pattern of several), and either
-//! the course's model with area and point lights and an environment whose
-//! points are Sobol's, or physical shading under area, point and sphere
-//! lights and an environment map. Lanes on mirrors reflect their rays as the
-//! next wave of lanes, one reflection deeper ([`DirectIntegrator::li_wave`]),
-//! with their differentials where the scene reads footprints; lanes not in a
-//! wave are masked, not traced apart. Physical shading draws
+//! Every scene whose closest hits are found in lanes is shaded so, in
+//! either shading model, whatever its light and environment patterns:
+//! each lane takes its points as its camera sample alone takes them
+//! ([`LanePoints`]), the lanes whose points come from their own streams
+//! drawing only where `li_at` draws. Lanes on mirrors reflect their rays as
+//! the next wave of lanes, one reflection deeper
+//! ([`DirectIntegrator::li_wave`]), with their differentials where the scene
+//! reads footprints; lanes not in a wave are masked, not traced apart.
+//! Physical shading draws
 //! each lane's light samples with its own point's sampler (by area or solid
 //! angle) and takes them through the diffuse kernel a point's light samples
 //! share ([`crate::physical::DiffusePoints`]), or on glossy points through
@@ -62,58 +62,10 @@ use glint_texture::{Checkerboard, TexCoord, Texture};
 use std::cell::OnceCell;
 
 impl DirectIntegrator {
-    /// Whether the first hits of `scene`'s camera samples can be shaded [`LANES`] at
-    /// a time (`li_first_hits`), mirrors and all: light points each sample
-    /// can draw alone, and either the course's shading model with area and
-    /// point lights and environment points drawn from no random stream, or
-    /// physical shading with area, point and sphere lights where its light
-    /// and environment points are drawn from no random stream.
-    pub fn shades_first_hits_in_lanes(&self, scene: &Scene) -> bool {
-        let lights = |admitted: fn(&Light) -> bool| scene.lights.iter().all(admitted);
-        self.light_samples_in_lanes()
-            && match scene.shading {
-                ShadingModel::Phong => {
-                    lights(|l| matches!(l, Light::Area(_) | Light::Point(_)))
-                        && self.environment_drawn_from_no_stream(scene)
-                }
-                ShadingModel::Physical => {
-                    lights(|l| matches!(l, Light::Area(_) | Light::Point(_) | Light::Sphere(_)))
-                        && self.physical_in_lanes(scene)
-                }
-            }
-    }
-
-    /// Whether physical shading's first hits can take the lanes: light and
-    /// environment points no random stream draws (a point behind a light
-    /// draws none, which would shift a stream's later draws).
-    fn physical_in_lanes(&self, scene: &Scene) -> bool {
-        matches!(
-            self.light_pattern,
-            SamplePattern::Sobol | SamplePattern::Grid
-        ) && self.environment_drawn_from_no_stream(scene)
-    }
-
-    /// Whether the environment's samples, if any, come from no random
-    /// stream: drawn at Sobol points, in lanes across the camera samples.
-    fn environment_drawn_from_no_stream(&self, scene: &Scene) -> bool {
-        scene.environment.is_none()
-            || self.environment_samples == 0
-            || self.environment_pattern == SamplePattern::Sobol
-    }
-
-    /// Whether each camera sample's light points can be drawn lane by lane, the
-    /// lanes being camera samples: one point each from any pattern, or any
-    /// number from the patterns whose points do not depend on their count
-    /// (Sobol, random, grid; not stratified, whose cells do).
-    fn light_samples_in_lanes(&self) -> bool {
-        self.light_samples == 1 || self.light_pattern != SamplePattern::Stratified
-    }
-
     /// The radiance of the first `used` of [`LANES`] camera samples, lane k
     /// sample `samples.lane(k)`, whose camera rays `rays` have the closest
     /// hits `closest`: for each, what [`Self::li_at`] gives it alone (with
     /// [`SampleContext::begin_sample`] for that sample), bit for bit.
-    /// Only for scenes where [`Self::shades_first_hits_in_lanes`] holds.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn li_first_hits<T: Tracer>(
         &self,
@@ -125,16 +77,15 @@ impl DirectIntegrator {
         samples: &LaneSamples,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        debug_assert!(self.shades_first_hits_in_lanes(scene));
-        // Each lane's own stream, as `SampleContext::begin_sample` makes it. The
-        // random pattern draws a point as two uniforms; so does the stratified
-        // one for a single point (its one cell is the whole square, and
-        // `(0 + u)·1` is `u`). Grid and Sobol points draw nothing.
-        let mut rngs = matches!(
-            self.light_pattern,
-            SamplePattern::Random | SamplePattern::Stratified
-        )
-        .then(|| Pcg32Lanes::new(samples.stream_seeds()));
+        // Each lane's own stream, as `SampleContext::begin_sample` makes it,
+        // where a pattern draws from it (grid and Sobol points draw nothing).
+        let draws = |pattern| matches!(pattern, SamplePattern::Random | SamplePattern::Stratified);
+        let mut streams = LaneStreams {
+            samples,
+            live: 0,
+            rngs: (draws(self.light_pattern) || draws(self.environment_pattern))
+                .then(|| Pcg32Lanes::new(samples.stream_seeds())),
+        };
         let wave = Wave {
             rays,
             diffs,
@@ -142,21 +93,23 @@ impl DirectIntegrator {
             lanes: (1 << used) - 1,
             depth: 0,
         };
-        self.li_wave(scene, wave, samples, &mut rngs, ctx)
+        self.li_wave(scene, wave, &mut streams, ctx)
     }
 
     /// `li_at` for every lane of `wave`, `wave.depth` reflections deep, for
-    /// the lanes' camera samples `samples` (whose streams are `rngs`, where
-    /// the pattern draws): misses read the environment, emitters give their
+    /// the lanes' camera samples (`streams`): misses read the environment, emitters give their
     /// radiance, and surfaces their local shading and, on a mirror, the
     /// radiance of the next wave ([`Self::mirror_wave`]), in `li_at`'s
     /// order and operations. The other lanes are zero.
+    // Inlined into the first hits and into `mirror_wave`, which alone
+    // recurses: the first wave is then one function, as it was before
+    // mirrors took the lanes (its lanes passed in registers, not memory).
+    #[inline(always)]
     fn li_wave<T: Tracer>(
         &self,
         scene: &Scene,
         wave: Wave,
-        samples: &LaneSamples,
-        rngs: &mut Option<Pcg32Lanes>,
+        streams: &mut LaneStreams,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let hit_lanes = wave.closest.hits & wave.lanes;
@@ -164,22 +117,36 @@ impl DirectIntegrator {
         if hit_lanes == 0 {
             return radiance;
         }
-        let mirrors = Mirrors::of(scene, wave.closest, hit_lanes);
+        let hits = FirstHits::of(scene, wave.closest, hit_lanes);
+        let mirrors = Mirrors::of(scene, wave.closest, hit_lanes, &hits);
+        // Perfect mirrors have no local shading.
         let local = hit_lanes & !mirrors.perfect;
+        let hits = match local == hit_lanes {
+            true => hits,
+            false => FirstHits::of(scene, wave.closest, local),
+        };
+        let on = (local, hits);
+        // Of the lanes that draw no points for a term, only these go on
+        // to draw later (for another term, or a next wave).
+        streams.live = hit_lanes;
         let shaded = match local {
             0 => 0,
-            _ => self.local_shading_lanes(scene, &wave, local, samples, rngs, &mut radiance, ctx),
+            _ => self.local_shading_lanes(scene, &wave, on, streams, &mut radiance, ctx),
         };
         // `li_at`'s `(1 − r)·local + r·mirror` on every surface: a zero
         // mirror term on all but mirrors (which turns a −0 to +0 there too),
         // and no local term on a perfect mirror.
+        if mirrors.lanes == 0 {
+            let plus_zero = radiance + Vec3Lanes::default();
+            return Vec3Lanes::select(lanes::from_bits(shaded), &plus_zero, &radiance);
+        }
         let traced = match wave.depth < self.max_depth {
             true => mirrors.lanes,
             false => 0,
         };
         let mirror = match traced {
             0 => Vec3Lanes::default(),
-            _ => self.mirror_wave(scene, &wave, traced, samples, rngs, ctx) * mirrors.tint,
+            _ => self.mirror_wave(scene, &wave, traced, streams, ctx) * mirrors.tint,
         };
         let r = mirrors.reflectivity;
         let value = radiance.scale(F32Lanes::splat(1.0) - r) + mirror.scale(r);
@@ -191,6 +158,7 @@ impl DirectIntegrator {
     /// `misses`, which hit nothing (zero elsewhere, and without one): the map
     /// unfiltered under physical shading, filtered over each ray's footprint
     /// in the course's model, as `li_at`'s `environment_seen` reads it.
+    #[inline(always)]
     fn environment_seen_lanes<T: Tracer>(
         &self,
         scene: &Scene,
@@ -222,25 +190,25 @@ impl DirectIntegrator {
         radiance
     }
 
-    /// The lanes of `local`, on surfaces, shaded: an emitter's radiance, or
-    /// a material's ambient term, lights and environment (`li_at`'s local
-    /// shading), put in `radiance`. The lanes shaded on a material are
-    /// returned.
+    /// The lanes of `local`, on surfaces (`hits`), shaded: an emitter's
+    /// radiance, or a material's ambient term, lights and environment
+    /// (`li_at`'s local shading), put in `radiance`. The lanes shaded on a
+    /// material are returned.
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     fn local_shading_lanes<T: Tracer>(
         &self,
         scene: &Scene,
         wave: &Wave,
-        local: u32,
-        samples: &LaneSamples,
-        rngs: &mut Option<Pcg32Lanes>,
+        (local, hits): (u32, FirstHits),
+        streams: &mut LaneStreams,
         radiance: &mut Vec3Lanes,
         ctx: &mut SampleContext<T>,
     ) -> u32 {
         let (rays, closest) = (wave.rays, wave.closest);
         // Each arm builds the lanes in place: made over a default, or moved
         // out of an `Option`, their kilobytes cost a zeroing or a copy a chunk.
-        let mut shaded = match FirstHits::of(scene, closest, local) {
+        let mut shaded = match hits {
             FirstHits::OnOneObject(object, shape, material) => {
                 let on = (object, shape, material);
                 ShadedLanes::on_one_object(scene, rays, closest, local, on, radiance, ctx)
@@ -257,25 +225,24 @@ impl DirectIntegrator {
         };
         shaded.depth = wave.depth;
         if shaded.lanes != 0 {
-            *radiance = self.with_direct_lighting(scene, &shaded, samples, rngs, *radiance, ctx);
+            *radiance = self.with_direct_lighting(scene, &shaded, streams, *radiance, ctx);
         }
         shaded.lanes
     }
 
     /// `radiance` plus, in the lanes of `shaded`, each light's term and the
     /// environment's, added in `li_at`'s order, for the camera samples
-    /// `samples`. Only the shaded lanes draw from their streams `rngs`.
+    /// `streams`.
+    #[inline(always)]
     fn with_direct_lighting<T: Tracer>(
         &self,
         scene: &Scene,
         shaded: &ShadedLanes,
-        samples: &LaneSamples,
-        rngs: &mut Option<Pcg32Lanes>,
+        streams: &mut LaneStreams,
         mut radiance: Vec3Lanes,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let shaded_mask = lanes::from_bits(shaded.lanes);
-        let streams_before = *rngs;
         let mut pairs = PairAllocation::new(shaded.depth);
         let physical = scene.shading == ShadingModel::Physical;
         for (index, light) in scene.lights.iter().enumerate() {
@@ -287,7 +254,7 @@ impl DirectIntegrator {
             let term = match light {
                 Light::Area(area) => {
                     let pair = pairs.take(own, self.light_samples);
-                    let points = (samples, pair, &mut *rngs);
+                    let points = (pair, &mut *streams);
                     if physical {
                         self.physical_area_light_term(scene, shaded, (index, area), points, ctx)
                     } else {
@@ -303,11 +270,12 @@ impl DirectIntegrator {
                         Vec3Lanes::scaled_splat_lanes(point.color, &reflected)
                     }
                 }
+                // The course's model has no sphere lights (`shade`).
+                Light::Sphere(_) if !physical => Vec3Lanes::default(),
                 Light::Sphere(sphere) => {
-                    debug_assert!(physical, "the course's model admits no sphere lights");
                     let pair = pairs.take(own, self.light_samples);
                     let sphere = (index, sphere);
-                    self.physical_sphere_light_term(scene, shaded, sphere, (samples, pair), ctx)
+                    self.physical_sphere_light_term(scene, shaded, sphere, (pair, streams), ctx)
                 }
             };
             radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
@@ -317,13 +285,8 @@ impl DirectIntegrator {
             .as_ref()
             .filter(|_| self.environment_samples > 0)
         {
-            let term = self.environment_term_lanes(scene, env, shaded, samples, ctx);
+            let term = self.environment_term_lanes(scene, env, shaded, streams, ctx);
             radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
-        }
-        // The other lanes' streams stay where they were: a lane on a
-        // perfect mirror draws its first points in the next wave.
-        if let (Some(streams), Some(before)) = (rngs.as_mut(), streams_before) {
-            *streams = Pcg32Lanes::select(shaded.lanes, streams, &before);
         }
         radiance
     }
@@ -332,13 +295,13 @@ impl DirectIntegrator {
     /// into, on mirrors, found as the next wave one reflection deeper: the
     /// rays made in their own lanes ([`reflected_rays`]), their closest hits
     /// found together, and their radiance by [`Self::li_wave`].
+    #[inline(never)]
     fn mirror_wave<T: Tracer>(
         &self,
         scene: &Scene,
         wave: &Wave,
         traced: u32,
-        samples: &LaneSamples,
-        rngs: &mut Option<Pcg32Lanes>,
+        streams: &mut LaneStreams,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let (rays, diffs, traced) = reflected_rays(scene, wave, traced);
@@ -355,7 +318,7 @@ impl DirectIntegrator {
             lanes: traced,
             depth: wave.depth + 1,
         };
-        self.li_wave(scene, next, samples, rngs, ctx)
+        self.li_wave(scene, next, streams, ctx)
     }
 
     /// `environment_light` at every lane's point: each lane's `n` samples
@@ -369,19 +332,20 @@ impl DirectIntegrator {
         scene: &Scene,
         env: &EnvironmentLight,
         shaded: &ShadedLanes,
-        samples: &LaneSamples,
+        streams: &mut LaneStreams,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let n = self.environment_samples;
         let count = u64::from(shaded.lanes.count_ones());
         ctx.counters.environment_samples += u64::from(n) * count;
         let pair = self.environment_pair(scene, shaded.depth);
-        let sequences = RunSequences::new(samples, shaded.lanes, pair, n, ctx);
+        let of = (PointsOf::Environment, pair, shaded.lanes);
+        let mut points = self.lane_points(of, streams, ctx);
         let len = (u32::BITS - shaded.lanes.leading_zeros()) as usize;
         let by_map = self.samples_environment_by_map(scene);
         let mut sum = Vec3Lanes::default();
         for j in 0..n {
-            let u = sequences.points(j, n);
+            let u = points.get(j);
             let (direction, radiance, pdf) = if by_map {
                 let (ux, uy) = (u.0.to_array(), u.1.to_array());
                 let points: [Vec2; LANES] = lanes::array_from_fn(|k| Vec2::new(ux[k], uy[k]));
@@ -416,12 +380,13 @@ impl DirectIntegrator {
             let visible = lanes::from_bits(traced & !blocked);
             sum = sum + Vec3Lanes::select(visible, &value, &Vec3Lanes::default());
         }
+        points.finish(ctx);
         sum.div_splat(n as f32)
     }
 
     /// `li_at`'s `L · (0 + Σ reflected) / n` for area light `index`, each lane
     /// summing its own `n` samples in order, their points those of `pair` for
-    /// the lanes' camera samples `samples` (drawn from `rngs` where the pattern
+    /// the lanes' camera samples (drawn from their streams where the pattern
     /// draws). A sample a lane's point does not see adds +0 where `li_at` adds
     /// nothing: the same, as the sum is never −0.
     fn area_light_term<T: Tracer>(
@@ -429,33 +394,19 @@ impl DirectIntegrator {
         scene: &Scene,
         shaded: &ShadedLanes,
         (index, area): (usize, &AreaLight),
-        (samples, pair, rngs): (&LaneSamples, DimensionPair, &mut Option<Pcg32Lanes>),
+        (pair, streams): (DimensionPair, &mut LaneStreams),
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        let grid = self.grid_points(pair, ctx);
-        let n = self.light_samples;
-        let sequences = (self.light_pattern == SamplePattern::Sobol)
-            .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
+        // `area_light` draws its points at every point, seen or not.
+        let mut points = self.lane_points((PointsOf::Lights, pair, shaded.lanes), streams, ctx);
         let occluders = shaded.occluders(scene, index, area, ctx);
         let mut sum = Vec3Lanes::default();
         for j in 0..self.light_samples {
-            let u = match (&mut *rngs, &grid, &sequences) {
-                (Some(rngs), _, _) => rngs.uniform2(),
-                (None, Some(grid), _) => {
-                    let p = grid.get(j as usize);
-                    (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
-                }
-                (None, None, Some(sequences)) => sequences.points(j, n),
-                (None, None, None) => {
-                    unreachable!("the patterns in lanes draw, share or are Sobol")
-                }
-            };
+            let u = points.get(j);
             ctx.counters.light_samples += u64::from(shaded.lanes.count_ones());
             sum = sum + shaded.area_light(scene, area, &occluders, u, ctx);
         }
-        if let Some(grid) = grid {
-            ctx.light_points = grid;
-        }
+        points.finish(ctx);
         Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(self.light_samples as f32)
     }
 
@@ -472,7 +423,7 @@ impl DirectIntegrator {
         scene: &Scene,
         shaded: &ShadedLanes,
         (index, area): (usize, &AreaLight),
-        (samples, pair, _): (&LaneSamples, DimensionPair, &mut Option<Pcg32Lanes>),
+        (pair, streams): (DimensionPair, &mut LaneStreams),
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let n = self.light_samples;
@@ -507,7 +458,7 @@ impl DirectIntegrator {
         };
         let mis = self.mis_lanes(shaded, lit);
         let shadowed = (lit, mis, &occluders);
-        let mut sum = self.light_sum(scene, shaded, shadowed, (samples, pair), draw, ctx);
+        let mut sum = self.light_sum(scene, shaded, shadowed, (pair, streams), draw, ctx);
         if mis != 0 {
             let light_pdf = |k: usize, y: Vec3| match &samplers[k] {
                 Some(sampler) => sampler.pdf(y),
@@ -515,7 +466,7 @@ impl DirectIntegrator {
                     .sampler(shaded.point.lane(k), self.area_sampling)
                     .pdf(y),
             };
-            sum = sum + self.lobe_sum(scene, shaded, (mis, index), light_pdf, samples, ctx);
+            sum = sum + self.lobe_sum(scene, shaded, (mis, index), light_pdf, streams, ctx);
         }
         Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(n as f32)
     }
@@ -533,7 +484,7 @@ impl DirectIntegrator {
         scene: &Scene,
         shaded: &ShadedLanes,
         (index, light): (usize, &SphereLight),
-        (samples, pair): (&LaneSamples, DimensionPair),
+        (pair, streams): (DimensionPair, &mut LaneStreams),
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let n = self.light_samples;
@@ -548,17 +499,17 @@ impl DirectIntegrator {
         };
         let mis = self.mis_lanes(shaded, lit);
         let all = (lit, mis, &Occluders::ALL);
-        let mut sum = self.light_sum(scene, shaded, all, (samples, pair), draw, ctx);
+        let mut sum = self.light_sum(scene, shaded, all, (pair, streams), draw, ctx);
         if mis != 0 {
             let light_pdf = |k: usize, _: Vec3| light.pdf(shaded.point.lane(k));
-            sum = sum + self.lobe_sum(scene, shaded, (mis, index), light_pdf, samples, ctx);
+            sum = sum + self.lobe_sum(scene, shaded, (mis, index), light_pdf, streams, ctx);
         }
         Vec3Lanes::scaled_splat_lanes(light.color, &sum).div_splat(n as f32)
     }
 
     /// `Σ_j f · cos θ / p · V · w` over a light's `light_samples` samples at
     /// every lane of `lit`, each lane summing its own in order: sample `j`'s
-    /// points (the grid's, or each lane's Sobol points of `pair`) drawn by
+    /// points (each lane's of `pair`, [`LanePoints`]; only `lit` draws) drawn by
     /// `draw` into light points, their densities and their shadow rays' ends,
     /// tested against `occluders`; `w` the power heuristic's weight against
     /// the lobe in the lanes `mis`, else 1. A blocked sample adds +0 where
@@ -568,26 +519,21 @@ impl DirectIntegrator {
         scene: &Scene,
         shaded: &ShadedLanes,
         (lit, mis, occluders): (u32, u32, &Occluders),
-        (samples, pair): (&LaneSamples, DimensionPair),
+        (pair, streams): (DimensionPair, &mut LaneStreams),
         mut draw: impl FnMut((F32Lanes, F32Lanes)) -> (Vec3Lanes, F32Lanes, Vec3Lanes),
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        let n = self.light_samples;
-        let grid = self.grid_points(pair, ctx);
-        let sequences = (self.light_pattern == SamplePattern::Sobol)
-            .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
+        let mut points = self.lane_points((PointsOf::Lights, pair, lit), streams, ctx);
         let mut sum = Vec3Lanes::default();
-        for j in 0..n {
-            let (position, pdf, ends) = draw(light_points_at(&grid, &sequences, j, n));
+        for j in 0..self.light_samples {
+            let (position, pdf, ends) = draw(points.get(j));
             let (values, traced) = shaded.light_samples(&position, pdf, (lit, mis), ctx);
             let towards = position - shaded.point;
             let visible = traced & !shaded.blocked(scene, occluders, &ends, &towards, traced);
             let zero = Vec3Lanes::default();
             sum = sum + Vec3Lanes::select(lanes::from_bits(visible), &values, &zero);
         }
-        if let Some(grid) = grid {
-            ctx.light_points = grid;
-        }
+        points.finish(ctx);
         sum
     }
 
@@ -615,7 +561,7 @@ impl DirectIntegrator {
         shaded: &ShadedLanes,
         (mis, index): (u32, usize),
         light_pdf: impl Fn(usize, Vec3) -> f32,
-        samples: &LaneSamples,
+        streams: &mut LaneStreams,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let n = self.light_samples;
@@ -623,14 +569,12 @@ impl DirectIntegrator {
             light: index as u32,
             depth: shaded.depth,
         };
-        let grid = self.grid_points(pair, ctx);
-        let sequences = (self.light_pattern == SamplePattern::Sobol)
-            .then(|| RunSequences::new(samples, shaded.lanes, pair, n, ctx));
+        let mut points = self.lane_points((PointsOf::Lights, pair, mis), streams, ctx);
         ctx.counters.lobe_samples += u64::from(n) * u64::from(mis.count_ones());
         let object = scene.light_objects[index];
         let mut sum = Vec3Lanes::default();
         for j in 0..n {
-            let u = light_points_at(&grid, &sequences, j, n);
+            let u = points.get(j);
             let (l, pdf, drawn) = shaded.lobe_directions(u, mis, &mut ctx.counters);
             let (f, traced) = shaded.lobe_reflections(&l, drawn, &mut ctx.counters);
             if traced == 0 {
@@ -662,25 +606,138 @@ impl DirectIntegrator {
             let value = f.scale(F32Lanes::new(weights));
             sum = sum + Vec3Lanes::select(lanes::from_bits(reached), &value, &Vec3Lanes::default());
         }
-        if let Some(grid) = grid {
-            ctx.light_points = grid;
-        }
+        points.finish(ctx);
         sum
     }
 
-    /// The grid pattern's points for `pair` (the same for every camera sample),
-    /// in the buffer taken from `ctx.light_points` (the caller puts it back);
-    /// `None` for the other patterns.
-    fn grid_points<T: Tracer>(
+    /// Each lane's points of `pair` for the lights or the environment, as
+    /// its camera sample takes them alone, the lanes `drawing` drawing from
+    /// their streams where the pattern draws ([`LanePoints`]).
+    #[inline(always)]
+    fn lane_points<'s, T: Tracer>(
         &self,
-        pair: DimensionPair,
+        (of, pair, drawing): (PointsOf, DimensionPair, u32),
+        streams: &'s mut LaneStreams,
         ctx: &mut SampleContext<T>,
-    ) -> Option<SamplePoints> {
-        (self.light_pattern == SamplePattern::Grid).then(|| {
-            let mut points = std::mem::take(&mut ctx.light_points);
-            ctx.fill_points(self.light_pattern, pair, &mut points);
-            points
-        })
+    ) -> LanePoints<'s> {
+        let (pattern, n) = match of {
+            PointsOf::Lights => (self.light_pattern, self.light_samples),
+            PointsOf::Environment => (self.environment_pattern, self.environment_samples),
+        };
+        let samples = streams.samples;
+        match pattern {
+            SamplePattern::Sobol => {
+                LanePoints::Sobol(RunSequences::new(samples, drawing, pair, n, ctx), n)
+            }
+            SamplePattern::Grid => {
+                let mut points = std::mem::take(of.buffer(ctx));
+                ctx.fill_points(pattern, pair, &mut points);
+                LanePoints::Grid(points, of)
+            }
+            SamplePattern::Random | SamplePattern::Stratified => {
+                let rngs = streams
+                    .rngs
+                    .as_mut()
+                    .expect("streams where the pattern draws");
+                // Two uniforms a point: random points, and a stratified one
+                // (its one cell is the whole square, and `(0 + u)·1` is `u`).
+                if pattern == SamplePattern::Random || n == 1 {
+                    let (before, kept) = (*rngs, streams.live & !drawing);
+                    return LanePoints::Uniform(rngs, before, kept);
+                }
+                let n = n as usize;
+                let mut points = std::mem::take(&mut ctx.lane_points);
+                points.resize(LANES * n, Vec2::ZERO);
+                for k in lanes::each_set(drawing) {
+                    let mut rng = rngs.lane(k);
+                    let sobol = samples.lane(k).sobol_points(pair, n as u32);
+                    pattern.fill(&mut rng, sobol, &mut points[k * n..(k + 1) * n]);
+                    rngs.set_lane(k, rng);
+                }
+                LanePoints::Filled(points, n)
+            }
+        }
+    }
+}
+
+/// The camera samples of a chunk's lanes, and their streams where a pattern
+/// draws from them.
+pub(crate) struct LaneStreams<'a> {
+    samples: &'a LaneSamples,
+    /// The lanes whose streams are read after the term being drawn.
+    live: u32,
+    rngs: Option<Pcg32Lanes>,
+}
+
+/// Whose points: the lights' (and their lobes'), or the environment's.
+#[derive(Clone, Copy)]
+enum PointsOf {
+    Lights,
+    Environment,
+}
+
+impl PointsOf {
+    /// The context's buffer for a camera sample's points.
+    fn buffer<T: Tracer>(self, ctx: &mut SampleContext<T>) -> &mut SamplePoints {
+        match self {
+            Self::Lights => &mut ctx.light_points,
+            Self::Environment => &mut ctx.environment_points,
+        }
+    }
+}
+
+/// Each lane's points of one dimension pair, as its camera sample alone
+/// takes them from its pattern: the grid's (the same in every lane); its
+/// own points of its pixel's Sobol sequence; its stream's next two uniforms
+/// a point, drawn in lanes (random, and stratified for one point); or the
+/// pattern's points drawn lane by lane up front from each lane's stream
+/// (stratified). Only the lanes named on making them draw:
+/// [`LanePoints::finish`] leaves the other lanes' streams as they were, as
+/// `li_at` draws nothing there, and puts the buffers back.
+// On the stack for one light's samples: boxing the sequences would
+// allocate per light and chunk.
+#[allow(clippy::large_enum_variant)]
+enum LanePoints<'s> {
+    Grid(SamplePoints, PointsOf),
+    Sobol(RunSequences, u32),
+    /// The streams, where they were, and the lanes read later that do not
+    /// draw.
+    Uniform(&'s mut Pcg32Lanes, Pcg32Lanes, u32),
+    /// Lane k's `n` points at `k·n`.
+    Filled(Vec<Vec2>, usize),
+}
+
+impl LanePoints<'_> {
+    /// Every lane's point `j`.
+    #[inline(always)]
+    fn get(&mut self, j: u32) -> (F32Lanes, F32Lanes) {
+        match self {
+            Self::Grid(points, _) => {
+                let p = points.get(j as usize);
+                (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
+            }
+            Self::Sobol(sequences, n) => sequences.points(j, *n),
+            Self::Uniform(rngs, _, _) => rngs.uniform2(),
+            Self::Filled(points, n) => {
+                let p = |k: usize| points[k * *n + j as usize];
+                (lanes::from_fn(|k| p(k).x), lanes::from_fn(|k| p(k).y))
+            }
+        }
+    }
+
+    /// The lanes that did not draw keep their streams; the buffers go back
+    /// to `ctx`.
+    #[inline(always)]
+    fn finish<T: Tracer>(self, ctx: &mut SampleContext<T>) {
+        match self {
+            Self::Grid(points, of) => *of.buffer(ctx) = points,
+            Self::Sobol(..) => {}
+            Self::Uniform(rngs, before, kept) if kept != 0 => {
+                *rngs = Pcg32Lanes::select(kept, &before, rngs);
+            }
+            Self::Uniform(..) => {}
+            Self::Filled(points, _) => ctx.lane_points = points,
+        }
     }
 }
 
@@ -837,13 +894,28 @@ struct Mirrors {
 }
 
 impl Mirrors {
-    fn of(scene: &Scene, closest: &ClosestLanes, hit_lanes: u32) -> Self {
+    /// The mirrors among the lanes `hit_lanes`, which landed on `hits`.
+    #[inline(always)]
+    fn of(scene: &Scene, closest: &ClosestLanes, hit_lanes: u32, hits: &FirstHits) -> Self {
         let mut mirrors = Self {
             reflectivity: F32Lanes::ZERO,
             tint: Vec3Lanes::default(),
             lanes: 0,
             perfect: 0,
         };
+        match hits {
+            FirstHits::OnOneObject(_, _, m) if m.reflectivity > 0.0 => {
+                mirrors.reflectivity = F32Lanes::splat(m.reflectivity);
+                mirrors.tint = Vec3Lanes::splat(m.mirror_tint);
+                mirrors.lanes = hit_lanes;
+                if !m.has_local_shading() {
+                    mirrors.perfect = hit_lanes;
+                }
+                return mirrors;
+            }
+            FirstHits::OnOneObject(..) | FirstHits::OnOneEmitter(_) => return mirrors,
+            FirstHits::Several => {}
+        }
         if !scene.materials.iter().any(|m| m.reflectivity > 0.0) {
             return mirrors;
         }
@@ -878,6 +950,7 @@ enum FirstHits<'a> {
 }
 
 impl<'a> FirstHits<'a> {
+    #[inline(always)]
     fn of(scene: &'a Scene, closest: &ClosestLanes, hit_lanes: u32) -> Self {
         let Some(object) = closest.common_object(hit_lanes) else {
             return Self::Several;
@@ -903,24 +976,6 @@ impl<'a> FirstHits<'a> {
 fn count_light_samples(counters: &mut ShadingCounters, n: u32, shaded: u32, lit: u32) {
     counters.light_samples += u64::from(n) * u64::from(shaded.count_ones());
     counters.light_skips.behind_light += u64::from(n) * u64::from((shaded & !lit).count_ones());
-}
-
-/// Light sample `j` of `n` in every lane: the grid's point `j` in all of
-/// them, or each lane's Sobol point.
-fn light_points_at(
-    grid: &Option<SamplePoints>,
-    sequences: &Option<RunSequences>,
-    j: u32,
-    n: u32,
-) -> (F32Lanes, F32Lanes) {
-    match (grid, sequences) {
-        (Some(grid), _) => {
-            let p = grid.get(j as usize);
-            (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
-        }
-        (None, Some(sequences)) => sequences.points(j, n),
-        (None, None) => unreachable!("physical_in_lanes admits grid and Sobol points"),
-    }
 }
 
 /// Each lit lane's point on the light and its density, drawn by its own
@@ -1752,6 +1807,11 @@ mod tests {
             (SamplePattern::Random, 1, false, true, 4),
             (SamplePattern::Sobol, 4, true, true, 4),
             (SamplePattern::Random, 3, false, true, 1),
+            // Stratified points of a square count, and of another (a Latin
+            // hypercube), drawn lane by lane; the grid's under the sky.
+            (SamplePattern::Stratified, 4, false, false, 4),
+            (SamplePattern::Stratified, 3, true, true, 4),
+            (SamplePattern::Grid, 4, false, true, 4),
         ] {
             let mut scene = match sky_and_mirrors {
                 false => room(),
@@ -1783,17 +1843,20 @@ mod tests {
             if footprints {
                 checks_over_footprints(&mut scene);
             }
+            // Under the sky, its points in the lights' pattern.
             let integrator = DirectIntegrator {
                 light_samples,
                 light_pattern: pattern,
                 environment_samples: 4,
-                environment_pattern: SamplePattern::Sobol,
+                environment_pattern: match sky_and_mirrors {
+                    true => pattern,
+                    false => SamplePattern::Sobol,
+                },
                 environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
                 max_depth,
                 area_sampling: glint_lighting::AreaSampling::Auto,
                 mis: true,
             };
-            assert!(integrator.shades_first_hits_in_lanes(&scene));
             let differentials = footprints || sky_and_mirrors;
             let compared = compare_lanes_with_scalar(
                 &scene,
@@ -1821,63 +1884,6 @@ mod tests {
         assert!(total.specular_lobes > 0, "{total:?}");
         assert!(total.footprints > 0, "{total:?}");
         assert!(total.point_light_samples > 0, "{total:?}");
-    }
-
-    #[test]
-    fn scenes_that_need_more_at_a_hit_are_shaded_one_by_one() {
-        let scene = room();
-        let integrator = |light_samples| DirectIntegrator {
-            light_samples,
-            light_pattern: SamplePattern::Random,
-            environment_samples: 0,
-            environment_pattern: SamplePattern::Sobol,
-            environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
-            max_depth: 4,
-            area_sampling: glint_lighting::AreaSampling::Auto,
-            mis: true,
-        };
-        assert!(integrator(1).shades_first_hits_in_lanes(&scene));
-        assert!(integrator(2).shades_first_hits_in_lanes(&scene));
-        // Stratified points depend on their count: several are drawn one by one.
-        let stratified = |light_samples| DirectIntegrator {
-            light_pattern: SamplePattern::Stratified,
-            ..integrator(light_samples)
-        };
-        assert!(stratified(1).shades_first_hits_in_lanes(&scene));
-        assert!(!stratified(2).shades_first_hits_in_lanes(&scene));
-        let with = |change: fn(&mut Scene)| {
-            let mut scene = room();
-            change(&mut scene);
-            integrator(1).shades_first_hits_in_lanes(&scene)
-        };
-        // Mirror lanes reflect as the next wave; the environment's points drawn from
-        // random streams are not drawn in lanes.
-        assert!(with(|s| s.materials[1].reflectivity = 0.5));
-        let sky_drawn_from = |pattern| {
-            let mut scene = room();
-            scene.environment = Some(sky());
-            let integrator = DirectIntegrator {
-                environment_samples: 4,
-                environment_pattern: pattern,
-                ..integrator(1)
-            };
-            integrator.shades_first_hits_in_lanes(&scene)
-        };
-        assert!(sky_drawn_from(SamplePattern::Sobol));
-        assert!(!sky_drawn_from(SamplePattern::Random));
-        // Footprints are looked up lane by lane.
-        assert!(with(|s| {
-            s.materials[0].diffuse = Texture::Checkerboard(Checkerboard {
-                analytic: true,
-                ..Checkerboard::new(Vec3::ZERO, Vec3::ONE, 4)
-            })
-        }));
-        assert!(with(|s| s.lights.push(Light::Point(
-            glint_lighting::PointLight {
-                position: Vec3::Y,
-                color: Vec3::ONE
-            }
-        ))));
     }
 
     /// The reflected rays made in place for lanes on one sphere or wall, and
@@ -1981,6 +1987,13 @@ mod tests {
             (SamplePattern::Sobol, 3, false, AreaSampling::Auto, 0, true, true),
             (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 4, false, true),
             (SamplePattern::Grid, 4, true, AreaSampling::Auto, 3, true, true),
+            // Points from each sample's stream, which a lane behind a light
+            // or inside one, or not glossy, does not draw from.
+            (SamplePattern::Random, 4, false, AreaSampling::Auto, 3, true, true),
+            (SamplePattern::Random, 1, false, AreaSampling::Area, 1, false, false),
+            (SamplePattern::Stratified, 4, true, AreaSampling::SolidAngle, 4, false, true),
+            (SamplePattern::Stratified, 3, false, AreaSampling::Auto, 0, true, true),
+            (SamplePattern::Stratified, 1, false, AreaSampling::Auto, 2, true, true),
         ];
         for (
             pattern,
@@ -2013,13 +2026,16 @@ mod tests {
                 light_samples,
                 light_pattern: pattern,
                 environment_samples,
-                environment_pattern: SamplePattern::Sobol,
+                // The lights' pattern where it places that many points.
+                environment_pattern: match pattern.supports(environment_samples) {
+                    true => pattern,
+                    false => SamplePattern::Sobol,
+                },
                 environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
                 max_depth: 4,
                 area_sampling,
                 mis: true,
             };
-            assert!(integrator.shades_first_hits_in_lanes(&scene));
             let compared =
                 compare_lanes_with_scalar(&scene, &integrator, footprints, &mut total, &mut common);
             assert_eq!(compared, 12 * 10 * (4 * LANES - 1));
@@ -2037,34 +2053,6 @@ mod tests {
         assert!(total.lobe_samples > 0 && total.brdf_rays > 0, "{total:?}");
         assert!(total.lobe_skips.below_surface > 0, "{total:?}");
         assert!(total.specular_lobes > 0, "{total:?}");
-        // Light or environment points drawn from random streams keep the
-        // one-by-one route.
-        let mut glossy = room();
-        glossy.shading = ShadingModel::Physical;
-        glossy.environment = Some(sky());
-        let sobol = DirectIntegrator {
-            light_samples: 4,
-            light_pattern: SamplePattern::Sobol,
-            environment_samples: 4,
-            environment_pattern: SamplePattern::Sobol,
-            environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
-            max_depth: 4,
-            area_sampling: AreaSampling::Auto,
-            mis: true,
-        };
-        assert!(sobol.shades_first_hits_in_lanes(&glossy));
-        let random = DirectIntegrator {
-            light_pattern: SamplePattern::Random,
-            ..sobol
-        };
-        assert!(!random.shades_first_hits_in_lanes(&glossy));
-        let random_sky = DirectIntegrator {
-            environment_pattern: SamplePattern::Random,
-            ..sobol
-        };
-        assert!(!random_sky.shades_first_hits_in_lanes(&glossy));
-        glossy.environment = None;
-        assert!(random_sky.shades_first_hits_in_lanes(&glossy));
     }
 
     /// Checks read from the normals in lanes are the scalar path's, bit for

@@ -1,6 +1,5 @@
 use crate::camera_lanes::LaneOccluders;
 use crate::counters::{ShadingCounters, TextureCounters};
-use crate::drawn_ahead::DrawnAhead;
 use crate::light_samples::LANES_FROM_SAMPLES;
 use crate::sampling::Pcg32;
 use crate::sampling::{
@@ -82,8 +81,8 @@ pub struct SampleContext<T: Tracer = ()> {
     pub(crate) lane_occluders: Option<LaneOccluders>,
     /// The Sobol sequences of the pixel's pairs, hashed once for its samples.
     pub(crate) sequences: SequenceCache,
-    /// Environment samples drawn for a chunk's first hits, all together.
-    pub(crate) drawn_ahead: DrawnAhead,
+    /// Each lane's points, drawn up front, in the camera-sample lanes.
+    pub(crate) lane_points: Vec<Vec2>,
 }
 
 /// The shapes that may block shadow rays to one area light from anywhere
@@ -119,7 +118,7 @@ impl<T: Tracer> SampleContext<T> {
             occluders: None,
             lane_occluders: None,
             sequences: SequenceCache::default(),
-            drawn_ahead: DrawnAhead::default(),
+            lane_points: Vec::new(),
         }
     }
 
@@ -494,6 +493,25 @@ impl DirectIntegrator {
             && (scene.environment.as_ref()).is_some_and(EnvironmentLight::is_sampled_by_map)
     }
 
+    /// The dimension pair of the environment's samples at a point `depth`
+    /// reflections deep: the one `shade_with` gives it after the lights that
+    /// sample take theirs.
+    pub(crate) fn environment_pair(&self, scene: &Scene, depth: u32) -> DimensionPair {
+        let mut pairs = PairAllocation::new(depth);
+        for (index, light) in scene.lights.iter().enumerate() {
+            let samples = match light {
+                Light::Area(_) => true,
+                Light::Sphere(_) => scene.shading == ShadingModel::Physical,
+                Light::Point(_) => false,
+            };
+            if samples {
+                self.light_pair(&mut pairs, index, depth);
+            }
+        }
+        let own = DimensionPair::Environment { depth };
+        pairs.take(own, self.environment_samples)
+    }
+
     /// Monte Carlo estimate of `∫ L_env(ω)·V(ω)·f(ω)·cos θ dω` with directions
     /// importance-sampled from the environment (the points of
     /// `environment_pattern` over [0, 1)² mapped to directions), for a shading
@@ -512,22 +530,14 @@ impl DirectIntegrator {
         ctx.counters.environment_samples += n as u64;
         let one_by_one = T::ON || n < LANES_FROM_SAMPLES;
         let mut sum = Vec3::ZERO;
-        if let Some(i) = ctx.drawn_ahead.find(ctx.sample, pair) {
-            let ahead = std::mem::take(&mut ctx.drawn_ahead);
-            for drawn in ahead.samples_of(i, n).chunks(LANES) {
-                point.add_environment_samples(scene, drawn, one_by_one, &mut sum, ctx);
-            }
-            ctx.drawn_ahead = ahead;
-        } else {
-            let mut samples = std::mem::take(&mut ctx.environment_points);
-            ctx.fill_points(self.environment_pattern, pair, &mut samples);
-            for chunk in samples.chunks() {
-                let drawn = drawn_together(env, self.environment_sampling, point.n, &chunk);
-                let drawn = &drawn[..chunk.len];
-                point.add_environment_samples(scene, drawn, one_by_one, &mut sum, ctx);
-            }
-            ctx.environment_points = samples;
+        let mut samples = std::mem::take(&mut ctx.environment_points);
+        ctx.fill_points(self.environment_pattern, pair, &mut samples);
+        for chunk in samples.chunks() {
+            let drawn = drawn_together(env, self.environment_sampling, point.n, &chunk);
+            let drawn = &drawn[..chunk.len];
+            point.add_environment_samples(scene, drawn, one_by_one, &mut sum, ctx);
         }
+        ctx.environment_points = samples;
         sum / self.environment_samples as f32
     }
 }

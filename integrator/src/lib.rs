@@ -37,7 +37,6 @@ mod aov;
 mod camera_lanes;
 pub mod counters;
 mod direct;
-mod drawn_ahead;
 mod explain;
 mod light_samples;
 mod physical;

@@ -3,13 +3,11 @@ use crate::direct::SampleContext;
 use crate::sampling::{pixel_rng, LaneSamples, PixelSample, SobolPoints, PIXEL_STREAM};
 use crate::settings::{Crop, RenderSettings, SettingsError};
 use crate::trace::{Event, Tracer};
-use crate::{DirectIntegrator, Scene, SurfaceKind};
+use crate::{DirectIntegrator, Scene};
 use glam::{UVec2, Vec2, Vec3};
 use glint_camera::{Camera, Film, PartialFilm};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
-use glint_geometry::{
-    take_counters, ClosestLanes, CountingGuard, Hit, QueryCounters, Ray, RayDifferential, RayLanes,
-};
+use glint_geometry::{take_counters, CountingGuard, QueryCounters, Ray, RayDifferential, RayLanes};
 use rayon::prelude::*;
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -288,7 +286,6 @@ pub(crate) struct PixelRenderer<'a> {
     /// scales differentials the same way, never below 1/8).
     footprint_scale: f32,
     differentials: bool,
-    first_hits_in_lanes: bool,
     /// The whole of a camera sample in lanes, from its ray to its radiance.
     all_in_lanes: bool,
     /// The objects the last span of pixels may see, for its next pixels.
@@ -316,16 +313,13 @@ impl<'a> PixelRenderer<'a> {
         integrator: &'a DirectIntegrator,
     ) -> Self {
         let differentials = scene.needs_differentials();
-        let first_hits_in_lanes = integrator.shades_first_hits_in_lanes(scene);
         Self {
             scene,
             settings,
             integrator,
             footprint_scale: (1.0 / (settings.spp as f32).sqrt()).max(0.125),
             differentials,
-            first_hits_in_lanes,
-            all_in_lanes: first_hits_in_lanes
-                && settings.aov.is_none()
+            all_in_lanes: settings.aov.is_none()
                 && !differentials
                 && scene.shapes.has_closest_lanes(),
             span: Cell::new(None),
@@ -463,7 +457,7 @@ impl<'a> PixelRenderer<'a> {
         if self.all_in_lanes && !T::ON && chunk.jitters.len() > 1 {
             self.samples_in_lanes(chunk, candidates, ctx)
         } else {
-            self.samples_by_rays(chunk, self.first_hits_in_lanes && !T::ON, ctx)
+            self.samples_by_rays(chunk, ctx)
         }
     }
 
@@ -485,12 +479,11 @@ impl<'a> PixelRenderer<'a> {
 
     /// The radiance (or AOV) of a chunk's camera samples, each camera ray made
     /// with its differentials: their closest hits found together where the
-    /// scene's layout allows it (the same hits), then shaded together if
-    /// `first_hits_in_lanes`, else one by one.
+    /// scene's layout allows it (the same hits) and then shaded together,
+    /// else one by one.
     fn samples_by_rays<T: Tracer>(
         &self,
         chunk: &SampleChunk,
-        first_hits_in_lanes: bool,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let (scene, settings, used) = (self.scene, self.settings, chunk.jitters.len());
@@ -507,8 +500,7 @@ impl<'a> PixelRenderer<'a> {
             .then(|| scene.shapes.closest_lanes(&ray_lanes, used))
             .flatten();
         match &closest {
-            // One sample per light: the chunk's samples shaded together.
-            Some(closest) if first_hits_in_lanes => (self.integrator).li_first_hits(
+            Some(closest) => (self.integrator).li_first_hits(
                 scene,
                 &ray_lanes,
                 Some(&diffs),
@@ -517,86 +509,38 @@ impl<'a> PixelRenderer<'a> {
                 &chunk.samples,
                 ctx,
             ),
-            _ => {
-                if let Some(closest) = &closest {
-                    self.draw_environment_ahead(chunk, closest, used, ctx);
-                }
-                self.samples_one_by_one(chunk, (&ray_lanes, &diffs), closest.as_ref(), ctx)
-            }
+            None => self.samples_one_by_one(chunk, (&ray_lanes, &diffs), ctx),
         }
     }
 
     /// Each of a chunk's camera samples traced alone from its ray and
-    /// differentials (`rays`), from its first hit where found (`closest`).
+    /// differentials (`rays`).
     fn samples_one_by_one<T: Tracer>(
         &self,
         chunk: &SampleChunk,
         (ray_lanes, diffs): (&RayLanes, &[RayDifferential; LANES]),
-        closest: Option<&ClosestLanes>,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        let (scene, used) = (self.scene, chunk.jitters.len());
+        let used = chunk.jitters.len();
         Vec3Lanes::from_lanes(std::array::from_fn(|k| {
             if k >= used {
                 return Vec3::ZERO;
             }
             let (ray, diff) = (&ray_lanes.lane(k), &diffs[k]);
-            let hit = closest.as_ref().map(|closest| {
-                closest
-                    .hit(k)
-                    .and_then(|found| scene.shapes.surface_record(ray, found))
-            });
             let sample = chunk.samples.lane(k).sample;
-            self.sample(
-                chunk.x(k),
-                chunk.y,
-                chunk.jitters[k],
-                sample,
-                ray,
-                diff,
-                hit,
-                ctx,
-            )
+            let x = chunk.x(k);
+            self.sample((x, chunk.y, chunk.jitters[k]), sample, ray, diff, ctx)
         }))
     }
 
-    /// Draws the environment samples of the chunk's camera samples that hit
-    /// a surface with local shading, all together, where the integrator can
-    /// ([`DirectIntegrator::draws_environment_ahead`]): the samples each
-    /// takes at its first hit.
-    fn draw_environment_ahead<T: Tracer>(
-        &self,
-        chunk: &SampleChunk,
-        closest: &ClosestLanes,
-        used: usize,
-        ctx: &mut SampleContext<T>,
-    ) {
-        let (scene, integrator) = (self.scene, self.integrator);
-        if T::ON || self.settings.aov.is_some() || !integrator.draws_environment_ahead(scene) {
-            return;
-        }
-        let shaded = |k: usize| match scene.surface_of_primitive(closest.object[k], 0) {
-            SurfaceKind::Material(material) => material.has_local_shading(),
-            SurfaceKind::Emitter(_) => false,
-        };
-        let lanes = lanes::each_set(closest.hits & ((1 << used) - 1))
-            .filter(|&k| shaded(k))
-            .fold(0u32, |lanes, k| lanes | 1 << k);
-        integrator.draw_environment_ahead(scene, &chunk.samples, lanes, ctx);
-    }
-
     /// The radiance (or AOV) of camera sample `sample` of pixel (x, y), at
-    /// `jitter` in it, along `ray`; `hit` is its first hit where already found.
-    #[allow(clippy::too_many_arguments)]
+    /// `jitter` in it, along `ray`.
     fn sample<T: Tracer>(
         &self,
-        x: u32,
-        y: u32,
-        jitter: Vec2,
+        (x, y, jitter): (u32, u32, Vec2),
         sample: u64,
         ray: &Ray,
         diff: &RayDifferential,
-        hit: Option<Option<Hit>>,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let (scene, settings, integrator) = (self.scene, self.settings, self.integrator);
@@ -605,10 +549,9 @@ impl<'a> PixelRenderer<'a> {
         ctx.tracer.start_sample(sample);
         ctx.tracer
             .record(|| self.camera_event(jitter, x, y, ray, diff));
-        let value = match (settings.aov, hit) {
-            (None, Some(hit)) => integrator.li_at(scene, ray, diff, hit, 0, ctx),
-            (None, None) => integrator.li(scene, ray, diff, 0, ctx),
-            (Some(aov), _) => aov.evaluate(scene, ray, diff, settings.max_depth),
+        let value = match settings.aov {
+            None => integrator.li(scene, ray, diff, 0, ctx),
+            Some(aov) => aov.evaluate(scene, ray, diff, settings.max_depth),
         };
         ctx.tracer.record(|| Event::SampleRadiance { value });
         value

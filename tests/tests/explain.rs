@@ -7,7 +7,7 @@ use glam::{UVec2, Vec3};
 use glint_integrator::trace::{Event, SampleSelection};
 use glint_integrator::{
     explain_pixel, render, render_with, Crop, EnvironmentSampling, ExplainError, RenderControl,
-    RenderSettings, Scene,
+    RenderSettings, SamplePattern, Scene,
 };
 use glint_scene::load;
 use glint_tests::scene_path;
@@ -35,8 +35,8 @@ fn bits(v: Vec3) -> [u32; 3] {
 /// first hits in lanes with light samples in lanes,
 /// the scalar path with footprints, mirrors and environment samples, the BVH,
 /// physical shading with MIS and without (its light samples' shadow rays
-/// in lanes when rendered, one by one when explained), and environment
-/// samples drawn ahead for a chunk's camera samples.
+/// in lanes when rendered, one by one when explained), and every pattern of
+/// light and environment points.
 fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
     let size = UVec2::new(24, 18);
     let few = |s: &mut RenderSettings| {
@@ -74,9 +74,8 @@ fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
         ("ground-mipmap", scene("ground-mipmap", size, few)),
         ("bunny-cornell", scene("bunny-cornell", size, few)),
         ("physical-glossy", scene("physical-glossy", size, few)),
-        // Environment samples drawn ahead for a chunk's first hits, one or
-        // four a point (the first pair joint with the pixel's), and drawn by
-        // each point itself behind a mirror.
+        // Environment samples one or four a point (the first pair joint
+        // with the pixel's), and behind a mirror.
         ("physical-textured-ground, 1 sample", {
             scene("physical-textured-ground", size, |s| {
                 few(s);
@@ -124,6 +123,29 @@ fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
             scene("environment", size, |s| {
                 few(s);
                 s.environment_sampling = EnvironmentSampling::Cosine;
+            })
+        }),
+        // Points from each sample's own stream, in the camera-sample lanes
+        // too: random and stratified (drawn only where the scalar path
+        // draws), and the grid's.
+        ("physical-glossy, random points", {
+            scene("physical-glossy", size, |s| {
+                few(s);
+                s.light_pattern = SamplePattern::Random;
+            })
+        }),
+        ("physical-environment, stratified points", {
+            scene("physical-environment", size, |s| {
+                few(s);
+                s.light_pattern = SamplePattern::Stratified;
+                s.environment_pattern = SamplePattern::Stratified;
+            })
+        }),
+        ("environment, random and grid points", {
+            scene("environment", size, |s| {
+                few(s);
+                s.light_pattern = SamplePattern::Grid;
+                s.environment_pattern = SamplePattern::Random;
             })
         }),
     ]

@@ -185,16 +185,31 @@ impl Pcg32Lanes {
         (uniforms(first), uniforms(second))
     }
 
+    /// Lane k's generator, where it is now.
+    #[inline]
+    pub fn lane(&self, k: usize) -> Pcg32 {
+        Pcg32 {
+            state: self.state[k],
+        }
+    }
+
+    /// Puts `rng` in lane k.
+    #[inline]
+    pub fn set_lane(&mut self, k: usize, rng: Pcg32) {
+        self.state[k] = rng.state;
+    }
+
     /// Lane k from `if_set` where bit k of `lanes` is set, else from
     /// `if_clear`: the streams of the lanes that drew, the others as they were.
-    #[inline]
+    #[inline(always)]
     pub fn select(lanes: u32, if_set: &Self, if_clear: &Self) -> Self {
-        Self {
-            state: std::array::from_fn(|k| match lanes >> k & 1 {
-                1 => if_set.state[k],
-                _ => if_clear.state[k],
-            }),
+        // Without branches, so that it compiles to a blend.
+        let mut state = if_clear.state;
+        for (k, state) in state.iter_mut().enumerate() {
+            let set = 0u64.wrapping_sub(u64::from(lanes >> k & 1));
+            *state ^= (*state ^ if_set.state[k]) & set;
         }
+        Self { state }
     }
 }
 

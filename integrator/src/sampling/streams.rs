@@ -105,6 +105,16 @@ impl LaneSamples {
     #[inline]
     pub fn stream_seeds(&self) -> [u64; LANES] {
         let mut seeds = [0; LANES];
+        if self.per_pixel == LANES {
+            // One pixel's: a loop the compiler vectorizes, whose seeds the
+            // generators' seeding then reads from registers (written lane
+            // by lane, they stall its vector loads).
+            let key = pixel_key(self.seed, self.pixels[0]);
+            for (k, seed) in seeds.iter_mut().enumerate() {
+                *seed = mix64(key ^ (self.first + k as u64));
+            }
+            return seeds;
+        }
         for (run, lanes) in seeds.chunks_mut(self.per_pixel).enumerate() {
             let key = pixel_key(self.seed, self.pixels[run]);
             for (k, seed) in lanes.iter_mut().enumerate() {

@@ -1018,6 +1018,8 @@ struct ShadedLanes<'a> {
     origins: ShadowOrigins,
     /// The one object every lane is on, where set together.
     object: Option<u32>,
+    /// Each lane's object, where set one by one.
+    objects: [u32; LANES],
     /// The reflections the camera rays took to the points.
     depth: u32,
 }
@@ -1102,6 +1104,7 @@ impl<'a> ShadedLanes<'a> {
         self.phong
             .set(k, material, p.kd, p.ks, p.n, p.v, p.has_specular);
         self.lanes |= 1 << k;
+        self.objects[k] = p.hit.shape;
         self.point.set_lane(k, p.hit.point);
         self.error.set_lane(k, p.hit.error);
         self.geometric_normal.set_lane(k, p.hit.geometric_normal);
@@ -1160,6 +1163,7 @@ impl<'a> ShadedLanes<'a> {
             ng,
             phong: PhongLanes::of_lanes(hit_lanes, material, &kd, &ks, &n, &v, specular),
             object: Some(object),
+            objects: [object; LANES],
             depth: 0,
         }
     }
@@ -1177,9 +1181,8 @@ impl<'a> ShadedLanes<'a> {
     ) -> Occluders {
         let light_object = scene.light_objects[index];
         let Some(object) = self.object else {
-            // Lanes on several surfaces: only the light's own is left out,
-            // which a far grazing ray may meet by rounding (each lane's own
-            // surface lies behind its offset origin).
+            // Lanes on several surfaces: the light's own is left out here,
+            // each lane's own by its shadow rays (`blocked`).
             return scene.shapes.occluders_but([light_object, light_object]);
         };
         let farthest_from = |center: Vec3| {
@@ -1408,7 +1411,9 @@ impl<'a> ShadedLanes<'a> {
     }
 
     /// The `traced` lanes whose shadow ray, from the point (offset to the side
-    /// `towards` leaves on) to `end` (a light point off its surface), is blocked.
+    /// `towards` leaves on) to `end` (a light point off its surface), is
+    /// blocked; lanes on several objects each leave their own flat surface
+    /// out, as the one point's culling does.
     // Inlined: out of line, the light samples' lanes go through memory, and
     // reloading them costs a store-forwarding stall (measured: 1.1× the
     // time of `cornell-set1`, AMD EPYC).
@@ -1426,7 +1431,12 @@ impl<'a> ShadedLanes<'a> {
             origin,
             direction: *end - origin,
         };
-        scene.shapes.any_hits_among(occluders, &rays, 1.0, traced)
+        match self.object {
+            Some(_) => scene.shapes.any_hits_among(occluders, &rays, 1.0, traced),
+            None => {
+                (scene.shapes).any_hits_among_leaving(occluders, &rays, 1.0, traced, &self.objects)
+            }
+        }
     }
 
     /// Each lane's shadow-ray origin (of the lanes `traced`; the others'
@@ -2058,6 +2068,51 @@ mod tests {
         assert!(total.lobe_samples > 0 && total.brdf_rays > 0, "{total:?}");
         assert!(total.lobe_skips.below_surface > 0, "{total:?}");
         assert!(total.specular_lobes > 0, "{total:?}");
+    }
+
+    /// Lights flush with the walls they light, a hair in front: shadow rays
+    /// from the walls to the lights graze the walls' own planes, where a
+    /// lane's own surface could block it by rounding. The lanes give each
+    /// sample's `li_at` bit for bit, in both shading models. (Lanes on
+    /// several objects leave each one's own wall out, as the one-by-one
+    /// route does, `any_hits_among_leaving`; no ray here happens to need it,
+    /// at offsets from 10⁻⁵ down to 0, so the geometry's own test checks it.)
+    #[test]
+    fn lights_flush_with_a_wall_are_shaded_in_lanes_as_one_by_one() {
+        let (mut total, mut common) = (ShadingCounters::default(), [0; 3]);
+        for shading in [ShadingModel::Phong, ShadingModel::Physical] {
+            let mut scene = room_with(|b| {
+                // On the back wall (z = −9), facing into the room, and on the
+                // floor (y = −2), facing up.
+                let back = AreaLight::new(
+                    Vec3::new(-4.0, -1.0, -9.0 + 1e-5),
+                    Vec3::X * 3.0,
+                    Vec3::Y * 4.0,
+                    Vec3::splat(0.8),
+                );
+                b.area_light(back.unwrap().facing(Vec3::Z));
+                let floor = AreaLight::new(
+                    Vec3::new(1.0, -2.0 + 1e-5, -8.0),
+                    Vec3::X * 3.0,
+                    Vec3::Z * 2.0,
+                    Vec3::splat(0.5),
+                );
+                b.area_light(floor.unwrap().facing(Vec3::Y));
+            });
+            scene.shading = shading;
+            let integrator = DirectIntegrator {
+                light_samples: 16,
+                light_pattern: SamplePattern::Sobol,
+                environment_samples: 0,
+                environment_pattern: SamplePattern::Sobol,
+                environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
+                max_depth: 4,
+                area_sampling: glint_lighting::AreaSampling::Area,
+                mis: true,
+            };
+            compare_lanes_with_scalar(&scene, &integrator, false, &mut total, &mut common);
+        }
+        assert!(common[0] > 0 && total.light_shadow_rays > 0, "{common:?}");
     }
 
     /// Checks read from the normals in lanes are the scalar path's, bit for

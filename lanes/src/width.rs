@@ -130,6 +130,14 @@ pub fn each_set(bits: u32) -> impl Iterator<Item = usize> {
     })
 }
 
+/// The lanes where `values` holds `value`, as bits (lane k as bit k): one
+/// comparison of all the lanes.
+#[inline(always)]
+pub fn bits_eq(values: &[u32; LANES], value: u32) -> u32 {
+    let equal = U32Lanes::new(*values).simd_eq(U32Lanes::splat(value));
+    bits(bytemuck::cast(equal))
+}
+
 /// The mask of the lanes whose bit is set in `bits` (lane k as bit k): the
 /// inverse of [`bits`].
 #[inline]
@@ -194,6 +202,15 @@ mod tests {
         for bits in [0x8000_0001u32, 0x1234_5678] {
             let filtered = (0..32).filter(|k| bits >> k & 1 == 1);
             assert!(each_set(bits).eq(filtered), "{bits:#x}");
+        }
+    }
+
+    #[test]
+    fn bits_eq_names_the_lanes_holding_a_value() {
+        let values: [u32; LANES] = std::array::from_fn(|k| [7, u32::MAX, 7, 0][k % 4]);
+        for value in [7, u32::MAX, 0, 5] {
+            let expected = (0..LANES).filter(|&k| values[k] == value);
+            assert!(each_set(bits_eq(&values, value)).eq(expected), "{value}");
         }
     }
 

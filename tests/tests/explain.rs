@@ -231,9 +231,11 @@ fn the_recorded_samples_make_the_pixel_and_the_light_samples_their_lights() {
     }
 }
 
+/// Every case, mirror waves and every pattern in lanes included: a crop
+/// starting mid-run regroups the chunks' lanes, and no pixel may change.
 #[test]
 fn a_crop_renders_the_same_pixels_as_the_whole_image() {
-    for (name, scene, settings) in cases().into_iter().take(4) {
+    for (name, scene, settings) in cases() {
         let whole = render(&scene, &settings, &|_, _| {}).unwrap().film;
         let crop = Crop {
             x0: 5,

@@ -63,8 +63,9 @@ use std::cell::OnceCell;
 
 impl DirectIntegrator {
     /// The radiance of the first `used` of [`LANES`] camera samples, lane k
-    /// sample `samples.lane(k)`, whose camera rays `rays` have the closest
-    /// hits `closest`: for each, what [`Self::li_at`] gives it alone (with
+    /// sample `samples.lane(k)`, whose camera rays `rays` (with their
+    /// differentials `diffs` where the scene reads footprints) have the
+    /// closest hits `closest`: for each, what [`Self::li_at`] gives it alone (with
     /// [`SampleContext::begin_sample`] for that sample), bit for bit.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn li_first_hits<T: Tracer>(
@@ -831,7 +832,7 @@ fn reflected_in_place(
 
 /// The rays the lanes `traced` of `wave` reflect into, each in its own lane
 /// as `li_at` makes it ([`mirror_ray`]), and the lanes that hold one. With
-/// differentials where the wave carries them and the scene reads footprints;
+/// differentials where the wave carries them (the scene reads footprints);
 /// without, all at once where the lanes lie on one sphere or wall
 /// ([`reflected_in_place`]), else lane by lane. The other lanes hold the
 /// wave's own rays, whose answers are not read.
@@ -840,13 +841,12 @@ fn reflected_rays(
     wave: &Wave,
     traced: u32,
 ) -> (RayLanes, Option<[RayDifferential; LANES]>, u32) {
-    let with_differentials = wave.diffs.filter(|_| scene.needs_differentials());
-    if with_differentials.is_none() {
+    if wave.diffs.is_none() {
         if let Some(rays) = reflected_in_place(scene, wave.rays, wave.closest, traced) {
             return (rays, None, traced);
         }
     }
-    let (mut rays, mut diffs, mut reflected) = (*wave.rays, with_differentials.copied(), 0);
+    let (mut rays, mut diffs, mut reflected) = (*wave.rays, wave.diffs.copied(), 0);
     for k in lanes::each_set(traced) {
         let ray = wave.rays.lane(k);
         let found = wave.closest.hit(k).expect("a hit lane");

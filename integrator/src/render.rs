@@ -503,7 +503,7 @@ impl<'a> PixelRenderer<'a> {
             Some(closest) => (self.integrator).li_first_hits(
                 scene,
                 &ray_lanes,
-                Some(&diffs),
+                self.differentials.then_some(&diffs),
                 closest,
                 used,
                 &chunk.samples,

@@ -55,8 +55,8 @@ use glint_geometry::{
     RayLanes, Shape, Sphere, SurfaceLanes, SPHERE_UV_APPROX_ERROR,
 };
 use glint_lighting::{
-    AreaLight, AreaLightSampler, EnvironmentLight, Light, PhongLanes, PhongMaterial, PointLight,
-    ShadingModel, SphereLight, UvTransform,
+    AreaLight, EnvironmentLight, Light, PhongLanes, PhongMaterial, PointLight, ShadingModel,
+    SphereLight, UvTransform,
 };
 use glint_texture::{Checkerboard, TexCoord, Texture};
 use std::cell::OnceCell;
@@ -431,42 +431,24 @@ impl DirectIntegrator {
         let center = area.surface().center();
         let lit = area.illuminates_lanes(&Vec3Lanes::splat(center), &shaded.point);
         let lit = shaded.lanes & lanes::bits(lit);
-        let mut samplers: [Option<AreaLightSampler>; LANES] = std::array::from_fn(|_| None);
-        if lit & area.by_solid_angle_lanes(&shaded.point, self.area_sampling) != 0 {
-            for k in lanes::each_set(lit) {
-                samplers[k] = Some(area.sampler(shaded.point.lane(k), self.area_sampling));
-            }
-        }
         count_light_samples(&mut ctx.counters, n, shaded.lanes, lit);
         if lit == 0 {
             return Vec3Lanes::default();
         }
-        let by_area =
-            (samplers.iter().flatten()).all(|s| matches!(s, AreaLightSampler::Area { .. }));
+        let lit_lanes = lanes::from_bits(lit);
+        let sampler = area.sampler_from(&shaded.point, self.area_sampling, lit_lanes);
         let occluders = shaded.occluders(scene, index, area, ctx);
-        let draw = |u: (F32Lanes, F32Lanes)| {
-            let (position, pdf) = if by_area {
-                let (position, pdf) = area.sample_by_area_lanes(&shaded.point, u);
-                let lit = lanes::from_bits(lit);
-                (
-                    Vec3Lanes::select(lit, &position, &shaded.point),
-                    F32Lanes::select(lit, pdf, F32Lanes::ZERO),
-                )
-            } else {
-                each_lanes_sample(&samplers, &shaded.point, lit, u)
-            };
+        let draw = |(ux, uy): (F32Lanes, F32Lanes)| {
+            let (position, pdf) = sampler.sample_at(ux, uy);
+            let position = Vec3Lanes::select(lit_lanes, &position, &shaded.point);
+            let pdf = F32Lanes::select(lit_lanes, pdf, F32Lanes::ZERO);
             (position, pdf, area.shadow_ends(&position))
         };
         let mis = self.mis_lanes(shaded, lit);
         let shadowed = (lit, mis, &occluders);
         let mut sum = self.light_sum(scene, shaded, shadowed, (pair, streams), draw, ctx);
         if mis != 0 {
-            let light_pdf = |k: usize, y: Vec3| match &samplers[k] {
-                Some(sampler) => sampler.pdf(y),
-                None => area
-                    .sampler(shaded.point.lane(k), self.area_sampling)
-                    .pdf(y),
-            };
+            let light_pdf = |k: usize, y: Vec3| sampler.pdf_in_lane(k, y);
             sum = sum + self.lobe_sum(scene, shaded, (mis, index), light_pdf, streams, ctx);
         }
         Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(n as f32)
@@ -976,29 +958,6 @@ impl<'a> FirstHits<'a> {
 fn count_light_samples(counters: &mut ShadingCounters, n: u32, shaded: u32, lit: u32) {
     counters.light_samples += u64::from(n) * u64::from(shaded.count_ones());
     counters.light_skips.behind_light += u64::from(n) * u64::from((shaded & !lit).count_ones());
-}
-
-/// Each lit lane's point on the light and its density, drawn by its own
-/// sampler at its `(ux, uy)`; the other lanes keep their shading point and a
-/// zero density.
-fn each_lanes_sample(
-    samplers: &[Option<AreaLightSampler>; LANES],
-    points: &Vec3Lanes,
-    lit: u32,
-    (ux, uy): (F32Lanes, F32Lanes),
-) -> (Vec3Lanes, F32Lanes) {
-    let (ux, uy) = (ux.to_array(), uy.to_array());
-    let mut positions = *points;
-    let mut pdfs = [0.0; LANES];
-    for k in lanes::each_set(lit) {
-        let s = samplers[k]
-            .as_ref()
-            .expect("a lit lane")
-            .sample(Vec2::new(ux[k], uy[k]));
-        positions.set_lane(k, s.point);
-        pdfs[k] = s.pdf;
-    }
-    (positions, F32Lanes::new(pdfs))
 }
 
 /// The shading points of up to [`LANES`] lanes: all at once where the lanes hit

@@ -61,6 +61,31 @@ pub trait Float:
     fn eq(self, other: Self) -> Self::Mask;
     /// Per lane, `if_true` where `mask` holds, else `if_false`.
     fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
+    /// [`Self::select`] of two values computed only if some lane takes them:
+    /// for one `f32` a branch, for lanes both sides only where the mask is
+    /// mixed.
+    #[inline(always)]
+    fn select_with(
+        mask: Self::Mask,
+        if_true: impl FnOnce() -> Self,
+        if_false: impl FnOnce() -> Self,
+    ) -> Self {
+        if mask.all() {
+            if_true()
+        } else if !mask.any() {
+            if_false()
+        } else {
+            Self::select(mask, if_true(), if_false())
+        }
+    }
+    /// The library's [`f32::atan2`] of `(self, x)`, lane by lane, so that a
+    /// lane gives the scalar bits (where that matters more than speed: the
+    /// polynomial [`crate::atan2_approx`] rounds differently).
+    fn atan2(self, x: Self) -> Self;
+    /// The library's [`f32::sin`], lane by lane.
+    fn sin(self) -> Self;
+    /// The library's [`f32::cos`], lane by lane.
+    fn cos(self) -> Self;
     /// [`f32::next_up`]: the least float greater than `self` (∞ and NaN kept,
     /// −0 and +0 both to the least positive float), without a branch.
     fn next_up(self) -> Self;
@@ -185,6 +210,18 @@ impl Float for f32 {
     fn mulsign(self, sign: Self) -> Self {
         f32::from_bits(self.to_bits() ^ (sign.to_bits() & SIGN_BIT))
     }
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        f32::atan2(self, x)
+    }
+    #[inline(always)]
+    fn sin(self) -> Self {
+        f32::sin(self)
+    }
+    #[inline(always)]
+    fn cos(self) -> Self {
+        f32::cos(self)
+    }
 }
 
 /// The sign bit of an `f32`.
@@ -284,6 +321,19 @@ macro_rules! lanes_of_f32 {
                 let sign_bit = <$i>::splat(SIGN_BIT as i32);
                 let bits: $i = bytemuck::cast(self);
                 bytemuck::cast(bits ^ (bytemuck::cast::<_, $i>(sign) & sign_bit))
+            }
+            #[inline(always)]
+            fn atan2(self, x: Self) -> Self {
+                let (y, x) = (self.to_array(), x.to_array());
+                <$t>::new(std::array::from_fn(|k| f32::atan2(y[k], x[k])))
+            }
+            #[inline(always)]
+            fn sin(self) -> Self {
+                <$t>::new(self.to_array().map(f32::sin))
+            }
+            #[inline(always)]
+            fn cos(self) -> Self {
+                <$t>::new(self.to_array().map(f32::cos))
             }
         }
     };
@@ -386,5 +436,48 @@ mod tests {
             |v| wide::f32x16::new(v.try_into().unwrap()),
             |f| f.to_array().to_vec(),
         );
+    }
+    #[test]
+    fn trigonometry_in_lanes_is_the_librarys_lane_by_lane() {
+        // Hidden from the optimiser: it folds the library's functions of
+        // constants to the correctly rounded value, which the library itself
+        // may miss by one unit (atan2(1, −1e-45)).
+        let values = std::hint::black_box(VALUES);
+        let y = wide::f32x16::new(values);
+        let x = wide::f32x16::new(std::array::from_fn(|k| values[(k + 5) % 16]));
+        let (ys, xs) = (y.to_array(), x.to_array());
+        for (k, (&a, &b)) in ys.iter().zip(&xs).enumerate() {
+            let lane = |f: wide::f32x16| f.to_array()[k].to_bits();
+            assert_eq!(lane(Float::atan2(y, x)), a.atan2(b).to_bits(), "{a}, {b}");
+            assert_eq!(lane(Float::sin(y)), a.sin().to_bits(), "{a}");
+            assert_eq!(lane(Float::cos(y)), a.cos().to_bits(), "{a}");
+        }
+    }
+
+    #[test]
+    fn select_with_computes_only_the_sides_some_lane_takes() {
+        let calls = std::cell::Cell::new((0, 0));
+        let pick = |mask| {
+            <wide::f32x4 as Float>::select_with(
+                mask,
+                || {
+                    calls.set((calls.get().0 + 1, calls.get().1));
+                    wide::f32x4::ONE
+                },
+                || {
+                    calls.set((calls.get().0, calls.get().1 + 1));
+                    wide::f32x4::ZERO
+                },
+            )
+        };
+        let on = f32::from_bits(u32::MAX);
+        assert_eq!(pick(wide::f32x4::TRUE), wide::f32x4::ONE);
+        assert_eq!(calls.get(), (1, 0));
+        assert_eq!(pick(wide::f32x4::FALSE), wide::f32x4::ZERO);
+        assert_eq!(calls.get(), (1, 1));
+        let mixed = wide::f32x4::new([on, 0.0, on, 0.0]);
+        assert_eq!(pick(mixed).to_array(), [1.0, 0.0, 1.0, 0.0]);
+        assert_eq!(calls.get(), (2, 2));
+        assert_eq!(f32::select_with(false, || 1.0, || 2.0), 2.0);
     }
 }

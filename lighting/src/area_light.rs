@@ -1,5 +1,5 @@
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes};
+use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, Vector3};
 use glint_geometry::{offset_ray_origins, Parallelogram, RayTarget};
 
 /// A rectangular (parallelogram) light of uniform color, emitting from its front side.
@@ -45,15 +45,15 @@ impl AreaLight {
         self.surface.normal().dot(receiver - light_point) > 0.0
     }
 
-    /// [`Self::sample_point`] for [`LANES`](glint_geometry::lanes::LANES) sample coordinates `(ux, uy)` at once,
+    /// [`Self::sample_point`] for each lane's sample coordinates `(ux, uy)`,
     /// each lane bit for bit the scalar point.
-    #[inline]
-    pub fn sample_points(&self, ux: F32Lanes, uy: F32Lanes) -> Vec3Lanes {
+    #[inline(always)]
+    pub fn sample_points<F: Float>(&self, ux: F, uy: F) -> Vector3<F> {
         let (e1, e2) = self.surface.edges();
         // origin + u.x·edge1 + u.y·edge2, rounded in that order.
-        Vec3Lanes::splat(self.surface.origin())
-            + Vec3Lanes::scaled_splat(e1, ux)
-            + Vec3Lanes::scaled_splat(e2, uy)
+        Vector3::splat(self.surface.origin())
+            + Vector3::scaled_splat(e1, ux)
+            + Vector3::scaled_splat(e2, uy)
     }
 
     /// What a shadow ray towards the light point `position` aims at: the point

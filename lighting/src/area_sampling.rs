@@ -19,7 +19,7 @@
 
 use crate::{AreaLight, SphericalRectangle};
 use glam::{Vec2, Vec3};
-use glint_geometry::lanes::{F32Lanes, Float, Mask, Vec3Lanes, Vector3};
+use glint_geometry::lanes::{F32Lanes, Float, Mask, Vector3};
 
 /// The solid angles (steradians) sampled by solid angle; outside, by area.
 /// Below about 3e-4 sr the f32 parametrisation's angles are too close together
@@ -82,17 +82,17 @@ pub struct LightSample {
     pub pdf: f32,
 }
 
-/// An area light's sampler for one shading point ([`AreaLight::sampler`]).
+/// An area light's sampler for one shading point ([`AreaLight::sampler`]), or
+/// for each lane's ([`AreaLight::sampler_from`]): by solid angle in the lanes
+/// of `by_solid_angle`, by area in the others.
 #[derive(Clone, Debug)]
-pub enum AreaLightSampler<'a> {
-    SolidAngle {
-        light: &'a AreaLight,
-        rectangle: SphericalRectangle,
-    },
-    Area {
-        light: &'a AreaLight,
-        reference: Vec3,
-    },
+pub struct AreaLightSampler<'a, F: Float = f32> {
+    light: &'a AreaLight,
+    reference: Vector3<F>,
+    /// The rectangle as the lanes see it; `None` where no lane samples by
+    /// solid angle.
+    rectangle: Option<SphericalRectangle<F>>,
+    by_solid_angle: F::Mask,
 }
 
 impl AreaLight {
@@ -101,29 +101,44 @@ impl AreaLight {
     /// not a rectangle, a point in the light's plane, or a solid angle outside
     /// [`SOLID_ANGLE_RANGE`]).
     pub fn sampler(&self, reference: Vec3, strategy: AreaSampling) -> AreaLightSampler<'_> {
-        let surface = self.surface();
-        let (e1, e2) = surface.edges();
-        let by_solid_angle = match strategy {
-            AreaSampling::SolidAngle => true,
-            AreaSampling::Area => false,
-            AreaSampling::Auto => {
-                let reference = Vector3::new(reference.x, reference.y, reference.z);
-                self.subtends_enough(&reference)
-            }
-        };
-        if by_solid_angle {
-            if let Some(rectangle) = SphericalRectangle::new(reference, surface.origin(), e1, e2)
-                .filter(|r| SOLID_ANGLE_RANGE.contains(&r.solid_angle()))
+        self.sampler_from(&reference.into(), strategy, true)
+    }
+
+    /// [`Self::sampler`] for each lane's shading point, each lane of `within`
+    /// choosing and sampling as the scalar sampler does, to the same bits;
+    /// the other lanes, whatever they hold, by area.
+    #[inline(always)]
+    pub fn sampler_from<F: Float>(
+        &self,
+        reference: &Vector3<F>,
+        strategy: AreaSampling,
+        within: F::Mask,
+    ) -> AreaLightSampler<'_, F> {
+        let asked = within
+            & match strategy {
+                AreaSampling::SolidAngle => F::Mask::TRUE,
+                AreaSampling::Area => F::Mask::FALSE,
+                AreaSampling::Auto => self.subtends_enough(reference),
+            };
+        let (mut rectangle, mut by_solid_angle) = (None, F::Mask::FALSE);
+        if asked.any() {
+            let surface = self.surface();
+            let (e1, e2) = surface.edges();
+            if let Some((seen, lanes)) =
+                SphericalRectangle::seen_from(reference, surface.origin(), e1, e2)
             {
-                return AreaLightSampler::SolidAngle {
-                    light: self,
-                    rectangle,
-                };
+                let omega = seen.solid_angle();
+                let (low, high) = SOLID_ANGLE_RANGE.into_inner();
+                let in_range = omega.ge(F::splat(low)) & omega.le(F::splat(high));
+                by_solid_angle = asked & lanes & in_range;
+                rectangle = Some(seen);
             }
         }
-        AreaLightSampler::Area {
+        AreaLightSampler {
             light: self,
-            reference,
+            reference: *reference,
+            rectangle: rectangle.filter(|_| by_solid_angle.any()),
+            by_solid_angle,
         }
     }
 }
@@ -133,18 +148,10 @@ impl AreaLightSampler<'_> {
     /// point is seen edge on).
     #[inline]
     pub fn sample(&self, u: Vec2) -> LightSample {
-        match self {
-            AreaLightSampler::SolidAngle { rectangle, .. } => LightSample {
-                point: rectangle.sample(u),
-                pdf: 1.0 / rectangle.solid_angle(),
-            },
-            AreaLightSampler::Area { light, reference } => {
-                let point = light.sample_point(u);
-                LightSample {
-                    point,
-                    pdf: area_pdf(light, *reference, point),
-                }
-            }
+        let (point, pdf) = self.sample_at(u.x, u.y);
+        LightSample {
+            point: point.into(),
+            pdf,
         }
     }
 
@@ -152,18 +159,79 @@ impl AreaLightSampler<'_> {
     /// direction towards `point`, a point on the light.
     #[inline]
     pub fn pdf(&self, point: Vec3) -> f32 {
-        match self {
-            AreaLightSampler::SolidAngle { rectangle, .. } => 1.0 / rectangle.solid_angle(),
-            AreaLightSampler::Area { light, reference } => area_pdf(light, *reference, point),
+        self.pdf_at(&point.into())
+    }
+
+    /// The rectangle as seen from the point, where it is sampled by solid angle.
+    pub fn rectangle(&self) -> Option<&SphericalRectangle> {
+        self.rectangle.as_ref()
+    }
+}
+
+impl AreaLightSampler<'_, F32Lanes> {
+    /// [`AreaLightSampler::pdf`] of lane `k`'s sampler for `point`.
+    #[inline]
+    pub fn pdf_in_lane(&self, k: usize, point: Vec3) -> f32 {
+        match &self.rectangle {
+            Some(rectangle) if self.by_solid_angle.bits() >> k & 1 == 1 => {
+                1.0 / rectangle.solid_angle().to_array()[k]
+            }
+            _ => area_pdf(self.light, self.reference.lane(k), point),
+        }
+    }
+}
+
+impl<F: Float> AreaLightSampler<'_, F> {
+    /// Each lane's point for `(ux, uy)` ∈ [0, 1)², and its density in solid
+    /// angle: uniform in the solid angle the lanes of `by_solid_angle` see,
+    /// uniform in area in the others.
+    #[inline(always)]
+    pub fn sample_at(&self, ux: F, uy: F) -> (Vector3<F>, F) {
+        let by_area = || {
+            let point = self.light.sample_points(ux, uy);
+            let pdf = area_pdf_of(self.light, &self.reference, &point);
+            (point, pdf)
+        };
+        let Some(rectangle) = &self.rectangle else {
+            return by_area();
+        };
+        let by_solid_angle = (
+            rectangle.sample_at(ux, uy),
+            F::ONE / rectangle.solid_angle(),
+        );
+        if self.by_solid_angle.all() {
+            return by_solid_angle;
+        }
+        let (point, pdf) = by_area();
+        let mask = self.by_solid_angle;
+        (
+            Vector3::select(mask, &by_solid_angle.0, &point),
+            F::select(mask, by_solid_angle.1, pdf),
+        )
+    }
+
+    /// The density in solid angle with which [`Self::sample_at`] draws the
+    /// direction towards each lane's `point`, a point on the light.
+    #[inline(always)]
+    pub fn pdf_at(&self, point: &Vector3<F>) -> F {
+        let by_area = || area_pdf_of(self.light, &self.reference, point);
+        match &self.rectangle {
+            Some(rectangle) => F::select_with(
+                self.by_solid_angle,
+                || F::ONE / rectangle.solid_angle(),
+                by_area,
+            ),
+            None => by_area(),
         }
     }
 
+    /// The lanes sampled by solid angle.
+    pub fn by_solid_angle(&self) -> F::Mask {
+        self.by_solid_angle
+    }
+
     pub fn light(&self) -> &AreaLight {
-        match self {
-            AreaLightSampler::SolidAngle { light, .. } | AreaLightSampler::Area { light, .. } => {
-                light
-            }
-        }
+        self.light
     }
 }
 
@@ -185,41 +253,12 @@ impl AreaLight {
         let projected = F::splat(surface.area()) * d.dot_splat(surface.normal()).abs();
         projected.ge(F::splat(AUTO_SOLID_ANGLE_FROM) * distance2 * distance2.sqrt())
     }
-
-    /// The lanes of the points `reference` (bit k for lane k) that `strategy`
-    /// may sample by solid angle ([`Self::sampler`] still falls back to area
-    /// where the rectangle's parametrisation does); the others it samples by
-    /// area.
-    #[inline]
-    pub fn by_solid_angle_lanes(&self, reference: &Vec3Lanes, strategy: AreaSampling) -> u32 {
-        match strategy {
-            AreaSampling::SolidAngle => u32::MAX,
-            AreaSampling::Area => 0,
-            AreaSampling::Auto => self.subtends_enough(reference).bits(),
-        }
-    }
-
-    /// [`AreaLightSampler::sample`] by area ([`AreaSampling::Area`]) for the
-    /// shading points `x`, sixteen at a time: each lane's point on the light
-    /// for its `(ux, uy)` and its density in solid angle, bit for bit the
-    /// scalar sample's.
-    #[inline]
-    pub fn sample_by_area_lanes(
-        &self,
-        x: &Vec3Lanes,
-        (ux, uy): (F32Lanes, F32Lanes),
-    ) -> (Vec3Lanes, F32Lanes) {
-        let y = self.sample_points(ux, uy);
-        let pdf = area_pdf_of(self, x, &y);
-        (y, pdf)
-    }
 }
 
 /// `‖y − x‖² / (A · |cos θ′|)`: the area density `1/A` per unit solid angle at `x`.
 #[inline]
 fn area_pdf(light: &AreaLight, x: Vec3, y: Vec3) -> f32 {
-    let at = |v: Vec3| Vector3::new(v.x, v.y, v.z);
-    area_pdf_of(light, &at(x), &at(y))
+    area_pdf_of(light, &x.into(), &y.into())
 }
 
 /// [`area_pdf`] in one lane or in many, the same bits in each.
@@ -247,18 +286,21 @@ mod tests {
         .facing(-Vec3::Y)
     }
 
-    /// Samples by area in lanes are each lane's scalar sample, bit for bit,
-    /// from points near and far, oblique, and in the light's plane (density 0);
-    /// so is `Auto`'s choice of solid angle.
+    /// Samples in lanes are each lane's scalar sample, bit for bit, by every
+    /// strategy, from points near and far, oblique, behind the light, and in
+    /// its plane (density 0; no solid angle), lanes by solid angle and by
+    /// area side by side; so are the densities of points on the light.
     #[test]
-    fn samples_by_area_in_lanes_are_each_lanes_sample() {
-        use glint_geometry::lanes::LANES;
+    fn samples_in_lanes_are_each_lanes_sample() {
+        use glint_geometry::lanes::{Vec3Lanes, LANES};
         let light = light();
         let points: [Vec3; LANES] = std::array::from_fn(|k| match k {
             0 => Vec3::new(0.1, 1.5, 0.2),
             1 => Vec3::new(5.0, 2.0, -1.0),
             2 => Vec3::new(0.5, 1.999, 1.0),
             3 => Vec3::new(0.3, 2.0, 0.5),
+            4 => Vec3::new(0.0, -98.0, 0.0),
+            5 => Vec3::new(0.2, 2.5, 0.9),
             _ => Vec3::new(
                 0.7 * k as f32 - 4.0,
                 -0.3 * k as f32,
@@ -266,37 +308,44 @@ mod tests {
             ),
         });
         let x = Vec3Lanes::from_lanes(points);
-        // Auto's choice in lanes is each lane's: a lane it leaves out is
-        // sampled by area, one it keeps subtends at least the threshold.
-        let solid = light.by_solid_angle_lanes(&x, AreaSampling::Auto);
-        assert!(solid & 1 == 1 && solid & 2 == 0, "{solid:b}");
-        for (k, &p) in points.iter().enumerate() {
-            let by_area = matches!(
-                light.sampler(p, AreaSampling::Auto),
-                AreaLightSampler::Area { .. }
-            );
-            let kept = solid >> k & 1 == 1;
-            assert_eq!(
-                kept,
-                light.subtends_enough(&Vector3::new(p.x, p.y, p.z)),
-                "lane {k}"
-            );
-            assert!(kept || by_area, "lane {k}");
-        }
-        for i in 0..32 {
-            let (u, us) = crate::lane_points(i, 32);
-            let (y, pdf) = light.sample_by_area_lanes(&x, us);
-            for k in 0..LANES {
-                let s = light.sampler(points[k], AreaSampling::Area).sample(u[k]);
-                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-                assert_eq!(bits(y.lane(k)), bits(s.point), "lane {k}, point {i}");
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        let mut kinds = [0; 2];
+        for strategy in [
+            AreaSampling::Auto,
+            AreaSampling::SolidAngle,
+            AreaSampling::Area,
+        ] {
+            let lanes = light.sampler_from(&x, strategy, F32Lanes::TRUE);
+            let scalar = points.map(|p| light.sampler(p, strategy));
+            for (k, sampler) in scalar.iter().enumerate() {
+                let solid = sampler.rectangle().is_some();
                 assert_eq!(
-                    pdf.to_array()[k].to_bits(),
-                    s.pdf.to_bits(),
-                    "lane {k}, point {i}"
+                    solid,
+                    lanes.by_solid_angle().bits() >> k & 1 == 1,
+                    "lane {k}"
                 );
+                kinds[usize::from(solid)] += 1;
+            }
+            for i in 0..32 {
+                let (u, (ux, uy)) = crate::lane_points(i, 32);
+                let (y, pdf) = lanes.sample_at(ux, uy);
+                for (k, sampler) in scalar.iter().enumerate() {
+                    let s = sampler.sample(u[k]);
+                    let at = format!("{strategy:?}, lane {k}, point {i}");
+                    assert_eq!(bits(y.lane(k)), bits(s.point), "{at}");
+                    assert_eq!(pdf.to_array()[k].to_bits(), s.pdf.to_bits(), "{at}");
+                    let (p, on_light) = (sampler.pdf(s.point), lanes.pdf_in_lane(k, s.point));
+                    assert_eq!(on_light.to_bits(), p.to_bits(), "{at}");
+                }
+                let pdfs = lanes.pdf_at(&y).to_array();
+                for (k, sampler) in scalar.iter().enumerate() {
+                    let want = sampler.pdf(y.lane(k)).to_bits();
+                    assert_eq!(pdfs[k].to_bits(), want, "{strategy:?}, lane {k}");
+                }
             }
         }
+        // Each kind of lane is there: by solid angle and by area.
+        assert!(kinds[0] > 0 && kinds[1] > 0, "{kinds:?}");
     }
 
     /// Both samplers estimate the solid angle the light subtends, `∫ 1 dω`,
@@ -306,10 +355,10 @@ mod tests {
     fn both_samplers_integrate_the_solid_angle() {
         let light = light();
         let x = Vec3::new(0.3, 0.0, -0.4);
-        let exact = match light.sampler(x, AreaSampling::SolidAngle) {
-            AreaLightSampler::SolidAngle { rectangle, .. } => rectangle.solid_angle(),
-            AreaLightSampler::Area { .. } => panic!("a rectangle is sampled by solid angle"),
-        };
+        let sampler = light.sampler(x, AreaSampling::SolidAngle);
+        let rectangle = sampler.rectangle();
+        let exact = rectangle.expect("a rectangle is sampled by solid angle");
+        let exact = exact.solid_angle();
         for strategy in [AreaSampling::SolidAngle, AreaSampling::Area] {
             let sampler = light.sampler(x, strategy);
             let side = 64;
@@ -334,29 +383,29 @@ mod tests {
     #[test]
     fn a_parallelogram_that_is_not_a_rectangle_or_is_tiny_is_sampled_by_area() {
         let skewed = AreaLight::new(Vec3::Y, Vec3::X, Vec3::new(0.5, 0.0, 1.0), Vec3::ONE).unwrap();
-        assert!(matches!(
-            skewed.sampler(Vec3::ZERO, AreaSampling::SolidAngle),
-            AreaLightSampler::Area { .. }
-        ));
+        assert!(skewed
+            .sampler(Vec3::ZERO, AreaSampling::SolidAngle)
+            .rectangle()
+            .is_none());
         // Auto: by solid angle near the light only.
         let near = Vec3::new(0.3, 1.0, -0.4);
-        assert!(matches!(
-            light().sampler(near, AreaSampling::Auto),
-            AreaLightSampler::SolidAngle { .. }
-        ));
-        assert!(matches!(
-            light().sampler(near - 2.0 * Vec3::Y, AreaSampling::Auto),
-            AreaLightSampler::Area { .. }
-        ));
+        assert!(light()
+            .sampler(near, AreaSampling::Auto)
+            .rectangle()
+            .is_some());
+        assert!(light()
+            .sampler(near - 2.0 * Vec3::Y, AreaSampling::Auto)
+            .rectangle()
+            .is_none());
         // 1 x 2 at a distance of 100: about 2e-4 sr.
         let far = Vec3::new(0.0, -98.0, 0.0);
-        assert!(matches!(
-            light().sampler(far, AreaSampling::SolidAngle),
-            AreaLightSampler::Area { .. }
-        ));
-        assert!(matches!(
-            light().sampler(far + 90.0 * Vec3::Y, AreaSampling::SolidAngle),
-            AreaLightSampler::SolidAngle { .. }
-        ));
+        assert!(light()
+            .sampler(far, AreaSampling::SolidAngle)
+            .rectangle()
+            .is_none());
+        assert!(light()
+            .sampler(far + 90.0 * Vec3::Y, AreaSampling::SolidAngle)
+            .rectangle()
+            .is_some());
     }
 }

@@ -6,8 +6,11 @@
 //! which is noisy for lights that are near or large.
 
 use glam::{Vec2, Vec3};
+use glint_geometry::lanes::{Float, Vector3};
 
-/// The rectangle `corner + s·ex + t·ey`, s,t ∈ [0,1], (ex ⟂ ey) as seen from `reference`.
+/// The rectangle `corner + s·ex + t·ey`, s,t ∈ [0,1], (ex ⟂ ey) as seen from `reference`,
+/// from one point (`F = f32`) or from each lane's (`F` lanes of them): one kernel
+/// for both, each lane bit for bit the scalar rectangle.
 ///
 /// It is held in the paper's local frame: `reference` at the origin, x along `ex`, y
 /// along `ey`, and the rectangle `[x0,x1]×[y0,y1]` in the plane at distance `z > 0`.
@@ -16,22 +19,22 @@ use glam::{Vec2, Vec3};
 /// by the largest of `|x0|,|x1|,|y0|,|y1|,z`: angles are scale-invariant, and squares
 /// of the scaled lengths can neither overflow nor underflow.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SphericalRectangle {
+pub struct SphericalRectangle<F: Float = f32> {
     corner: Vec3,
     ex: Vec3,
     ey: Vec3,
-    x0: f32,
-    x1: f32,
-    y0: f32,
-    y1: f32,
-    z: f32,
+    x0: F,
+    x1: F,
+    y0: F,
+    y1: F,
+    z: F,
     /// `θ(x0)` and `θ(x1)` (see [`SphericalRectangle::sample`]).
-    theta0: f32,
-    theta1: f32,
+    theta0: F,
+    theta1: F,
     /// `Δ = ψ1 − ψ0` and `Σ = ψ0 + ψ1`, with `ψi = atan2(yi, z)`.
-    delta: f32,
-    sigma: f32,
-    solid_angle: f32,
+    delta: F,
+    sigma: F,
+    solid_angle: F,
 }
 
 /// Smallest argument allowed under a square root that is divided by.
@@ -43,61 +46,88 @@ impl SphericalRectangle {
     /// its distance to the plane is at most 1e-6·|corner − reference|, the rounding
     /// noise of f32) or the solid angle is not finite/positive.
     pub fn new(reference: Vec3, corner: Vec3, ex: Vec3, ey: Vec3) -> Option<Self> {
+        let reference = Vector3::new(reference.x, reference.y, reference.z);
+        Self::seen_from(&reference, corner, ex, ey)
+            .and_then(|(rectangle, seen)| seen.then_some(rectangle))
+    }
+
+    /// The point on the rectangle for u ∈ [0,1]², distributed uniformly in solid
+    /// angle ([`Self::sample_at`]).
+    #[inline]
+    pub fn sample(&self, u: Vec2) -> Vec3 {
+        self.sample_at(u.x, u.y).into()
+    }
+}
+
+impl<F: Float> SphericalRectangle<F> {
+    /// The rectangle as seen from each lane's `reference`, and the lanes that
+    /// see it ([`SphericalRectangle::new`] gives `Some` there); `None` if it is
+    /// no rectangle (its edges not perpendicular, zero-length or not finite).
+    #[inline(always)]
+    pub fn seen_from(
+        reference: &Vector3<F>,
+        corner: Vec3,
+        ex: Vec3,
+        ey: Vec3,
+    ) -> Option<(Self, F::Mask)> {
         let (w, h) = (ex.length(), ey.length());
         if !(w > 0.0 && h > 0.0 && w.is_finite() && h.is_finite()) {
             return None;
         }
         let (xa, ya) = (ex / w, ey / h);
-        let d = corner - reference;
-        if xa.dot(ya).abs() > 1e-4 || !d.is_finite() {
+        if xa.dot(ya).abs() > 1e-4 {
             return None;
         }
-        let (x0, y0, z) = (d.dot(xa), d.dot(ya), d.dot(xa.cross(ya).normalize()).abs());
-        let (x1, y1) = (x0 + w, y0 + h);
-        if z <= 1e-6 * d.length() || !x1.is_finite() || !y1.is_finite() {
-            return None;
-        }
-        let inv = 1.0 / x0.abs().max(x1.abs()).max(y0.abs()).max(y1.abs()).max(z);
+        let d = Vector3::splat_sub(corner, reference);
+        let finite = d.x.is_finite() & d.y.is_finite() & d.z.is_finite();
+        let (x0, y0) = (d.dot_splat(xa), d.dot_splat(ya));
+        let z = d.dot_splat(xa.cross(ya).normalize()).abs();
+        let (x1, y1) = (x0 + F::splat(w), y0 + F::splat(h));
+        let off_plane = !z.le(F::splat(1e-6) * d.dot(&d).sqrt());
+        let seen = finite & off_plane & x1.is_finite() & y1.is_finite();
+        let inv = F::ONE / x0.abs().max(x1.abs()).max(y0.abs()).max(y1.abs()).max(z);
         let (x0, x1, y0, y1, z) = (x0 * inv, x1 * inv, y0 * inv, y1 * inv, z * inv);
         // θ(x) = F(x,y1) − F(x,y0) as one atan2 (the argument of a complex product),
         // with `y1·R0 − y0·R1` rewritten for y0, y1 of one sign, where it would cancel.
-        let theta = |x: f32| {
+        let theta = |x: F| {
             let (rr, yy) = (x * x + z * z, y0 * y1);
             let (r0, r1) = ((rr + y0 * y0).sqrt(), (rr + y1 * y1).sqrt());
-            let cross = if yy > 0.0 {
-                (y1 - y0) * (y1 + y0) * rr / (y1 * r0 + y0 * r1)
-            } else {
-                y1 * r0 - y0 * r1
-            };
+            let cross = F::select_with(
+                yy.gt(F::ZERO),
+                || (y1 - y0) * (y1 + y0) * rr / (y1 * r0 + y0 * r1),
+                || y1 * r0 - y0 * r1,
+            );
             (x * z * cross).atan2(z * z * r0 * r1 + x * x * yy)
         };
         let (theta0, theta1) = (theta(x0), theta(x1));
-        let solid_angle = if x0 <= 0.0 && 0.0 <= x1 && y0 <= 0.0 && 0.0 <= y1 {
+        let foot_inside = x0.le(F::ZERO) & F::ZERO.le(x1) & y0.le(F::ZERO) & F::ZERO.le(y1);
+        let solid_angle = F::select_with(
+            foot_inside,
             // The foot of the perpendicular is inside: Ω = θ1 − θ0 is a sum of four
             // corner terms of one sign.
-            theta1 - theta0
-        } else {
+            || theta1 - theta0,
             // Outside, those terms would cancel: two triangles instead, each by Van
             // Oosterom & Strackee (IEEE Trans. Biomed. Eng. 30(2), 1983): tan(Ω_t/2) =
             // |a·(b×c)| / (abc + (a·b)c + (a·c)b + (b·c)a). Both triple products are
             // z·w·h exactly, so small Ω keeps its digits (the paper's Σγ − 2π cancels
             // to nothing in f32 below ~1e-5 sr).
-            let v = |x, y| Vec3::new(x, y, z);
-            let (v00, v10, v11, v01) = (v(x0, y0), v(x1, y0), v(x1, y1), v(x0, y1));
-            let triple = z * (x1 - x0) * (y1 - y0);
-            let triangle = |a: Vec3, b: Vec3, c: Vec3| {
-                let (la, lb, lc) = (a.length(), b.length(), c.length());
-                let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-                2.0 * triple.atan2(den)
-            };
-            triangle(v00, v10, v11) + triangle(v00, v11, v01)
-        };
-        if !(solid_angle > 0.0 && solid_angle.is_finite()) {
-            return None;
-        }
+            || {
+                let v = |x, y| Vector3::new(x, y, z);
+                let (v00, v10, v11, v01) = (v(x0, y0), v(x1, y0), v(x1, y1), v(x0, y1));
+                let triple = z * (x1 - x0) * (y1 - y0);
+                let triangle = |a: Vector3<F>, b: Vector3<F>, c: Vector3<F>| {
+                    let length = |v: &Vector3<F>| v.dot(v).sqrt();
+                    let (la, lb, lc) = (length(&a), length(&b), length(&c));
+                    let den = la * lb * lc + a.dot(&b) * lc + a.dot(&c) * lb + b.dot(&c) * la;
+                    F::splat(2.0) * triple.atan2(den)
+                };
+                triangle(v00, v10, v11) + triangle(v00, v11, v01)
+            },
+        );
+        let seen = seen & solid_angle.gt(F::ZERO) & solid_angle.is_finite();
         let delta = (z * (y1 - y0)).atan2(z * z + y0 * y1);
         let sigma = y0.atan2(z) + y1.atan2(z);
-        Some(Self {
+        let rectangle = Self {
             corner,
             ex,
             ey,
@@ -111,7 +141,8 @@ impl SphericalRectangle {
             delta,
             sigma,
             solid_angle,
-        })
+        };
+        Some((rectangle, seen))
     }
 
     /// Solid angle Ω subtended (steradians); the sampling pdf is 1/Ω per unit solid angle.
@@ -123,23 +154,24 @@ impl SphericalRectangle {
     /// Strackee's formula. Accurate to ~1e-6 relative from tiny solid angles to near 2π,
     /// given the plane distance `z`; at grazing angles Ω ∝ z also carries the f32
     /// rounding of `z` itself, ~1e-7·|corner − reference|/z relative.
-    pub fn solid_angle(&self) -> f32 {
+    pub fn solid_angle(&self) -> F {
         self.solid_angle
     }
 
-    /// The point on the rectangle for u ∈ [0,1]², distributed uniformly in solid angle;
-    /// the map is continuous and area preserving (strata of [0,1]² map to equal solid angles).
+    /// The point on the rectangle for `(ux, uy)` ∈ [0,1]², distributed uniformly
+    /// in solid angle; the map is continuous and area preserving (strata of
+    /// [0,1]² map to equal solid angles).
     ///
-    /// `u.x` moves along `ex` and `u.y` along `ey`, both monotonically: `(0,0)` maps to
+    /// `ux` moves along `ex` and `uy` along `ey`, both monotonically: `(0,0)` maps to
     /// `corner`, `(1,0)` to `corner + ex`, `(0,1)` to `corner + ey` and `(1,1)` to the
-    /// opposite corner; the columns `u.x = const` are the segments `s = const`.
+    /// opposite corner; the columns `ux = const` are the segments `s = const`.
     ///
     /// In the paper's frame, the part `[x0,x]×[y0,y1]` subtends `θ(x) − θ(x0)` with
     /// `θ(x) = F(x,y1) − F(x,y0)` (see [`Self::solid_angle`]); θ is the paper's
     /// `au − π = γ0' + γ1' − π`, the angles at the moving edge, and with its
     /// `cu = x/√(x²+z²)`, `b0 = −y0/√(y0²+z²)`, `b1 = y1/√(y1²+z²)`,
     /// `θ = asin(cu·b0) + asin(cu·b1)`.
-    /// 1. `θ = θ0 + u.x·(θ1 − θ0)`. The paper inverts this as `cu = sign(fu)/√(fu²+b0²)`,
+    /// 1. `θ = θ0 + ux·(θ1 − θ0)`. The paper inverts this as `cu = sign(fu)/√(fu²+b0²)`,
     ///    `fu = (cos(au)·b0 − b1)/sin(au)`, i.e. `cu = sinθ / √(b0² + b1² + 2b0b1·cosθ)`,
     ///    then `x = z·cu/√(1 − cu²)`. With `ψi = atan2(yi, z)`, `Δ = ψ1 − ψ0` and
     ///    `Σ = ψ0 + ψ1` that is, without the cancellation in `1 − cu²` at grazing
@@ -148,44 +180,43 @@ impl SphericalRectangle {
     ///    every factor positive for `|θ| < Δ`.
     /// 2. Along the line at `x`, at distance `d = √(x²+z²)`, the angle subtended from
     ///    `y0` to `y` grows as `h(y) = y/√(y²+d²)`, so `h` is the lerp of `h0`, `h1` by
-    ///    `u.y` and `y = d·h/√((1−h)(1+h))`; `1 ∓ h` are lerped from end values computed
+    ///    `uy` and `y = d·h/√((1−h)(1+h))`; `1 ∓ h` are lerped from end values computed
     ///    without cancellation, so `y` keeps its digits where `h → ±1`.
     ///
     /// Square roots are guarded and `x`, `y` clamped to the rectangle, so the result is
-    /// always a finite point of the rectangle.
-    pub fn sample(&self, u: Vec2) -> Vec3 {
+    /// always a finite point of the rectangle (in the lanes that see it).
+    #[inline(always)]
+    pub fn sample_at(&self, ux: F, uy: F) -> Vector3<F> {
         let (x0, x1, y0, y1, z) = (self.x0, self.x1, self.y0, self.y1, self.z);
         // Unlike `clamp`, also turns NaN into a bound (0).
-        let unit = |t: f32| if t > 0.0 { t.min(1.0) } else { 0.0 };
-        let (ux, uy) = (unit(u.x), unit(u.y));
+        let unit = |t: F| F::select(t.gt(F::ZERO), t.min(F::ONE), F::ZERO);
+        let (ux, uy) = (unit(ux), unit(uy));
         let theta = self.theta0 + ux * (self.theta1 - self.theta0);
-        let (dl, sg) = (self.delta, self.sigma);
-        let prod = (0.5 * (dl - theta)).sin()
-            * (0.5 * (dl + theta)).sin()
-            * (0.5 * (theta + sg)).cos()
-            * (0.5 * (theta - sg)).cos();
-        let x = (z * theta.sin() / (2.0 * prod.max(TINY).sqrt()))
+        let (dl, sg, half) = (self.delta, self.sigma, F::splat(0.5));
+        let prod = (half * (dl - theta)).sin()
+            * (half * (dl + theta)).sin()
+            * (half * (theta + sg)).cos()
+            * (half * (theta - sg)).cos();
+        let tiny = F::splat(TINY);
+        let x = (z * theta.sin() / (F::splat(2.0) * prod.max(tiny).sqrt()))
             .max(x0)
             .min(x1);
         let d2 = x * x + z * z;
         // h(y) = y/√(y²+d²) is lerped for its digits near 0, and 1 ∓ h (computed
         // without cancellation) for theirs near ±1.
         let (m0, m1) = ((y0 * y0 + d2).sqrt(), (y1 * y1 + d2).sqrt());
-        let one_minus_h = |y: f32, m: f32| {
-            if y > 0.0 {
-                d2 / (m * (m + y))
-            } else {
-                1.0 - y / m
-            }
-        };
-        let lerp = |a: f32, b: f32| (1.0 - uy) * a + uy * b;
+        let one_minus_h =
+            |y: F, m: F| F::select_with(y.gt(F::ZERO), || d2 / (m * (m + y)), || F::ONE - y / m);
+        let lerp = |a: F, b: F| (F::ONE - uy) * a + uy * b;
         let h = y0 / m0 + uy * (y1 / m1 - y0 / m0);
         let p = lerp(one_minus_h(y0, m0), one_minus_h(y1, m1)); // 1 − h
         let q = lerp(one_minus_h(-y0, m0), one_minus_h(-y1, m1)); // 1 + h
-        let y = (h * d2.sqrt() / (p * q).max(TINY).sqrt()).max(y0).min(y1);
+        let y = (h * d2.sqrt() / (p * q).max(tiny).sqrt()).max(y0).min(y1);
         let s = unit((x - x0) / (x1 - x0));
         let t = unit((y - y0) / (y1 - y0));
-        self.corner + s * self.ex + t * self.ey
+        Vector3::splat(self.corner)
+            + Vector3::scaled_splat(self.ex, s)
+            + Vector3::scaled_splat(self.ey, t)
     }
 }
 

@@ -78,14 +78,6 @@ pub trait Float:
             Self::select(mask, if_true(), if_false())
         }
     }
-    /// The library's [`f32::atan2`] of `(self, x)`, lane by lane, so that a
-    /// lane gives the scalar bits (where that matters more than speed: the
-    /// polynomial [`crate::atan2_approx`] rounds differently).
-    fn atan2(self, x: Self) -> Self;
-    /// The library's [`f32::sin`], lane by lane.
-    fn sin(self) -> Self;
-    /// The library's [`f32::cos`], lane by lane.
-    fn cos(self) -> Self;
     /// [`f32::next_up`]: the least float greater than `self` (∞ and NaN kept,
     /// −0 and +0 both to the least positive float), without a branch.
     fn next_up(self) -> Self;
@@ -210,18 +202,6 @@ impl Float for f32 {
     fn mulsign(self, sign: Self) -> Self {
         f32::from_bits(self.to_bits() ^ (sign.to_bits() & SIGN_BIT))
     }
-    #[inline(always)]
-    fn atan2(self, x: Self) -> Self {
-        f32::atan2(self, x)
-    }
-    #[inline(always)]
-    fn sin(self) -> Self {
-        f32::sin(self)
-    }
-    #[inline(always)]
-    fn cos(self) -> Self {
-        f32::cos(self)
-    }
 }
 
 /// The sign bit of an `f32`.
@@ -321,19 +301,6 @@ macro_rules! lanes_of_f32 {
                 let sign_bit = <$i>::splat(SIGN_BIT as i32);
                 let bits: $i = bytemuck::cast(self);
                 bytemuck::cast(bits ^ (bytemuck::cast::<_, $i>(sign) & sign_bit))
-            }
-            #[inline(always)]
-            fn atan2(self, x: Self) -> Self {
-                let (y, x) = (self.to_array(), x.to_array());
-                <$t>::new(std::array::from_fn(|k| f32::atan2(y[k], x[k])))
-            }
-            #[inline(always)]
-            fn sin(self) -> Self {
-                <$t>::new(self.to_array().map(f32::sin))
-            }
-            #[inline(always)]
-            fn cos(self) -> Self {
-                <$t>::new(self.to_array().map(f32::cos))
             }
         }
     };
@@ -437,23 +404,6 @@ mod tests {
             |f| f.to_array().to_vec(),
         );
     }
-    #[test]
-    fn trigonometry_in_lanes_is_the_librarys_lane_by_lane() {
-        // Hidden from the optimiser: it folds the library's functions of
-        // constants to the correctly rounded value, which the library itself
-        // may miss by one unit (atan2(1, −1e-45)).
-        let values = std::hint::black_box(VALUES);
-        let y = wide::f32x16::new(values);
-        let x = wide::f32x16::new(std::array::from_fn(|k| values[(k + 5) % 16]));
-        let (ys, xs) = (y.to_array(), x.to_array());
-        for (k, (&a, &b)) in ys.iter().zip(&xs).enumerate() {
-            let lane = |f: wide::f32x16| f.to_array()[k].to_bits();
-            assert_eq!(lane(Float::atan2(y, x)), a.atan2(b).to_bits(), "{a}, {b}");
-            assert_eq!(lane(Float::sin(y)), a.sin().to_bits(), "{a}");
-            assert_eq!(lane(Float::cos(y)), a.cos().to_bits(), "{a}");
-        }
-    }
-
     #[test]
     fn select_with_computes_only_the_sides_some_lane_takes() {
         let calls = std::cell::Cell::new((0, 0));

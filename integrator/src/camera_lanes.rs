@@ -43,7 +43,7 @@ use crate::direct::{mirror_ray, PairAllocation, SampleContext, ShadingPoint, CUL
 use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::physical::{power_heuristic, DiffusePoints};
 use crate::sampling::{
-    DimensionPair, LaneSamples, Pcg32Lanes, SamplePattern, SamplePoints, SobolSequence,
+    DimensionPair, LaneSamples, Pcg32Lanes, RunLanes, SamplePattern, SamplePoints, SobolSequence,
 };
 use crate::texture_lookup::texture_footprint;
 use crate::trace::Tracer;
@@ -743,6 +743,9 @@ struct RunSequences {
     /// Each run's sequence, its first point, and its first lane.
     runs: [(SobolSequence, u64, usize); LANES],
     count: usize,
+    /// The runs' points hashed together in one set of lanes, where every
+    /// lane's points lie in the first block of its sequence.
+    together: Option<RunLanes>,
 }
 
 impl RunSequences {
@@ -765,12 +768,21 @@ impl RunSequences {
         for (run, entry) in runs.iter_mut().enumerate().take(count).skip(1) {
             *entry = start(run);
         }
-        Self { runs, count }
+        let together = RunLanes::new(&runs[..count], u64::from(n), u64::from(n));
+        Self {
+            runs,
+            count,
+            together,
+        }
     }
 
     /// Every lane's light point `j` of `n`.
     #[inline]
     fn points(&self, j: u32, n: u32) -> (F32Lanes, F32Lanes) {
+        if let Some(together) = &self.together {
+            let u = together.points(j);
+            return (u.x, u.y);
+        }
         let (sequence, first, _) = self.runs[0];
         let mut u = sequence.lanes_strided(first + u64::from(j), u64::from(n));
         for &(sequence, first, lane) in &self.runs[1..self.count] {

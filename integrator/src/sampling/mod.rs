@@ -89,7 +89,7 @@ pub use mix::mix64;
 pub use pattern::SamplePattern;
 pub use pcg::{Pcg32, Pcg32Lanes, STREAM};
 pub use points::{PointChunk, PointLanes, SamplePoints};
-pub use sobol::{DimensionPair, SequenceCache, SobolPoints, SobolSequence, MAX_JOINT};
+pub use sobol::{DimensionPair, RunLanes, SequenceCache, SobolPoints, SobolSequence, MAX_JOINT};
 pub use streams::{
     pixel_key, pixel_rng, stream_seed, uniform, LaneSamples, PixelSample, PIXEL_STREAM,
 };

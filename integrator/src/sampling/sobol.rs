@@ -239,29 +239,15 @@ impl Scrambles {
     }
 
     /// The points of the indices `index` (all below 2^16), as [`Self::point`]
-    /// computes each, bit for bit: the integer hashing of them all in SIMD
-    /// lanes (wrapping products, exact), a joint pair's table lookups lane by
-    /// lane.
+    /// computes each, bit for bit ([`points_of`]).
     #[inline]
     fn points(self, index: U32Lanes) -> PointLanes {
-        let shuffled = owen_scramble_lanes(reverse_bits_lanes(index), self.index);
-        let (xs, ys) = match self.joint_tables() {
-            None => {
-                let x = reverse_bits_lanes(shuffled) & U32Lanes::splat(BLOCK_MASK);
-                (x, sobol_dimension_1(x, U32Lanes::splat))
-            }
-            Some(tables) => {
-                let (mut xs, mut ys) = ([0u32; LANES], [0u32; LANES]);
-                for (k, &shuffled) in shuffled.to_array().iter().enumerate() {
-                    (xs[k], ys[k]) = lookup(tables, shuffled);
-                }
-                (U32Lanes::new(xs), U32Lanes::new(ys))
-            }
-        };
-        PointLanes {
-            x: unit_lanes(xs, self.x),
-            y: unit_lanes(ys, self.y),
-        }
+        let splat = U32Lanes::splat;
+        points_of(
+            index,
+            [splat(self.index), splat(self.x), splat(self.y)],
+            self.joint_tables(),
+        )
     }
 
     /// The tables of this sequence's two dimensions where it reads a joint
@@ -289,6 +275,88 @@ impl Scrambles {
         let unit =
             |v: u32, scramble: u32| u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits());
         Vec2::new(unit(x, self.x), unit(y, self.y))
+    }
+}
+
+/// The points of the indices `index` (all below 2^16), each lane's of its
+/// own scrambles `[index, x, y]` ([`Scrambles`]), as [`Scrambles::point`]
+/// computes each, bit for bit: the integer hashing of them all in SIMD lanes
+/// (wrapping products, exact), a joint pair's table lookups lane by lane.
+#[inline]
+fn points_of(
+    index: U32Lanes,
+    [index_scramble, x_scramble, y_scramble]: [U32Lanes; 3],
+    tables: Option<&PairTables>,
+) -> PointLanes {
+    let shuffled = owen_scramble_lanes(reverse_bits_lanes(index), index_scramble);
+    let (xs, ys) = match tables {
+        None => {
+            let x = reverse_bits_lanes(shuffled) & U32Lanes::splat(BLOCK_MASK);
+            (x, sobol_dimension_1(x, U32Lanes::splat))
+        }
+        Some(tables) => {
+            let (mut xs, mut ys) = ([0u32; LANES], [0u32; LANES]);
+            for (k, &shuffled) in shuffled.to_array().iter().enumerate() {
+                (xs[k], ys[k]) = lookup(tables, shuffled);
+            }
+            (U32Lanes::new(xs), U32Lanes::new(ys))
+        }
+    };
+    PointLanes {
+        x: unit_lanes(xs, x_scramble),
+        y: unit_lanes(ys, y_scramble),
+    }
+}
+
+/// The points of a chunk's runs of camera samples for one pair, every run's
+/// lanes from its own pixel's sequence, hashed together in one set of
+/// lanes: lane k takes point `first + (k − lane)·stride + j` of the sequence
+/// of its run `(sequence, first, lane)`, the last run whose first lane is
+/// at most k.
+#[derive(Clone, Copy, Debug)]
+pub struct RunLanes {
+    /// Each lane's point index at `j = 0`.
+    index: U32Lanes,
+    /// Each lane's sequence's scrambles `[index, x, y]`.
+    scrambles: [U32Lanes; 3],
+    tables: Option<&'static PairTables>,
+}
+
+impl RunLanes {
+    /// The runs' lanes for the points `j < points`; `None` where a lane's
+    /// points leave the first 2^16 of its sequence, or the runs read
+    /// different dimensions. The first run starts at lane 0.
+    pub fn new(runs: &[(SobolSequence, u64, usize)], stride: u64, points: u64) -> Option<Self> {
+        let (first_run, _, _) = *runs.first()?;
+        let dimensions = first_run.dimensions;
+        let mut index = [0u32; LANES];
+        let mut scrambles = [[0u32; LANES]; 3];
+        let mut run = 0;
+        for k in 0..LANES {
+            while runs.get(run + 1).is_some_and(|&(_, _, lane)| lane <= k) {
+                run += 1;
+            }
+            let (sequence, first, lane) = runs[run];
+            let i = first + k.checked_sub(lane)? as u64 * stride;
+            if (i + points.max(1) - 1) >> BLOCK_BITS != 0 || sequence.dimensions != dimensions {
+                return None;
+            }
+            let hashed = sequence.first_block;
+            index[k] = i as u32;
+            [scrambles[0][k], scrambles[1][k], scrambles[2][k]] =
+                [hashed.index, hashed.x, hashed.y];
+        }
+        Some(Self {
+            index: U32Lanes::new(index),
+            scrambles: scrambles.map(U32Lanes::new),
+            tables: first_run.first_block.joint_tables(),
+        })
+    }
+
+    /// Every lane's point `j`.
+    #[inline]
+    pub fn points(&self, j: u32) -> PointLanes {
+        points_of(self.index + U32Lanes::splat(j), self.scrambles, self.tables)
     }
 }
 
@@ -328,13 +396,13 @@ where
     x
 }
 
-/// `sobol_burley::parts::owen_scramble_rev` on [`LANES`] integers (wrapping
-/// products and sums, so the same bits).
+/// `sobol_burley::parts::owen_scramble_rev` on [`LANES`] integers, each
+/// with its lane's `scramble` (wrapping products and sums, so the same bits).
 #[inline]
-fn owen_scramble_lanes(mut n_rev: U32Lanes, scramble: u32) -> U32Lanes {
+fn owen_scramble_lanes(mut n_rev: U32Lanes, scramble: U32Lanes) -> U32Lanes {
     n_rev ^= n_rev * U32Lanes::splat(0x3d20_adea);
-    n_rev += U32Lanes::splat(scramble);
-    n_rev *= U32Lanes::splat((scramble >> 16) | 1);
+    n_rev += scramble;
+    n_rev *= (scramble >> 16) | U32Lanes::splat(1);
     n_rev ^= n_rev * U32Lanes::splat(0x0552_6c56);
     n_rev ^= n_rev * U32Lanes::splat(0x53a2_2864);
     n_rev
@@ -353,7 +421,7 @@ fn reverse_bits_lanes(v: U32Lanes) -> U32Lanes {
 /// `u32_to_f32_norm(owen_scramble_rev(v, scramble).reverse_bits())`: the top 23
 /// bits as the mantissa of a float in [1, 2), minus 1.
 #[inline]
-fn unit_lanes(v: U32Lanes, scramble: u32) -> F32Lanes {
+fn unit_lanes(v: U32Lanes, scramble: U32Lanes) -> F32Lanes {
     let bits =
         (reverse_bits_lanes(owen_scramble_lanes(v, scramble)) >> 9) | U32Lanes::splat(0x3f80_0000);
     cast::<U32Lanes, F32Lanes>(bits) - F32Lanes::ONE

@@ -4,6 +4,7 @@
 
 use super::*;
 use glam::Vec2;
+use glint_geometry::lanes::LANES;
 
 /// The unscrambled Sobol generator inside `sobol_burley`: point `i`, dimension
 /// `dimension`, as a 32-bit fixed-point fraction.
@@ -103,6 +104,48 @@ fn filling_eight_at_a_time_gives_each_point_bit_for_bit() {
                 assert_eq!(out, expected, "{len} points from {first}");
             }
         }
+    }
+}
+
+#[test]
+fn runs_hashed_together_give_each_lanes_point_of_its_own_sequence() {
+    // Runs of camera samples of several pixels in one set of lanes, as a
+    // chunk holds them: lane k takes point `first + (k − lane)·stride + j`
+    // of its own run's sequence, bit for bit, for every pair kind.
+    let bits = |p: Vec2| p.to_array().map(f32::to_bits);
+    for pair in [
+        DimensionPair::Light { light: 1, depth: 0 },
+        DimensionPair::Joint { k: 1 },
+    ] {
+        for (lanes_per_run, stride, first) in
+            [(LANES, 16, 0), (4, 3, 7), (1, 1, 65_000), (5, 2, 12)]
+        {
+            let runs: Vec<_> = (0..LANES.div_ceil(lanes_per_run))
+                .map(|r| {
+                    let sequence = SobolSequence::new(3, 100 + r as u64, pair);
+                    (sequence, first + 11 * r as u64, r * lanes_per_run)
+                })
+                .collect();
+            let together = RunLanes::new(&runs, stride, stride).expect("in the first block");
+            for j in 0..stride as u32 {
+                let points = together.points(j);
+                for k in 0..LANES {
+                    let (sequence, first, lane) = runs[k / lanes_per_run];
+                    let want = sequence.point(first + (k - lane) as u64 * stride + u64::from(j));
+                    assert_eq!(
+                        bits(points.lane(k)),
+                        bits(want),
+                        "{pair:?}, lane {k}, point {j}"
+                    );
+                }
+            }
+        }
+        // A lane whose points run past the first 2^16 is left to the
+        // sequences one by one.
+        let sequence = SobolSequence::new(3, 7, pair);
+        assert!(RunLanes::new(&[(sequence, 65_530, 0)], 1, 1).is_none());
+        assert!(RunLanes::new(&[(sequence, 65_300, 0)], 16, 17).is_none());
+        assert!(RunLanes::new(&[(sequence, 65_279, 0)], 16, 17).is_some());
     }
 }
 

@@ -43,7 +43,8 @@ use crate::direct::{mirror_ray, PairAllocation, SampleContext, ShadingPoint, CUL
 use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::physical::{power_heuristic, DiffusePoints};
 use crate::sampling::{
-    DimensionPair, LaneSamples, Pcg32Lanes, RunLanes, SamplePattern, SamplePoints, SobolSequence,
+    DimensionPair, LaneSamples, Pcg32Lanes, PointLanes, RunLanes, SamplePattern, SamplePoints,
+    SobolSequence,
 };
 use crate::texture_lookup::texture_footprint;
 use crate::trace::Tracer;
@@ -610,7 +611,19 @@ impl DirectIntegrator {
         let samples = streams.samples;
         match pattern {
             SamplePattern::Sobol => {
-                LanePoints::Sobol(RunSequences::new(samples, drawing, pair, n, ctx), n)
+                let sequences = RunSequences::new(samples, drawing, pair, n, ctx);
+                match sequences.together {
+                    // All the points hashed up front: the hashes of
+                    // different points overlap, where one point's waits on
+                    // its own long chain of products.
+                    Some(together) if n > 1 => {
+                        let mut points = std::mem::take(&mut ctx.sobol_lanes);
+                        points.clear();
+                        points.extend((0..n).map(|j| together.points(j)));
+                        LanePoints::Hashed(points)
+                    }
+                    _ => LanePoints::Sobol(sequences, n),
+                }
             }
             SamplePattern::Grid => {
                 let mut points = std::mem::take(of.buffer(ctx));
@@ -683,6 +696,8 @@ impl PointsOf {
 enum LanePoints<'s> {
     Grid(SamplePoints, PointsOf),
     Sobol(RunSequences, u32),
+    /// Every lane's points of its run's sequence, point `j` at `j`.
+    Hashed(Vec<PointLanes>),
     /// The streams, where they were, and the lanes read later that do not
     /// draw.
     Uniform(&'s mut Pcg32Lanes, Pcg32Lanes, u32),
@@ -700,6 +715,10 @@ impl LanePoints<'_> {
                 (F32Lanes::splat(p.x), F32Lanes::splat(p.y))
             }
             Self::Sobol(sequences, n) => sequences.points(j, *n),
+            Self::Hashed(points) => {
+                let p = points[j as usize];
+                (p.x, p.y)
+            }
             Self::Uniform(rngs, _, _) => rngs.uniform2(),
             Self::Filled(points, n) => {
                 let p = |k: usize| points[k * *n + j as usize];
@@ -715,6 +734,7 @@ impl LanePoints<'_> {
         match self {
             Self::Grid(points, of) => *of.buffer(ctx) = points,
             Self::Sobol(..) => {}
+            Self::Hashed(points) => ctx.sobol_lanes = points,
             Self::Uniform(rngs, before, kept) if kept != 0 => {
                 *rngs = Pcg32Lanes::select(kept, &before, rngs);
             }

@@ -3,7 +3,8 @@ use crate::counters::{ShadingCounters, TextureCounters};
 use crate::light_samples::LANES_FROM_SAMPLES;
 use crate::sampling::Pcg32;
 use crate::sampling::{
-    DimensionPair, PixelSample, PointChunk, SamplePattern, SamplePoints, SequenceCache, MAX_JOINT,
+    DimensionPair, PixelSample, PointChunk, PointLanes, SamplePattern, SamplePoints, SequenceCache,
+    MAX_JOINT,
 };
 use crate::settings::RenderSettings;
 use crate::texture_lookup::texture_footprint;
@@ -83,6 +84,8 @@ pub struct SampleContext<T: Tracer = ()> {
     pub(crate) sequences: SequenceCache,
     /// Each lane's points, drawn up front, in the camera-sample lanes.
     pub(crate) lane_points: Vec<Vec2>,
+    /// The camera-sample lanes' Sobol points, hashed up front.
+    pub(crate) sobol_lanes: Vec<PointLanes>,
 }
 
 /// The shapes that may block shadow rays to one area light from anywhere
@@ -119,6 +122,7 @@ impl<T: Tracer> SampleContext<T> {
             lane_occluders: None,
             sequences: SequenceCache::default(),
             lane_points: Vec::new(),
+            sobol_lanes: Vec::new(),
         }
     }
 

@@ -32,7 +32,7 @@ const SOLID_ANGLE_RANGE: std::ops::RangeInclusive<f32> = 3e-4..=6.22;
 /// From about this solid angle (steradians) on, [`AreaSampling::Auto`]
 /// samples a rectangular light by solid angle. A solid-angle sample costs
 /// more than an area sample (the parametrisation's trigonometry; measured
-/// on an AMD EPYC, both in lanes: 1.87× the render time of
+/// on an Intel Xeon, both in lanes: 1.87× the render time of
 /// `cornell-physical`, 1.26× that of `physical-glossy`, each sampled all one
 /// way), and gives no lower error where the light is small or far (the
 /// same relMSE there); area sampling's extra variance grows with the

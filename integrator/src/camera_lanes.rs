@@ -56,8 +56,8 @@ use glint_geometry::{
     RayLanes, Shape, Sphere, SurfaceLanes, SPHERE_UV_APPROX_ERROR,
 };
 use glint_lighting::{
-    AreaLight, EnvironmentLight, Light, PhongLanes, PhongMaterial, PointLight, ShadingModel,
-    SphereLight, UvTransform,
+    sample_specular_at, specular_pdf_at, AreaLight, EnvironmentLight, Light, PhongLanes,
+    PhongMaterial, PointLight, ShadingModel, SphereLight, UvTransform,
 };
 use glint_texture::{Checkerboard, TexCoord, Texture};
 use std::cell::OnceCell;
@@ -1305,19 +1305,11 @@ impl<'a> ShadedLanes<'a> {
         let s = at.unshadowed_by(position, pdf, used, counters, |l| self.phong.brdf_cos(l));
         let glossy = s.evaluated & self.phong.specular_lanes();
         counters.specular_lobes += u64::from(glossy.count_ones());
-        let mut weights = [1.0; LANES];
-        let pdfs = pdf.to_array();
-        for k in lanes::each_set(s.reflects & mis) {
-            weights[k] = power_heuristic(pdfs[k], self.lobe_pdf(k, s.l.lane(k)));
-        }
-        (s.f_cos.scale(F32Lanes::new(weights) / pdf), s.reflects)
-    }
-
-    /// Lane `k`'s lobe's density of drawing the unit direction `l`.
-    fn lobe_pdf(&self, k: usize, l: Vec3) -> f32 {
-        let material = self.phong.material(k).expect("a glossy lane holds a point");
-        let (n, v) = (self.phong.normals().lane(k), self.phong.viewers().lane(k));
-        material.specular_pdf(n, l, v)
+        let (n, v) = (self.phong.normals(), self.phong.viewers());
+        let lobe_pdf = specular_pdf_at(self.phong.lobes(), n, &s.l, v);
+        let weighted = lanes::from_bits(s.reflects & mis);
+        let weights = F32Lanes::select(weighted, power_heuristic(pdf, lobe_pdf), F32Lanes::ONE);
+        (s.f_cos.scale(weights / pdf), s.reflects)
     }
 
     /// One direction drawn from each lane's lobe, of the glossy lanes `mis`,
@@ -1326,29 +1318,24 @@ impl<'a> ShadedLanes<'a> {
     /// counted as the lobe's zero-density skips).
     fn lobe_directions(
         &self,
-        (ux, uy): (F32Lanes, F32Lanes),
+        u: (F32Lanes, F32Lanes),
         mis: u32,
         counters: &mut ShadingCounters,
     ) -> (Vec3Lanes, F32Lanes, u32) {
-        let (ux, uy) = (ux.to_array(), uy.to_array());
-        let (mut directions, mut pdfs, mut drawn) = ([Vec3::ZERO; LANES], [0.0; LANES], 0);
-        for k in lanes::each_set(mis) {
-            let material = self.phong.material(k).expect("a glossy lane holds a point");
-            let (n, v) = (self.phong.normals().lane(k), self.phong.viewers().lane(k));
-            let Some(l) = material.sample_specular(n, v, Vec2::new(ux[k], uy[k])) else {
-                counters.lobe_skips.zero_density += 1;
-                continue;
-            };
-            let pdf = material.specular_pdf(n, l, v);
-            if !(pdf > 0.0 && pdf.is_finite()) {
-                counters.lobe_skips.zero_density += 1;
-                continue;
-            }
-            (directions[k], pdfs[k], drawn) = (l, pdf, drawn | 1 << k);
-        }
+        let (lobes, n, v) = (
+            self.phong.lobes(),
+            self.phong.normals(),
+            self.phong.viewers(),
+        );
+        let (l, sampled) = sample_specular_at(lobes, n, v, u);
+        let pdf = specular_pdf_at(lobes, n, &l, v);
+        let positive = pdf.gt(F32Lanes::ZERO) & pdf.is_finite();
+        let drawn = mis & lanes::bits(sampled & positive);
+        counters.lobe_skips.zero_density += u64::from((mis & !drawn).count_ones());
+        let drawn_lanes = lanes::from_bits(drawn);
         (
-            Vec3Lanes::from_lanes(directions),
-            F32Lanes::new(pdfs),
+            Vec3Lanes::select(drawn_lanes, &l, &Vec3Lanes::default()),
+            F32Lanes::select(drawn_lanes, pdf, F32Lanes::ZERO),
             drawn,
         )
     }

@@ -30,7 +30,7 @@ use crate::sampling::{DimensionPair, PointChunk, SamplePoints};
 use crate::trace::{Event, Shadow, Skip, Technique, Tracer};
 use crate::{DirectIntegrator, Scene, ShadingCounters, Skips};
 use glam::Vec3;
-use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
+use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, LANES};
 use glint_geometry::{spawn_ray, spawn_ray_to, Occluders, RayLanes, RayTarget};
 use glint_lighting::{AreaLight, AreaLightSampler, Light, PointLight, SphereLight};
 
@@ -269,13 +269,11 @@ pub(crate) struct UnshadowedLanes {
 /// Veach's power heuristic (β = 2) for a sample drawn with density `a` where
 /// the other technique has density `b`: `a² / (a² + b²)`, written so that
 /// neither square overflows.
-#[inline]
-pub(crate) fn power_heuristic(a: f32, b: f32) -> f32 {
-    if a <= 0.0 {
-        return 0.0;
-    }
+/// In one lane or in many.
+#[inline(always)]
+pub(crate) fn power_heuristic<F: Float>(a: F, b: F) -> F {
     let ratio = b / a;
-    1.0 / (1.0 + ratio * ratio)
+    F::select(a.le(F::ZERO), F::ZERO, F::ONE / (F::ONE + ratio * ratio))
 }
 
 impl ShadingPoint<'_> {

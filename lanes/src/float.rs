@@ -90,6 +90,11 @@ pub trait Float:
     /// its sign bit flipped where `sign`'s is set (so `−0` and `−NaN` count
     /// as negative), exact for every value.
     fn mulsign(self, sign: Self) -> Self;
+    /// `(m, e)` with `self = m·2^e`, `m` in [1, 2) and `e` a whole number, for
+    /// a positive normal float (its exponent field read off the bits).
+    fn frexp(self) -> (Self, Self);
+    /// `2^self` for a whole `self` in [−126, 127], exactly (made as bits).
+    fn exp2i(self) -> Self;
     /// The next float from `self` the way `direction` points: `next_up`
     /// where it is positive, `next_down` where negative, `self` where it is
     /// zero or NaN. One step up between two sign flips, since
@@ -202,7 +207,21 @@ impl Float for f32 {
     fn mulsign(self, sign: Self) -> Self {
         f32::from_bits(self.to_bits() ^ (sign.to_bits() & SIGN_BIT))
     }
+    #[inline(always)]
+    fn frexp(self) -> (Self, Self) {
+        let bits = self.to_bits();
+        let e = ((bits >> 23) & 0xff) as i32 - 127;
+        (f32::from_bits((bits & MANTISSA) | ONE_BITS), e as f32)
+    }
+    #[inline(always)]
+    fn exp2i(self) -> Self {
+        f32::from_bits(((self as i32 + 127) as u32) << 23)
+    }
 }
+
+/// The mantissa bits of an `f32`, and the bits of 1.0.
+const MANTISSA: u32 = 0x007f_ffff;
+const ONE_BITS: u32 = 0x3f80_0000;
 
 /// The sign bit of an `f32`.
 const SIGN_BIT: u32 = 1 << 31;
@@ -301,6 +320,18 @@ macro_rules! lanes_of_f32 {
                 let sign_bit = <$i>::splat(SIGN_BIT as i32);
                 let bits: $i = bytemuck::cast(self);
                 bytemuck::cast(bits ^ (bytemuck::cast::<_, $i>(sign) & sign_bit))
+            }
+            #[inline(always)]
+            fn frexp(self) -> (Self, Self) {
+                let bits: $i = bytemuck::cast(self);
+                let e: $i = ((bits >> 23) & <$i>::splat(0xff)) - <$i>::splat(127);
+                let mantissa: $i =
+                    (bits & <$i>::splat(MANTISSA as i32)) | <$i>::splat(ONE_BITS as i32);
+                (bytemuck::cast(mantissa), e.round_float())
+            }
+            #[inline(always)]
+            fn exp2i(self) -> Self {
+                bytemuck::cast((self.trunc_int() + <$i>::splat(127)) << 23)
             }
         }
     };

@@ -12,7 +12,10 @@ mod float;
 mod vector;
 mod width;
 
-pub use approx::{acos_approx, atan2_approx, sin_cos_approx, ACOS_ERROR, ATAN2_ERROR};
+pub use approx::{
+    acos_approx, atan2_approx, exp2_approx, log2_approx, powf_approx, sin_cos_approx, ACOS_ERROR,
+    ATAN2_ERROR,
+};
 pub use float::{Float, Mask};
 pub use vector::Vector3;
 pub use width::*;

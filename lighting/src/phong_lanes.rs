@@ -11,7 +11,7 @@
 //! or whose exponent is not an integer are computed one by one.
 
 use crate::material::{lobe_of_cosine, phong_cosine, phong_reflection};
-use crate::{PhongMaterial, SpecularLobe};
+use crate::{Lobes, PhongMaterial, SpecularLobe};
 use glam::Vec3;
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
 
@@ -159,6 +159,17 @@ impl<'a> PhongLanes<'a> {
     /// Lane `k`'s material, if the lane is set.
     pub fn material(&self, k: usize) -> Option<&'a PhongMaterial> {
         self.materials[k]
+    }
+
+    /// Each lane's specular lobe (unset lanes a Phong lobe of exponent 0),
+    /// for [`crate::sample_specular_at`] and [`crate::specular_pdf_at`].
+    pub fn lobes(&self) -> Lobes<F32Lanes> {
+        let lobe = |k: usize| self.materials[k].map(PhongMaterial::lobes);
+        let blinn = (0..LANES).filter(|&k| lobe(k).is_some_and(|l| l.blinn));
+        Lobes {
+            shininess: lanes::from_fn(|k| lobe(k).map_or(0.0, |l| l.shininess)),
+            blinn: lanes::from_bits(blinn.fold(0, |bits, k| bits | 1 << k)),
+        }
     }
 
     /// Each lane's unit direction to the viewer.

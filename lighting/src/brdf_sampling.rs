@@ -280,7 +280,8 @@ mod tests {
             blinn: lanes::from_bits(0xaaaa_aaaa),
         };
         let (mut drawn_count, mut below) = (0, 0);
-        for round in 0..64 {
+        // 1024 lobes whatever the lane width.
+        for round in 0..1024 / LANES {
             let at = |k: usize, c: f32| (round * LANES + k) as f32 * c;
             let n: [Vec3; LANES] =
                 std::array::from_fn(|k| unit(0.3 + 0.2 * at(k, 0.37).sin(), at(k, 1.3)));

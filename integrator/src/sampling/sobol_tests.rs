@@ -144,8 +144,10 @@ fn runs_hashed_together_give_each_lanes_point_of_its_own_sequence() {
         // sequences one by one.
         let sequence = SobolSequence::new(3, 7, pair);
         assert!(RunLanes::new(&[(sequence, 65_530, 0)], 1, 1).is_none());
-        assert!(RunLanes::new(&[(sequence, 65_300, 0)], 16, 17).is_none());
-        assert!(RunLanes::new(&[(sequence, 65_279, 0)], 16, 17).is_some());
+        // The last lane's last point, `first + (LANES − 1)·16 + 16`, at 2^16 − 1.
+        let last_in_block = 65_535 - (LANES as u64 - 1) * 16 - 16;
+        assert!(RunLanes::new(&[(sequence, last_in_block, 0)], 16, 17).is_some());
+        assert!(RunLanes::new(&[(sequence, last_in_block + 1, 0)], 16, 17).is_none());
     }
 }
 

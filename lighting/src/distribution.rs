@@ -76,7 +76,7 @@ impl PiecewiseConstant1D {
     /// The number of CDF values at most `u`: those of the buckets before
     /// `u`'s, plus those of its own bucket at most `u` (most buckets hold none
     /// or one, counted without a branch).
-    #[inline]
+    #[inline(always)]
     fn values_at_most(&self, u: f64) -> usize {
         let n = self.len();
         if !(0.0..1.0).contains(&u) {
@@ -117,7 +117,10 @@ impl PiecewiseConstant1D {
     }
 
     /// `(x, pdf(x), bin)` for a uniform `u` ∈ [0, 1).
-    #[inline]
+    // Inlined into `PiecewiseConstant2D::sample_each`'s stages, the samples of
+    // different points overlap better than as calls (`physical-environment`
+    // 0.975× its time, 11 pairs).
+    #[inline(always)]
     pub fn sample(&self, u: f32) -> (f32, f32, usize) {
         let u = u as f64;
         // The last bin whose cdf is ≤ u, skipping empty bins.

@@ -119,7 +119,7 @@ pub(crate) struct SceneArgs {
 
     /// Physical shading: how area lights are sampled (overrides
     /// render.area_sampling): auto (by solid angle where a light subtends more
-    /// than 1 sr, else by area), solid-angle (uniform over the solid angle a
+    /// than 1 sr or is seen obliquely, else by area), solid-angle (uniform over the solid angle a
     /// rectangular light subtends) or area (uniform over its area)
     #[arg(long, value_name = "STRATEGY", value_parser = named(&AreaSampling::NAMES, AreaSampling::from_name))]
     area_sampling: Option<AreaSampling>,

@@ -36,7 +36,9 @@ mod sphere_light;
 mod spherical_rectangle;
 
 pub use area_light::AreaLight;
-pub use area_sampling::{AreaLightSampler, AreaSampling, LightSample, AUTO_SOLID_ANGLE_FROM};
+pub use area_sampling::{
+    AreaLightSampler, AreaSampling, LightSample, AUTO_GEOMETRY_RATIO_FROM, AUTO_SOLID_ANGLE_FROM,
+};
 pub use brdf_sampling::{sample_specular_at, specular_pdf_at, Lobes};
 pub use environment_light::{EnvironmentLight, EnvironmentSample, EnvironmentSampling};
 pub use material::{blinn_phong_normalisation, PhongMaterial, SpecularLobe, UvTransform};

@@ -444,7 +444,10 @@ mod tests {
         let sampler = light.sampler(oblique, AreaSampling::Auto);
         let omega = sampler.rectangle().map(|r| r.solid_angle());
         assert!(omega.is_some_and(|omega| omega < 0.01), "{omega:?}");
-        assert!(light.sampler(below, AreaSampling::Auto).rectangle().is_none());
+        assert!(light
+            .sampler(below, AreaSampling::Auto)
+            .rectangle()
+            .is_none());
         let points = Vec3Lanes::from_lanes(std::array::from_fn(|k| [oblique, below][k % 2]));
         let lanes = light.sampler_from(&points, AreaSampling::Auto, F32Lanes::TRUE);
         let every_other = (0..LANES).step_by(2).fold(0u32, |bits, k| bits | 1 << k);

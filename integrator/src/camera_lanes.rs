@@ -612,17 +612,18 @@ impl DirectIntegrator {
         match pattern {
             SamplePattern::Sobol => {
                 let sequences = RunSequences::new(samples, drawing, pair, n, ctx);
-                match sequences.together {
-                    // All the points hashed up front: the hashes of
-                    // different points overlap, where one point's waits on
-                    // its own long chain of products.
-                    Some(together) if n > 1 => {
+                let stride = u64::from(n);
+                match RunLanes::new(&sequences.runs[..sequences.count], stride, stride) {
+                    // All the points hashed together and up front: the
+                    // hashes of different points overlap, where one point's
+                    // waits on its own long chain of products.
+                    Some(together) => {
                         let mut points = std::mem::take(&mut ctx.sobol_lanes);
                         points.clear();
                         points.extend((0..n).map(|j| together.points(j)));
                         LanePoints::Hashed(points)
                     }
-                    _ => LanePoints::Sobol(sequences, n),
+                    None => LanePoints::Sobol(sequences, n),
                 }
             }
             SamplePattern::Grid => {
@@ -695,6 +696,8 @@ impl PointsOf {
 #[allow(clippy::large_enum_variant)]
 enum LanePoints<'s> {
     Grid(SamplePoints, PointsOf),
+    /// Each run's points hashed from its own sequence, where some lane's
+    /// points leave its sequence's first 2^16 ([`RunLanes::new`]).
     Sobol(RunSequences, u32),
     /// Every lane's points of its run's sequence, point `j` at `j`.
     Hashed(Vec<PointLanes>),
@@ -763,9 +766,6 @@ struct RunSequences {
     /// Each run's sequence, its first point, and its first lane.
     runs: [(SobolSequence, u64, usize); LANES],
     count: usize,
-    /// The runs' points hashed together in one set of lanes, where every
-    /// lane's points lie in the first block of its sequence.
-    together: Option<RunLanes>,
 }
 
 impl RunSequences {
@@ -788,21 +788,12 @@ impl RunSequences {
         for (run, entry) in runs.iter_mut().enumerate().take(count).skip(1) {
             *entry = start(run);
         }
-        let together = RunLanes::new(&runs[..count], u64::from(n), u64::from(n));
-        Self {
-            runs,
-            count,
-            together,
-        }
+        Self { runs, count }
     }
 
     /// Every lane's light point `j` of `n`.
     #[inline]
     fn points(&self, j: u32, n: u32) -> (F32Lanes, F32Lanes) {
-        if let Some(together) = &self.together {
-            let u = together.points(j);
-            return (u.x, u.y);
-        }
         let (sequence, first, _) = self.runs[0];
         let mut u = sequence.lanes_strided(first + u64::from(j), u64::from(n));
         for &(sequence, first, lane) in &self.runs[1..self.count] {

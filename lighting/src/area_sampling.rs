@@ -243,10 +243,6 @@ impl<F: Float> AreaLightSampler<'_, F> {
     pub fn by_solid_angle(&self) -> F::Mask {
         self.by_solid_angle
     }
-
-    pub fn light(&self) -> &AreaLight {
-        self.light
-    }
 }
 
 impl AreaLight {

@@ -33,6 +33,10 @@ pub struct PhongLanes<'a> {
     exponent_bits: [u32; 32],
     /// The bits set in any lane's exponent (their top bit ends the squarings).
     exponent_top: u32,
+    /// Each lane's exponent as a float (0 where unset), for sampling lobes.
+    shininess: F32Lanes,
+    /// Lanes whose lobe is Blinn–Phong's.
+    blinn: u32,
 }
 
 impl<'a> PhongLanes<'a> {
@@ -86,6 +90,12 @@ impl<'a> PhongLanes<'a> {
             lane_lobes: with_exponent,
             exponent_bits: std::array::from_fn(|b| if exponent >> b & 1 == 1 { lanes } else { 0 }),
             exponent_top: exponent,
+            shininess: mask.select(F32Lanes::splat(material.shininess), F32Lanes::ZERO),
+            blinn: if material.lobe == SpecularLobe::BlinnPhong {
+                lanes
+            } else {
+                0
+            },
         }
     }
 
@@ -98,6 +108,14 @@ impl<'a> PhongLanes<'a> {
         for k in lanes::each_set(lanes) {
             self.materials[k] = Some(material);
         }
+        let mask = lanes::from_bits(lanes);
+        self.shininess = mask.select(F32Lanes::splat(material.shininess), self.shininess);
+        let blinn = if material.lobe == SpecularLobe::BlinnPhong {
+            lanes
+        } else {
+            0
+        };
+        self.blinn = (self.blinn & !lanes) | blinn;
         self.set_exponent(lanes, exponent.unwrap_or(0));
     }
 
@@ -164,11 +182,9 @@ impl<'a> PhongLanes<'a> {
     /// Each lane's specular lobe (unset lanes a Phong lobe of exponent 0),
     /// for [`crate::sample_specular_at`] and [`crate::specular_pdf_at`].
     pub fn lobes(&self) -> Lobes<F32Lanes> {
-        let lobe = |k: usize| self.materials[k].map(PhongMaterial::lobes);
-        let blinn = (0..LANES).filter(|&k| lobe(k).is_some_and(|l| l.blinn));
         Lobes {
-            shininess: lanes::from_fn(|k| lobe(k).map_or(0.0, |l| l.shininess)),
-            blinn: lanes::from_bits(blinn.fold(0, |bits, k| bits | 1 << k)),
+            shininess: self.shininess,
+            blinn: lanes::from_bits(self.blinn),
         }
     }
 

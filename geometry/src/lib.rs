@@ -75,6 +75,7 @@ pub use shape_list::{
     BvhRef, BvhVisit, ChildVisit, ClosestExplained, ClosestLanes, LeafPrimitive, ObjectRef,
     ObjectTest, Occluders, PrimitiveHit, ShapeList,
 };
+pub(crate) use shapes::triangle_lanes;
 pub use shapes::{triangle, triangle_packet};
 pub use shapes::{
     AaBox, MeshError, Parallelogram, ParallelogramPacket, Plane, Shape, Sphere, SpherePacket,

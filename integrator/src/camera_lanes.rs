@@ -309,10 +309,7 @@ impl DirectIntegrator {
         let (rays, diffs, traced) = reflected_rays(scene, wave, traced);
         ctx.counters.reflection_rays += u64::from(traced.count_ones());
         let used = (u32::BITS - traced.leading_zeros()) as usize;
-        // The scene's first hits were found in lanes: so are the next.
-        let Some(closest) = scene.shapes.closest_lanes(&rays, used) else {
-            unreachable!("a scene's hits in lanes at the first hit are in lanes at every depth");
-        };
+        let closest = scene.shapes.closest_lanes(&rays, used);
         let next = Wave {
             rays: &rays,
             diffs: diffs.as_ref(),
@@ -574,10 +571,7 @@ impl DirectIntegrator {
             let mut reached = 0;
             for k in lanes::each_set(traced) {
                 let ray = rays.lane(k);
-                let found = match &closest {
-                    Some(closest) => closest.hit(k),
-                    None => scene.shapes.closest_primitive(&ray, f32::INFINITY),
-                };
+                let found = closest.hit(k);
                 // The light's surface is one-sided: a hit on it is a hit on its front.
                 let on_light = found.filter(|found| found.object == object);
                 if let Some(hit) =
@@ -926,7 +920,9 @@ impl Mirrors {
         }
         let mut r = [0.0; LANES];
         for k in lanes::each_set(hit_lanes) {
-            let SurfaceKind::Material(m) = scene.surface_of_primitive(closest.object[k], 0) else {
+            let SurfaceKind::Material(m) =
+                scene.surface_of_primitive(closest.object[k], closest.primitive[k])
+            else {
                 continue;
             };
             if m.reflectivity > 0.0 {
@@ -1718,10 +1714,7 @@ mod tests {
                 let rays = cameras.map(|(ray, _)| ray);
                 let diffs = cameras.map(|(_, diff)| diff);
                 let ray_lanes = RayLanes::new(rays);
-                let closest = scene
-                    .shapes
-                    .closest_lanes(&ray_lanes, used)
-                    .expect("spheres and parallelograms: hits in lanes");
+                let closest = scene.shapes.closest_lanes(&ray_lanes, used);
                 let hit_lanes = closest.hits & ((1 << used) - 1);
                 match closest.common_object(hit_lanes) {
                     Some(object) if scene.light_objects.contains(&object) => common[2] += 1,
@@ -1890,7 +1883,7 @@ mod tests {
                     )
                 })),
             };
-            let closest = scene.shapes.closest_lanes(&rays, LANES).unwrap();
+            let closest = scene.shapes.closest_lanes(&rays, LANES);
             if closest.hits == 0 {
                 continue;
             }

@@ -319,9 +319,7 @@ impl<'a> PixelRenderer<'a> {
             integrator,
             footprint_scale: (1.0 / (settings.spp as f32).sqrt()).max(0.125),
             differentials,
-            all_in_lanes: settings.aov.is_none()
-                && !differentials
-                && scene.shapes.has_closest_lanes(),
+            all_in_lanes: settings.aov.is_none() && !differentials,
             span: Cell::new(None),
         }
     }
@@ -473,7 +471,6 @@ impl<'a> PixelRenderer<'a> {
         let (px, py) = chunk.raster_lanes();
         let rays = centre_rays(&scene.camera, px, py);
         let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
-        let closest = closest.expect("has_closest_lanes");
         (self.integrator).li_first_hits(scene, &rays, None, &closest, used, &chunk.samples, ctx)
     }
 
@@ -497,8 +494,7 @@ impl<'a> PixelRenderer<'a> {
             }
         };
         let closest = (settings.aov.is_none() && used > 1 && !T::ON)
-            .then(|| scene.shapes.closest_lanes(&ray_lanes, used))
-            .flatten();
+            .then(|| scene.shapes.closest_lanes(&ray_lanes, used));
         match &closest {
             Some(closest) => (self.integrator).li_first_hits(
                 scene,

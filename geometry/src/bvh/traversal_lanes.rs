@@ -21,20 +21,24 @@ use std::cell::RefCell;
 thread_local! {
     /// Each thread's stack of (link, lanes that reach it), reused query after query.
     static STACK: RefCell<Vec<(Link, u32)>> = const { RefCell::new(Vec::new()) };
+    /// Each thread's stack of (link, lanes that reach it, their entry
+    /// distances) for walks that prune by distance.
+    static NEAREST_STACK: RefCell<Vec<(Link, u32, F32Lanes)>> = const { RefCell::new(Vec::new()) };
 }
 
 impl Bvh {
     /// Which of the rays of `rays` in the lanes of `active` (bit k for lane k)
-    /// meet a primitive in (0, `t_max`): `blocked(first, count, lane)` says
-    /// whether the leaf with positions `first..first + count` holds a primitive
-    /// on lane `lane`'s ray (as the visit of [`Bvh::traverse_leaves`] would).
+    /// meet a primitive in (0, `t_max`): `blocked(first, count, reach)` gives
+    /// the lanes of `reach` whose ray meets a primitive of the leaf with
+    /// positions `first..first + count` (as the visit of
+    /// [`Bvh::traverse_leaves`] would find for each alone).
     /// Lanes whose ray has a NaN component meet nothing, as alone.
     pub fn any_hit_lanes(
         &self,
         rays: &RayLanes,
         t_max: f32,
         active: u32,
-        mut blocked: impl FnMut(u32, u32, usize) -> bool,
+        mut blocked: impl FnMut(u32, u32, u32) -> u32,
     ) -> u32 {
         let finite = !(nan_lanes(rays));
         let active = active & finite & lanes::all_bits();
@@ -61,11 +65,7 @@ impl Bvh {
                 if link.is_leaf() {
                     count(|c| c.bvh_leaves += u64::from(reach.count_ones()));
                     let (first, n) = link.leaf_range();
-                    for lane in lanes::each_set(reach) {
-                        if blocked(first, n, lane) {
-                            found |= 1 << lane;
-                        }
-                    }
+                    found |= blocked(first, n, reach) & reach;
                     if found == active {
                         break;
                     }
@@ -81,6 +81,81 @@ impl Bvh {
                 }
             }
             found
+        })
+    }
+}
+
+impl Bvh {
+    /// Visits the leaves the rays of `rays` in the lanes of `active` enter
+    /// before their `limit` (per lane), depth first, the nearer children
+    /// first (by the entry distance of the lowest lane that enters them):
+    /// `visit(first, count, reach, limit)` gets a leaf's run of positions in
+    /// leaf order, the lanes that reach it, and the limits, which it may
+    /// lower (a lane then skips the boxes it enters at or beyond its limit,
+    /// those pushed before too). Lanes whose ray has a NaN component reach
+    /// nothing. Which leaves a lane reaches depends on the limits it had
+    /// when each box was tested, and those on the order of the walk: the
+    /// caller's answers must not ([`ShapeList::closest_lanes_among`]).
+    ///
+    /// [`ShapeList::closest_lanes_among`]: crate::ShapeList::closest_lanes_among
+    pub fn traverse_leaves_lanes(
+        &self,
+        rays: &RayLanes,
+        active: u32,
+        limit: &mut F32Lanes,
+        mut visit: impl FnMut(u32, u32, u32, &mut F32Lanes),
+    ) {
+        let active = active & !nan_lanes(rays) & lanes::all_bits();
+        if active == 0 || self.is_empty() {
+            return;
+        }
+        let lanes = PreparedRayLanes::new(rays, f32::INFINITY);
+        NEAREST_STACK.with(|cell| {
+            let mut own = Vec::new();
+            let mut borrowed = cell.try_borrow_mut();
+            let stack = match borrowed.as_mut() {
+                Ok(stack) => &mut **stack,
+                Err(_) => &mut own,
+            };
+            stack.clear();
+            stack.push((Link::ROOT, active, F32Lanes::ZERO));
+            while let Some((link, reach, enter)) = stack.pop() {
+                let reach = reach & enter.simd_lt(*limit).to_bitmask();
+                if reach == 0 {
+                    continue;
+                }
+                if link.is_leaf() {
+                    count(|c| c.bvh_leaves += u64::from(reach.count_ones()));
+                    let (first, n) = link.leaf_range();
+                    visit(first, n, reach, limit);
+                    continue;
+                }
+                count(|c| c.bvh_nodes += u64::from(reach.count_ones()));
+                let node = &self.tree.nodes[link.node()];
+                // The children entered, nearest (by the lowest lane's entry) last.
+                let mut entered = [(0.0, Link::ROOT, 0, F32Lanes::ZERO); WIDTH];
+                let mut n = 0;
+                for child in 0..WIDTH {
+                    let (hits, enter) = lanes.enter_child_before(&node.planes, child, *limit);
+                    let hits = hits & reach;
+                    if hits == 0 {
+                        continue;
+                    }
+                    let key = enter.as_array()[hits.trailing_zeros() as usize];
+                    let mut k = n;
+                    while k > 0 && entered[k - 1].0 < key {
+                        entered[k] = entered[k - 1];
+                        k -= 1;
+                    }
+                    entered[k] = (key, node.link(child), hits, enter);
+                    n += 1;
+                }
+                stack.extend(
+                    entered[..n]
+                        .iter()
+                        .map(|&(_, link, hits, enter)| (link, hits, enter)),
+                );
+            }
         })
     }
 }
@@ -123,8 +198,20 @@ impl PreparedRayLanes {
     /// `t_max`: the scalar test's verdict in each lane.
     #[inline]
     fn enter_child(&self, planes: &[glam::Vec4; 6], child: usize) -> u32 {
+        self.enter_child_before(planes, child, self.t_max).0
+    }
+
+    /// [`Self::enter_child`] before each lane's own `t_max`, with the entry
+    /// distances.
+    #[inline(always)]
+    fn enter_child_before(
+        &self,
+        planes: &[glam::Vec4; 6],
+        child: usize,
+        t_max: F32Lanes,
+    ) -> (u32, F32Lanes) {
         let mut enter = F32Lanes::ZERO;
-        let mut exit = self.t_max;
+        let mut exit = t_max;
         for axis in 0..3 {
             let lo = F32Lanes::splat(planes[axis][child]);
             let hi = F32Lanes::splat(planes[axis + 3][child]);
@@ -137,8 +224,8 @@ impl PreparedRayLanes {
             enter = near.simd_gt(enter).select(near, enter);
             exit = far.simd_lt(exit).select(far, exit);
         }
-        let hit = enter.simd_le(exit * F32Lanes::splat(EXIT_SCALE)) & enter.simd_lt(self.t_max);
-        hit.to_bitmask()
+        let hit = enter.simd_le(exit * F32Lanes::splat(EXIT_SCALE)) & enter.simd_lt(t_max);
+        (hit.to_bitmask(), enter)
     }
 }
 

@@ -7,8 +7,10 @@
 use super::{LinearShapes, Object, Primitive, ShapeList};
 use crate::bvh::{Bounds3, Bvh, BvhStats, LEAF_WIDTH};
 use crate::counters::count;
+use crate::lanes::F32Lanes;
 use crate::triangle::WatertightRay;
-use crate::{Ray, Shape, TrianglePacket};
+use crate::triangle_lanes::WatertightLanes;
+use crate::{Ray, RayLanes, Shape, TrianglePacket};
 use glam::Vec4;
 
 /// Below this many primitives [`ShapeList::build_acceleration`] builds no BVH.
@@ -161,6 +163,53 @@ impl ShapeList {
             }
         }
         (hits, t)
+    }
+
+    /// The hits of the leaf at `first` for the rays of `reach` (lanes of
+    /// `rays`, prepared as `watertight`): `visit(slot, hits, t)` for each
+    /// primitive the leaf holds, in slot order, with the lanes of `reach`
+    /// whose ray hits it in (0, `t_max`) and their distances, bit for bit
+    /// each ray's [`Self::leaf_hits`]. A visit that returns `true` ends the
+    /// leaf.
+    #[inline(always)]
+    pub(super) fn leaf_hits_lanes(
+        &self,
+        first: u32,
+        (rays, watertight): (&RayLanes, &WatertightLanes),
+        t_max: f32,
+        reach: u32,
+        mut visit: impl FnMut(usize, u32, F32Lanes) -> bool,
+    ) {
+        let leaf = first as usize / LEAF_WIDTH;
+        let shapes = self.shape_lanes[leaf];
+        let tested = u64::from(reach.count_ones());
+        if shapes != 0xf {
+            count(|c| c.triangle_tests += LEAF_WIDTH as u64 * tested);
+        }
+        let packet = &self.packets[leaf];
+        let t_max_lanes = F32Lanes::splat(t_max);
+        for slot in 0..LEAF_WIDTH {
+            let (hits, t) = match shapes >> slot & 1 {
+                1 => {
+                    let p = self.primitives[first as usize + slot];
+                    let Object::Shape(s) = self.objects[p.object as usize] else {
+                        unreachable!("a shape's slot holds a shape");
+                    };
+                    self.shapes[s as usize].hit_distance_lanes(rays, t_max, tested)
+                }
+                _ => {
+                    let corners = packet.triangle(slot);
+                    // Padding (NaN) ends a leaf's run.
+                    if corners[0].x.is_nan() {
+                        break;
+                    }
+                    watertight.hits(&corners, t_max_lanes, reach)
+                }
+            };
+            if visit(slot, hits & reach, t) {
+                break;
+            }
+        }
     }
 
     /// Statistics of the BVH, once built.

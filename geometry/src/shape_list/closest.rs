@@ -1,7 +1,19 @@
 //! Closest-hit queries: the nearest hit with its surface record, the nearest
-//! primitive alone, and batches of rays traced as an interleaved stream. Ties at
-//! exactly equal distances go to the lowest (object, triangle), with or without
-//! the BVH.
+//! primitive alone, batches of rays traced as an interleaved stream, and
+//! [`LANES`] rays walked through the scene together. Ties at exactly equal
+//! distances go to the lowest (object, triangle), with or without the BVH.
+//!
+//! One rule makes the answer independent of the order primitives are met in,
+//! so that a ray gets the same hit alone or in lanes with others (whose walk
+//! visits the tree in another order): every primitive is tested up to the
+//! query's `t_max`, never up to the nearest hit so far, and the nearest is
+//! chosen by comparing the distances the tests computed. The nearest hit so
+//! far only prunes boxes, with room to spare ([`PRUNE_SCALE`]): a box the ray
+//! enters at or beyond `t·PRUNE_SCALE` cannot hold a hit at `t` or nearer.
+//! (Pruning tests at the nearest distance itself would make a hit within an
+//! ulp or two of another depend on which was met first: the scaled test
+//! `t·det < t_max·det` and the box's entry distance round differently from
+//! the distance itself.)
 
 use super::{LinearShapes, Object, ObjectRef, Primitive, ShapeList};
 use crate::bvh::RayStream;
@@ -10,10 +22,18 @@ use crate::lanes::I32Lanes;
 use crate::lanes::{self, F32Lanes, LANES};
 use crate::prefetch::prefetch;
 use crate::triangle::WatertightRay;
+use crate::triangle_lanes::WatertightLanes;
 use crate::{Hit, Ray};
 use crate::{RayLanes, Shape};
 use glam::{Vec3, Vec4};
+use std::cell::OnceCell;
 use std::ops::ControlFlow;
+
+/// How far past the nearest hit so far a box may be entered and still be
+/// visited: a relative 2⁻⁹, orders of magnitude beyond the rounding of a box's
+/// entry distance or a hit's distance, and too little to visit more than a
+/// handful of extra boxes.
+pub const PRUNE_SCALE: f32 = 1.0 + 1.0 / 512.0;
 
 /// A candidate for the closest hit: a primitive, or a position in the BVH's leaf
 /// order, looked up only when needed.
@@ -41,9 +61,11 @@ pub struct ClosestLanes {
     pub hits: u32,
     /// Each hit lane's distance, as [`PrimitiveHit::t`].
     pub t: F32Lanes,
-    /// Each hit lane's object, as [`PrimitiveHit::object`] (shapes only: the
-    /// primitive is 0).
+    /// Each hit lane's object, as [`PrimitiveHit::object`].
     pub object: [u32; LANES],
+    /// Each hit lane's triangle of a mesh (0 for a shape), as
+    /// [`PrimitiveHit::primitive`].
+    pub primitive: [u32; LANES],
 }
 
 impl ClosestLanes {
@@ -53,7 +75,7 @@ impl ClosestLanes {
         (self.hits >> lane & 1 == 1).then(|| PrimitiveHit {
             t: self.t.as_array()[lane],
             object: self.object[lane],
-            primitive: 0,
+            primitive: self.primitive[lane],
         })
     }
 
@@ -142,105 +164,113 @@ impl ShapeList {
     }
 
     /// [`ShapeList::closest_primitive`] without an upper limit for each of the
-    /// `LANES` rays of `rays`, one shape against all the rays at a time: the same
-    /// answers. The first `used` lanes hold real rays (the others are counted
-    /// by no `--stats` test, and their answers are to be ignored). `None` unless
-    /// the list is the linear loop with every object in its packets (spheres and
-    /// parallelograms: the course's scenes), where this pays; ask the rays one
-    /// by one then.
+    /// `LANES` rays of `rays`: the same answers, found for all the rays at
+    /// once. The first `used` lanes hold real rays (the others are counted by
+    /// no `--stats` test, and their answers are to be ignored).
     pub fn closest_primitives_lanes(
         &self,
         rays: &RayLanes,
         used: usize,
-    ) -> Option<[Option<PrimitiveHit>; LANES]> {
-        let closest = self.closest_lanes(rays, used)?;
-        Some(std::array::from_fn(|lane| closest.hit(lane)))
-    }
-
-    /// Whether [`ShapeList::closest_lanes`] answers (the linear loop holds every
-    /// object in its packets, but for planes and boxes).
-    pub fn has_closest_lanes(&self) -> bool {
-        self.lanes_layout().is_some()
-    }
-
-    pub(super) fn lanes_layout(&self) -> Option<&LinearShapes> {
-        self.linear.as_ref().filter(|linear| {
-            self.bvh.is_none()
-                && (linear.others.iter()).all(|&o| {
-                    matches!(
-                        self.object(o),
-                        ObjectRef::Shape(Shape::Plane(_) | Shape::Box(_))
-                    )
-                })
-        })
+    ) -> [Option<PrimitiveHit>; LANES] {
+        let closest = self.closest_lanes(rays, used);
+        std::array::from_fn(|lane| closest.hit(lane))
     }
 
     /// [`ShapeList::closest_primitives_lanes`] with the answers left in lanes.
-    pub fn closest_lanes(&self, rays: &RayLanes, used: usize) -> Option<ClosestLanes> {
+    pub fn closest_lanes(&self, rays: &RayLanes, used: usize) -> ClosestLanes {
         self.closest_lanes_among(rays, used, u64::MAX)
     }
 
     /// [`ShapeList::closest_lanes`] where the rays can only hit the objects of
-    /// `candidates` (object k as bit k; objects from 64 on always tested), as
-    /// [`ShapeList::objects_in_frustum`] finds them: the same answers.
+    /// `candidates` (object k as bit k; objects from 64 on, and those in a
+    /// BVH, always tested), as [`ShapeList::objects_in_frustum`] finds them:
+    /// the same answers.
+    ///
+    /// Each shape and each triangle is tested against all the rays at once,
+    /// each lane's verdict and distance its ray's alone, and the BVH is walked
+    /// by all the rays together ([`Bvh::traverse_leaves_lanes`](crate::bvh::Bvh::traverse_leaves_lanes)),
+    /// each lane pruning by its own nearest hit. With the rule of this module
+    /// (every primitive tested up to `t_max`, the nearest chosen by distance,
+    /// then the lowest key) the order of the walk changes no lane's answer.
     pub fn closest_lanes_among(
         &self,
         rays: &RayLanes,
         used: usize,
         candidates: u64,
-    ) -> Option<ClosestLanes> {
-        let tested = used.min(LANES) as u64;
-        let linear = self.lanes_layout()?;
-        // The nearest so far per lane, and its object (i32::MAX: none yet).
-        let mut best_t = F32Lanes::splat(f32::INFINITY);
-        let mut best_object = I32Lanes::splat(i32::MAX);
-        let spheres = linear.spheres.iter().map(|(_, objects)| objects);
-        let parallelograms = linear.parallelograms.iter().map(|(_, objects)| objects);
-        let used = spheres
-            .chain(parallelograms)
-            .flatten()
-            .filter(|&&o| o != u32::MAX && (o >= 64 || candidates >> o & 1 == 1));
-        // Planes, unbounded, are in every pixel's view, and boxes are few:
-        // always tested.
-        for &object in used.chain(&linear.others) {
-            let (hits, t) = match self.object(object) {
-                ObjectRef::Shape(Shape::Sphere(s)) => {
-                    count(|c| c.sphere_tests += tested);
-                    s.hit_distance_lanes(rays, f32::INFINITY)
+    ) -> ClosestLanes {
+        let active = lanes::all_bits()
+            & u32::MAX
+                .checked_shl(used.min(LANES) as u32)
+                .map_or(u32::MAX, |m| !m);
+        let tested = u64::from(active.count_ones());
+        let mut search = LanesSearch::new();
+        let watertight = OnceCell::new();
+        let watertight = || watertight.get_or_init(|| WatertightLanes::new(rays, active));
+        let packed = |o: &&u32| **o != u32::MAX && (**o >= 64 || candidates >> **o & 1 == 1);
+        match (&self.linear, &self.bvh) {
+            (Some(linear), _) => {
+                let spheres = linear.spheres.iter().map(|(_, objects)| objects);
+                let parallelograms = linear.parallelograms.iter().map(|(_, objects)| objects);
+                // Planes, unbounded, are in every pixel's view, and boxes are
+                // few: always tested.
+                let objects = spheres.chain(parallelograms).flatten().filter(packed);
+                for &object in objects.chain(&linear.others) {
+                    self.object_lanes(object, (rays, &watertight), (active, tested), &mut search);
                 }
-                ObjectRef::Shape(Shape::Parallelogram(p)) => {
-                    count(|c| c.parallelogram_tests += tested);
-                    p.hit_distance_lanes(rays, f32::INFINITY)
-                }
-                ObjectRef::Shape(Shape::Plane(p)) => {
-                    count(|c| c.plane_tests += tested);
-                    p.hit_distance_lanes(rays, f32::INFINITY)
-                }
-                ObjectRef::Shape(Shape::Box(b)) => {
-                    count(|c| c.box_tests += tested);
-                    b.hit_distance_lanes(rays, f32::INFINITY)
-                }
-                _ => {
-                    unreachable!("the lanes layout holds spheres, parallelograms, planes and boxes")
-                }
-            };
-            if hits == 0 {
-                continue;
             }
-            // The rule of `ClosestSearch::consider`: nearer, or as near and lower.
-            let o = I32Lanes::splat(object as i32);
-            let lower: F32Lanes = bytemuck::cast(o.simd_lt(best_object));
-            let nearer = lanes::lt(t, best_t) | (t.simd_eq(best_t) & lower);
-            let take = lanes::from_bits(hits) & nearer;
-            best_t = take.select(t, best_t);
-            best_object = bytemuck::cast::<F32Lanes, I32Lanes>(take).select(o, best_object);
+            (None, None) => {
+                for object in 0..self.objects.len() as u32 {
+                    self.object_lanes(object, (rays, &watertight), (active, tested), &mut search);
+                }
+            }
+            (None, Some(_)) => {}
         }
-        let none: F32Lanes = bytemuck::cast(best_object.simd_eq(I32Lanes::splat(i32::MAX)));
-        Some(ClosestLanes {
-            hits: !lanes::bits(none) & lanes::all_bits(),
-            t: best_t,
-            object: bytemuck::cast(best_object),
-        })
+        for &object in &self.unbounded {
+            self.object_lanes(object, (rays, &watertight), (active, tested), &mut search);
+        }
+        if let Some(bvh) = &self.bvh {
+            let mut limit = search.limit();
+            let walked = (rays, watertight());
+            bvh.traverse_leaves_lanes(rays, active, &mut limit, |first, _, reach, limit| {
+                self.leaf_hits_lanes(first, walked, f32::INFINITY, reach, |slot, hits, t| {
+                    if hits != 0 {
+                        let p = self.primitives[first as usize + slot];
+                        search.consider(hits, t, (p.object, p.triangle));
+                    }
+                    false
+                });
+                *limit = search.limit();
+            });
+        }
+        search.finish()
+    }
+
+    /// Tests object `object` against the lanes of `active` of `rays` (their
+    /// triangle tests prepared once, by `watertight`), for `search`.
+    #[inline(always)]
+    fn object_lanes<'r>(
+        &self,
+        object: u32,
+        (rays, watertight): (&'r RayLanes, &impl Fn() -> &'r WatertightLanes<'r>),
+        (active, tested): (u32, u64),
+        search: &mut LanesSearch,
+    ) {
+        match self.object(object) {
+            ObjectRef::Shape(shape) => {
+                let (hits, t) = shape.hit_distance_lanes(rays, f32::INFINITY, tested);
+                search.consider(hits & active, t, (object, 0));
+            }
+            ObjectRef::Mesh(mesh) => {
+                let watertight = watertight();
+                for triangle in 0..mesh.triangle_count() as u32 {
+                    count(|c| c.triangle_tests += tested);
+                    let corners = mesh.corners(triangle);
+                    let (hits, t) =
+                        watertight.hits(&corners, F32Lanes::splat(f32::INFINITY), active);
+                    search.consider(hits, t, (object, triangle));
+                }
+            }
+        }
     }
 
     /// [`ShapeList::closest_primitive`] for each of `rays`, with its own
@@ -291,17 +321,18 @@ impl ShapeList {
 
 /// One closest-hit query in progress: the ray, and the best hit so far.
 ///
-/// A candidate at distance t (found below the best's t, or equal to it) becomes
-/// the best if nearer, or as near with a lower (object, triangle). Only ties read
-/// which primitive a BVH slot holds.
+/// Every primitive is tested up to the query's `t_max`; a hit becomes the best
+/// if nearer, or as near with a lower (object, triangle). Only ties read which
+/// primitive a BVH slot holds.
 struct ClosestSearch {
     ray: Ray,
     /// The ray prepared for triangle tests, made on first use: a third of
     /// incoherent rays meet no leaf, and it costs three divisions.
     watertight: Option<WatertightRay>,
-    /// How far a hit may still be: the query's `t_max`, or just past the best
-    /// hit, so that the BVH still visits nodes entered exactly at its distance
-    /// (which may hold a lower-index primitive at the same distance).
+    /// The query's limit, which every primitive is tested up to.
+    t_max: f32,
+    /// Where boxes are pruned: the query's `t_max`, or [`PRUNE_SCALE`] past
+    /// the best hit.
     limit: f32,
     best: Option<(f32, Found)>,
 }
@@ -318,6 +349,7 @@ impl ClosestSearch {
         Self {
             ray: *ray,
             watertight: None,
+            t_max,
             limit: t_max,
             best: None,
         }
@@ -338,7 +370,7 @@ impl ClosestSearch {
         };
         if better {
             self.best = Some((t, found));
-            self.limit = t.next_up();
+            self.limit = self.limit.min(t * PRUNE_SCALE);
         }
     }
 
@@ -348,7 +380,7 @@ impl ClosestSearch {
         let watertight = *self
             .watertight
             .get_or_insert_with(|| WatertightRay::new(&ray));
-        if let Some(t) = list.primitive_distance(p, &self.ray, &watertight, self.limit()) {
+        if let Some(t) = list.primitive_distance(p, &self.ray, &watertight, self.t_max) {
             self.consider(list, Found::Primitive(p), t);
         }
     }
@@ -356,11 +388,11 @@ impl ClosestSearch {
     /// Tests every object through the linear loop's packets.
     fn test_linear(&mut self, list: &ShapeList, linear: &LinearShapes) {
         for (packet, objects) in &linear.spheres {
-            let (hits, t) = packet.hit4(&self.ray, self.limit);
+            let (hits, t) = packet.hit4(&self.ray, self.t_max);
             self.consider_lanes(list, hits, t, objects);
         }
         for (packet, objects) in &linear.parallelograms {
-            let (hits, t) = packet.hit4(&self.ray, self.limit);
+            let (hits, t) = packet.hit4(&self.ray, self.t_max);
             self.consider_lanes(list, hits, t, objects);
         }
         for &object in &linear.others {
@@ -396,11 +428,11 @@ impl ClosestSearch {
     /// Tests the leaf at `first`; returns the new limit.
     #[inline]
     fn visit_leaf(&mut self, list: &ShapeList, first: u32) -> f32 {
-        let (ray, limit) = (self.ray, self.limit());
+        let (ray, t_max) = (self.ray, self.t_max);
         let watertight = self
             .watertight
             .get_or_insert_with(|| WatertightRay::new(&ray));
-        let (hits, t) = list.leaf_hits(first, &ray, watertight, limit);
+        let (hits, t) = list.leaf_hits(first, &ray, watertight, t_max);
         if hits != 0 {
             // What the slot holds is read at the end of the query.
             if let Some(slot) = list.primitives.get(first as usize) {
@@ -421,6 +453,63 @@ impl ClosestSearch {
             object: p.object,
             primitive: p.triangle,
         })
+    }
+}
+
+/// The closest hits of [`LANES`] rays in progress
+/// ([`ShapeList::closest_lanes_among`]): per lane the nearest distance so far
+/// and its (object, triangle), `i32::MAX` for none yet.
+struct LanesSearch {
+    t: F32Lanes,
+    object: I32Lanes,
+    primitive: I32Lanes,
+}
+
+impl LanesSearch {
+    fn new() -> Self {
+        Self {
+            t: F32Lanes::splat(f32::INFINITY),
+            object: I32Lanes::splat(i32::MAX),
+            primitive: I32Lanes::splat(i32::MAX),
+        }
+    }
+
+    /// Takes the hits `hits` (their distances `t`) on primitive `key` (an
+    /// object and its triangle) where nearer than each lane's best, or as
+    /// near with a lower key: [`ClosestSearch::consider`] in every lane.
+    #[inline(always)]
+    fn consider(&mut self, hits: u32, t: F32Lanes, (object, primitive): (u32, u32)) {
+        if hits == 0 {
+            return;
+        }
+        let (o, p) = (
+            I32Lanes::splat(object as i32),
+            I32Lanes::splat(primitive as i32),
+        );
+        let lower = o.simd_lt(self.object) | (o.simd_eq(self.object) & p.simd_lt(self.primitive));
+        let nearer =
+            t.simd_lt(self.t) | (t.simd_eq(self.t) & bytemuck::cast::<I32Lanes, F32Lanes>(lower));
+        let take = lanes::from_bits(hits) & nearer;
+        self.t = take.select(t, self.t);
+        let take: I32Lanes = bytemuck::cast(take);
+        self.object = take.select(o, self.object);
+        self.primitive = take.select(p, self.primitive);
+    }
+
+    /// Where each lane prunes boxes: [`PRUNE_SCALE`] past its best hit.
+    #[inline(always)]
+    fn limit(&self) -> F32Lanes {
+        self.t * F32Lanes::splat(PRUNE_SCALE)
+    }
+
+    fn finish(&self) -> ClosestLanes {
+        let none: F32Lanes = bytemuck::cast(self.object.simd_eq(I32Lanes::splat(i32::MAX)));
+        ClosestLanes {
+            hits: !lanes::bits(none) & lanes::all_bits(),
+            t: self.t,
+            object: bytemuck::cast(self.object),
+            primitive: bytemuck::cast(self.primitive),
+        }
     }
 }
 

@@ -85,9 +85,10 @@ pub enum BvhVisit {
         depth: u32,
         children: Vec<ChildVisit>,
     },
-    /// A leaf reached, its primitives tested with the query's limit `t_max`
-    /// (just past the nearest hit so far, or the `t_max` given to
-    /// [`ShapeList::explain_closest`]).
+    /// A leaf reached while the query pruned boxes beyond `t_max` (the
+    /// nearest hit so far times [`PRUNE_SCALE`](super::closest::PRUNE_SCALE),
+    /// or the `t_max` given to [`ShapeList::explain_closest`]); its primitives
+    /// are tested up to the `t_max` given.
     Leaf {
         leaf: u32,
         depth: u32,

@@ -22,10 +22,10 @@ impl ShapeList {
     /// distance from the apex, and 10⁻⁴ of the coordinates' size), so that no
     /// hit a ray's exact test would find is left out. For
     /// [`ShapeList::closest_lanes_among`], with the corner rays of one pixel.
-    /// All objects without the lanes layout; every object where the corners
+    /// All objects without the linear layout; every object where the corners
     /// span no frustum (a plane's normal is not finite).
     pub fn objects_in_frustum(&self, apex: Vec3, corners: [Vec3; 4]) -> u64 {
-        let Some(linear) = self.lanes_layout() else {
+        let Some(linear) = self.linear.as_ref() else {
             return u64::MAX;
         };
         let inside = corners.iter().sum::<Vec3>();

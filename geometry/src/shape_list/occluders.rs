@@ -16,6 +16,7 @@ use crate::bvh::Bounds3;
 use crate::counters::count;
 use crate::lanes::{self, F32Lanes, LANES};
 use crate::triangle::WatertightRay;
+use crate::triangle_lanes::WatertightLanes;
 use crate::{Ray, RayLanes, Shape};
 use glam::{Vec3, Vec4};
 use glint_lanes::Vector3;
@@ -403,13 +404,21 @@ impl ShapeList {
         let Some(bvh) = &self.bvh else {
             return 0;
         };
-        let watertight: [WatertightRay; LANES] =
-            std::array::from_fn(|lane| WatertightRay::new(&rays.lane(lane)));
-        let mut blocked = self.lane_by_lane(active, |lane| {
-            self.unbounded_hit(&rays.lane(lane), &watertight[lane], t_max)
-        });
-        blocked |= bvh.any_hit_lanes(rays, t_max, active & !blocked, |first, _, lane| {
-            self.leaf_occludes(first, &rays.lane(lane), &watertight[lane], t_max)
+        let mut blocked = match self.unbounded.is_empty() {
+            true => 0,
+            false => self.lane_by_lane(active, |lane| {
+                let ray = rays.lane(lane);
+                self.unbounded_hit(&ray, &WatertightRay::new(&ray), t_max)
+            }),
+        };
+        let watertight = WatertightLanes::new(rays, active & !blocked);
+        blocked |= bvh.any_hit_lanes(rays, t_max, active & !blocked, |first, _, reach| {
+            let mut blocked = 0;
+            self.leaf_hits_lanes(first, (rays, &watertight), t_max, reach, |_, hits, _| {
+                blocked |= hits;
+                blocked == reach
+            });
+            blocked
         });
         blocked
     }

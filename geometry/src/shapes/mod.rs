@@ -15,6 +15,7 @@ mod ray_lanes;
 mod shape_packets;
 mod sphere;
 pub mod triangle;
+pub(crate) mod triangle_lanes;
 pub mod triangle_packet;
 
 pub use aabox::AaBox;
@@ -55,6 +56,30 @@ impl Shape {
             Shape::Parallelogram(p) => p.hit_distance(ray, t_max),
             Shape::Plane(p) => p.hit_distance(ray, t_max),
             Shape::Box(b) => b.hit_distance(ray, t_max),
+        }
+    }
+
+    /// [`Self::hit_distance`] for each of the [`LANES`](crate::lanes::LANES)
+    /// rays of `rays`: the lanes with a hit in (0, `t_max`), and their
+    /// distances, bit for bit the scalar ones. Counted as `tested` tests.
+    #[inline]
+    pub fn hit_distance_lanes(
+        &self,
+        rays: &crate::RayLanes,
+        t_max: f32,
+        tested: u64,
+    ) -> (u32, crate::lanes::F32Lanes) {
+        count(|c| match self {
+            Shape::Sphere(_) => c.sphere_tests += tested,
+            Shape::Parallelogram(_) => c.parallelogram_tests += tested,
+            Shape::Plane(_) => c.plane_tests += tested,
+            Shape::Box(_) => c.box_tests += tested,
+        });
+        match self {
+            Shape::Sphere(s) => s.hit_distance_lanes(rays, t_max),
+            Shape::Parallelogram(p) => p.hit_distance_lanes(rays, t_max),
+            Shape::Plane(p) => p.hit_distance_lanes(rays, t_max),
+            Shape::Box(b) => b.hit_distance_lanes(rays, t_max),
         }
     }
 

@@ -9,6 +9,7 @@
 //! no cracks. When an edge function is exactly zero it is recomputed in double
 //! precision, so that a ray exactly on an edge gets a consistent sign.
 
+use crate::lanes::Float;
 use crate::Ray;
 use glam::Vec3;
 
@@ -83,47 +84,151 @@ impl WatertightRay {
     /// (zero-area) triangles never are.
     #[inline]
     pub fn intersect(&self, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<(f32, [f32; 3])> {
-        let (a, b, c) = (p0 - self.origin, p1 - self.origin, p2 - self.origin);
-        let (a, b, c) = (a.to_array(), b.to_array(), c.to_array());
         let (kx, ky, kz) = (self.kx.index(), self.ky.index(), self.kz.index());
-        let ax = a[kx] - self.sx * a[kz];
-        let ay = a[ky] - self.sy * a[kz];
-        let bx = b[kx] - self.sx * b[kz];
-        let by = b[ky] - self.sy * b[kz];
-        let cx = c[kx] - self.sx * c[kz];
-        let cy = c[ky] - self.sy * c[kz];
-        // Edge functions: u for the edge opposite p0, v opposite p1, w opposite p2.
-        let mut u = cx * by - cy * bx;
-        let mut v = ax * cy - ay * cx;
-        let mut w = bx * ay - by * ax;
-        if u == 0.0 || v == 0.0 || w == 0.0 {
-            let edge = |px: f32, py: f32, qx: f32, qy: f32| {
-                (px as f64 * qy as f64 - py as f64 * qx as f64) as f32
-            };
-            u = edge(cx, cy, bx, by);
-            v = edge(ax, ay, cx, cy);
-            w = edge(bx, by, ax, ay);
-        }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-            return None;
-        }
-        let det = u + v + w;
-        if det == 0.0 || !det.is_finite() {
-            return None;
-        }
-        let (az, bz, cz) = (self.sz * a[kz], self.sz * b[kz], self.sz * c[kz]);
-        let t_scaled = u * az + v * bz + w * cz;
-        // t = t_scaled / det must lie in (0, t_max), without dividing first.
-        let inside = if det > 0.0 {
-            t_scaled > 0.0 && t_scaled < t_max * det
-        } else {
-            t_scaled < 0.0 && t_scaled > t_max * det
+        let permuted = |p: Vec3| {
+            let a = (p - self.origin).to_array();
+            [a[kx], a[ky], a[kz]]
         };
-        if !inside {
+        let shear = [self.sx, self.sy, self.sz];
+        let triangle = ShearedTriangle::new([p0, p1, p2].map(permuted), shear);
+        let mut uvw = triangle.edge_functions();
+        if uvw.contains(&0.0) {
+            uvw = triangle.edge_functions_f64();
+        }
+        let verdict = triangle.verdict(uvw, t_max);
+        if !verdict.hits {
             return None;
         }
-        let inv = 1.0 / det;
-        Some((t_scaled * inv, [u * inv, v * inv, w * inv]))
+        let inv = 1.0 / verdict.det;
+        Some((verdict.t_scaled * inv, uvw.map(|e| e * inv)))
+    }
+}
+
+/// A triangle in a ray's frame, the core of the watertight test written once
+/// for one ray and one triangle (`F = f32`), for one ray and several triangles
+/// ([`crate::triangle_packet`]) and for several rays and one triangle
+/// ([`crate::triangle_lanes`]): the corners' x and y sheared so that the ray
+/// runs along +z from the origin, and their z scaled by `1/d_z`.
+///
+/// Each lane performs the scalar test's IEEE operations in its order, so
+/// every caller's verdict and distance are bit for bit one another's.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ShearedTriangle<F> {
+    ax: F,
+    ay: F,
+    bx: F,
+    by: F,
+    cx: F,
+    cy: F,
+    az: F,
+    bz: F,
+    cz: F,
+}
+
+/// What [`ShearedTriangle::verdict`] finds.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Verdict<F: Float> {
+    /// Hit in (0, t_max): the edge functions share a sign, their sum `det` is
+    /// finite and nonzero, and `t_scaled / det` is in range.
+    pub hits: F::Mask,
+    /// `u·az + v·bz + w·cz`: the distance times `det`.
+    pub t_scaled: F,
+    pub det: F,
+}
+
+impl<F: Float> ShearedTriangle<F> {
+    /// The triangle with corners `corners` (each translated to the ray's
+    /// origin and permuted so that the ray's dominant axis is z: `[x, y, z]`),
+    /// sheared by the ray's `[sx, sy, sz]`.
+    #[inline(always)]
+    pub(crate) fn new([a, b, c]: [[F; 3]; 3], [sx, sy, sz]: [F; 3]) -> Self {
+        Self {
+            ax: a[0] - sx * a[2],
+            ay: a[1] - sy * a[2],
+            bx: b[0] - sx * b[2],
+            by: b[1] - sy * b[2],
+            cx: c[0] - sx * c[2],
+            cy: c[1] - sy * c[2],
+            az: sz * a[2],
+            bz: sz * b[2],
+            cz: sz * c[2],
+        }
+    }
+
+    /// The 2D edge functions at the origin: `u` for the edge opposite the
+    /// first corner, `v` opposite the second, `w` opposite the third.
+    #[inline(always)]
+    pub(crate) fn edge_functions(&self) -> [F; 3] {
+        let Self {
+            ax,
+            ay,
+            bx,
+            by,
+            cx,
+            cy,
+            ..
+        } = *self;
+        [cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax]
+    }
+
+    /// The lanes whose edge functions `uvw` hold an exact zero: the ray
+    /// passes through an edge or a corner, and the functions are to be
+    /// recomputed in double precision, for a consistent sign.
+    #[inline(always)]
+    pub(crate) fn on_edge([u, v, w]: [F; 3]) -> F::Mask {
+        u.eq(F::ZERO) | v.eq(F::ZERO) | w.eq(F::ZERO)
+    }
+
+    /// The hit test of Woop et al. from the edge functions `[u, v, w]`: the
+    /// ray hits iff they share a sign and `det = u + v + w` is finite and
+    /// nonzero, and then `t = (u·az + v·bz + w·cz) / det` must lie in
+    /// `(0, t_max)`, tested before dividing, on the scaled distance (the
+    /// inequality flips with the sign of `det`: the triangle seen from
+    /// behind).
+    #[inline(always)]
+    pub(crate) fn verdict(&self, [u, v, w]: [F; 3], t_max: F) -> Verdict<F> {
+        let zero = F::ZERO;
+        let det = u + v + w;
+        // Mixed signs are rejected. Where `det` is finite none of u, v, w is
+        // NaN (NaN would propagate into the sum), and there "no operand below
+        // zero" is "all at least zero": one mask for either sign.
+        let same_sign =
+            (u.ge(zero) & v.ge(zero) & w.ge(zero)) | (u.le(zero) & v.le(zero) & w.le(zero));
+        // det == 0 (degenerate triangle, or a ray in its plane) and overflow never hit.
+        let det_ok = !det.eq(zero) & det.is_finite();
+        let t_scaled = u * self.az + v * self.bz + w * self.cz;
+        let bound = t_max * det;
+        let front = det.gt(zero) & t_scaled.gt(zero) & t_scaled.lt(bound);
+        let back = det.lt(zero) & t_scaled.lt(zero) & t_scaled.gt(bound);
+        Verdict {
+            hits: same_sign & det_ok & (front | back),
+            t_scaled,
+            det,
+        }
+    }
+}
+
+impl ShearedTriangle<f32> {
+    /// [`Self::edge_functions`] in double precision, rounded to `f32`.
+    #[cold]
+    pub(crate) fn edge_functions_f64(&self) -> [f32; 3] {
+        let edge = |px: f32, py: f32, qx: f32, qy: f32| {
+            (px as f64 * qy as f64 - py as f64 * qx as f64) as f32
+        };
+        let Self {
+            ax,
+            ay,
+            bx,
+            by,
+            cx,
+            cy,
+            ..
+        } = *self;
+        [
+            edge(cx, cy, bx, by),
+            edge(ax, ay, cx, cy),
+            edge(bx, by, ax, ay),
+        ]
     }
 }
 

@@ -18,8 +18,10 @@
 //! passes exactly through an edge or a vertex, so lanes that need it are simply
 //! handed to the scalar test, off the common path.
 
-use crate::triangle::WatertightRay;
+use crate::lanes::Mask;
+use crate::triangle::{ShearedTriangle, WatertightRay};
 use glam::{Vec3, Vec4};
+use wide::f32x4;
 
 /// Four triangles, structure of arrays: `corners[v][axis]` holds coordinate `axis`
 /// (0 = x, 1 = y, 2 = z) of vertex `v` (0, 1, 2) of the four triangles, one per lane.
@@ -112,57 +114,31 @@ impl WatertightRay {
         }
     }
 
-    /// The vectorised test: exactly the operations of the scalar `intersect`, in the
-    /// same order, minus its double-precision fallback. Lanes with an edge function
-    /// of exactly zero are reported in `on_edge`; their `hits` bits are meaningless.
+    /// The vectorised test: exactly the operations of the scalar `intersect`
+    /// ([`ShearedTriangle`], the same code), minus its double-precision
+    /// fallback. Lanes with an edge function of exactly zero are reported in
+    /// `on_edge`; their `hits` bits are meaningless.
     #[inline]
     fn intersect4_simd(&self, packet: &TrianglePacket, t_max: f32) -> SimdResult {
         let (kx, ky, kz) = (self.kx.index(), self.ky.index(), self.kz.index());
-        let [p0, p1, p2] = &packet.corners;
-        // Translate to the ray origin (as `p - origin` in the scalar code), keeping
-        // only the permuted axes: index the axis arrays with kx, ky, kz.
         let o = self.origin.to_array();
-        let (ox, oy, oz) = (Vec4::splat(o[kx]), Vec4::splat(o[ky]), Vec4::splat(o[kz]));
-        let (a_x, a_y, a_z) = (p0[kx] - ox, p0[ky] - oy, p0[kz] - oz);
-        let (b_x, b_y, b_z) = (p1[kx] - ox, p1[ky] - oy, p1[kz] - oz);
-        let (c_x, c_y, c_z) = (p2[kx] - ox, p2[ky] - oy, p2[kz] - oz);
-        // Shear so that the ray runs along +z.
-        let (sx, sy) = (Vec4::splat(self.sx), Vec4::splat(self.sy));
-        let ax = a_x - sx * a_z;
-        let ay = a_y - sy * a_z;
-        let bx = b_x - sx * b_z;
-        let by = b_y - sy * b_z;
-        let cx = c_x - sx * c_z;
-        let cy = c_y - sy * c_z;
-        // Edge functions: u for the edge opposite p0, v opposite p1, w opposite p2.
-        let u = cx * by - cy * bx;
-        let v = ax * cy - ay * cx;
-        let w = bx * ay - by * ax;
-        let zero = Vec4::ZERO;
+        // Translated to the ray origin (as `p - origin` in the scalar code),
+        // keeping only the permuted axes: the axis arrays indexed with kx, ky, kz.
+        let permuted =
+            |p: &[Vec4; 3]| [kx, ky, kz].map(|k| f32x4::from(p[k].to_array()) - f32x4::splat(o[k]));
+        let shear = [self.sx, self.sy, self.sz].map(f32x4::splat);
+        let triangles = ShearedTriangle::new(packet.corners.each_ref().map(permuted), shear);
+        let uvw = triangles.edge_functions();
         // NaN == 0 is false: unused lanes never leave the SIMD path.
-        let on_edge = (u.cmpeq(zero) | v.cmpeq(zero) | w.cmpeq(zero)).bitmask();
-        let det = u + v + w;
-        // The scalar test rejects mixed signs, `(u < 0 || v < 0 || w < 0) && (u > 0
-        // || v > 0 || w > 0)`. Where `det` is finite none of u, v, w is NaN (NaN
-        // would propagate into the sum), and there "no operand below zero" is "all
-        // at least zero"; so accepting `all ≥ 0 or all ≤ 0` together with a finite
-        // `det` gives the same verdict in one mask, without a second movemask.
-        let same_sign = (u.cmpge(zero) & v.cmpge(zero) & w.cmpge(zero))
-            | (u.cmple(zero) & v.cmple(zero) & w.cmple(zero));
-        // det == 0 (degenerate triangle, or a ray in its plane) and overflow never hit.
-        let det_ok = det.cmpne(zero) & det.is_finite_mask();
-        let sz = Vec4::splat(self.sz);
-        let (az, bz, cz) = (sz * a_z, sz * b_z, sz * c_z);
-        let t_scaled = u * az + v * bz + w * cz;
-        // t = t_scaled / det in (0, t_max), tested without dividing; the inequality
-        // flips with the sign of det (the triangle seen from behind).
-        let bound = Vec4::splat(t_max) * det;
-        let front = det.cmpgt(zero) & t_scaled.cmpgt(zero) & t_scaled.cmplt(bound);
-        let back = det.cmplt(zero) & t_scaled.cmplt(zero) & t_scaled.cmpgt(bound);
-        let hits = (same_sign & det_ok & (front | back)).bitmask();
+        let on_edge = ShearedTriangle::on_edge(uvw).bits();
+        let verdict = triangles.verdict(uvw, f32x4::splat(t_max));
         // A true division, as in the scalar code: never an approximate reciprocal.
-        let t = t_scaled * (Vec4::ONE / det);
-        SimdResult { hits, t, on_edge }
+        let t = verdict.t_scaled * (f32x4::ONE / verdict.det);
+        SimdResult {
+            hits: verdict.hits.bits(),
+            t: Vec4::from_array(t.to_array()),
+            on_edge,
+        }
     }
 
     /// The rare lanes whose ray passes exactly through an edge or vertex: their

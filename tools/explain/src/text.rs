@@ -123,7 +123,8 @@ fn bvh_text(out: &mut String, sub: &str, path: &Value) {
             let primitives = leaf_primitives_text(&step["primitives"]);
             let limit = match &step["t_max"] {
                 Value::Null => "no hit yet".to_owned(),
-                t => format!("nearest so far t = {}", f(t)),
+                // The nearest hit so far, widened by PRUNE_SCALE.
+                t => format!("prunes beyond t = {}", f(t)),
             };
             writeln!(out, "{at}{} ({limit}): tests {}", name(step), primitives).unwrap();
         } else {

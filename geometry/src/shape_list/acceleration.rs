@@ -198,12 +198,13 @@ impl ShapeList {
                     self.shapes[s as usize].hit_distance_lanes(rays, t_max, tested)
                 }
                 _ => {
-                    let corners = packet.triangle(slot);
+                    let coordinate =
+                        |vertex: usize, axis: usize| packet.corners[vertex][axis][slot];
                     // Padding (NaN) ends a leaf's run.
-                    if corners[0].x.is_nan() {
+                    if coordinate(0, 0).is_nan() {
                         break;
                     }
-                    watertight.hits(&corners, t_max_lanes, reach)
+                    watertight.hits_of(coordinate, t_max_lanes, reach)
                 }
             };
             if visit(slot, hits & reach, t) {

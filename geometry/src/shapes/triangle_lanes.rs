@@ -129,19 +129,31 @@ impl<'a> WatertightLanes<'a> {
         t_max: F32Lanes,
         active: u32,
     ) -> (u32, F32Lanes) {
-        let permuted = |p: &Vec3| -> [F32Lanes; 3] {
-            let p = p.to_array();
+        self.hits_of(|vertex, axis| corners[vertex][axis], t_max, active)
+    }
+
+    /// [`Self::hits`] for the triangle whose corner `vertex`'s coordinate
+    /// `axis` is `coordinate(vertex, axis)`: read straight from where the
+    /// triangle is kept (a leaf's packet), with no copy of its corners.
+    #[inline(always)]
+    pub(crate) fn hits_of(
+        &self,
+        coordinate: impl Fn(usize, usize) -> f32,
+        t_max: F32Lanes,
+        active: u32,
+    ) -> (u32, F32Lanes) {
+        let permuted = |vertex: usize| -> [F32Lanes; 3] {
             let coordinates = match self.uniform {
-                Some(axes) => axes.map(|k| F32Lanes::splat(p[k])),
+                Some(axes) => axes.map(|k| F32Lanes::splat(coordinate(vertex, k))),
                 None => {
-                    let splat = p.map(F32Lanes::splat);
+                    let splat = [0, 1, 2].map(|k| F32Lanes::splat(coordinate(vertex, k)));
                     self.axes.map(|axis| axis.pick(splat))
                 }
             };
             // `p − origin` in the ray's frame: the scalar test's subtraction.
             [0, 1, 2].map(|i| coordinates[i] - self.origin[i])
         };
-        let triangle = ShearedTriangle::new(corners.each_ref().map(permuted), self.shear);
+        let triangle = ShearedTriangle::new([0, 1, 2].map(permuted), self.shear);
         let uvw = triangle.edge_functions();
         let verdict = triangle.verdict(uvw, t_max);
         let mut hits = verdict.hits.bits() & active;
@@ -149,7 +161,9 @@ impl<'a> WatertightLanes<'a> {
         let mut t = verdict.t_scaled * (F32Lanes::ONE / verdict.det);
         let on_edge = ShearedTriangle::on_edge(uvw).bits() & active;
         if on_edge != 0 {
-            (hits, t) = self.on_edges(corners, t_max, (hits, t), on_edge);
+            let corners =
+                [0, 1, 2].map(|v| Vec3::new(coordinate(v, 0), coordinate(v, 1), coordinate(v, 2)));
+            (hits, t) = self.on_edges(&corners, t_max, (hits, t), on_edge);
         }
         (hits, t)
     }

@@ -444,15 +444,16 @@ impl<'a> PixelRenderer<'a> {
         objects
     }
 
-    /// The radiance of a chunk's camera samples, by the route the scene
-    /// allows: all in lanes, first hits in lanes, or one by one.
+    /// The radiance of a chunk's camera samples, all in lanes (with their
+    /// rays' differentials where the scene reads footprints); one by one
+    /// only for an AOV or a traced sample.
     fn chunk_values<T: Tracer>(
         &self,
         chunk: &SampleChunk,
         candidates: u64,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        if self.all_in_lanes && !T::ON && chunk.jitters.len() > 1 {
+        if self.all_in_lanes && !T::ON {
             self.samples_in_lanes(chunk, candidates, ctx)
         } else {
             self.samples_by_rays(chunk, ctx)
@@ -475,9 +476,8 @@ impl<'a> PixelRenderer<'a> {
     }
 
     /// The radiance (or AOV) of a chunk's camera samples, each camera ray made
-    /// with its differentials: their closest hits found together where the
-    /// scene's layout allows it (the same hits) and then shaded together,
-    /// else one by one.
+    /// with its differentials: their closest hits found together and then
+    /// shaded together, or, for an AOV or a traced sample, one by one.
     fn samples_by_rays<T: Tracer>(
         &self,
         chunk: &SampleChunk,
@@ -493,7 +493,7 @@ impl<'a> PixelRenderer<'a> {
                 (rays, diffs)
             }
         };
-        let closest = (settings.aov.is_none() && used > 1 && !T::ON)
+        let closest = (settings.aov.is_none() && !T::ON)
             .then(|| scene.shapes.closest_lanes(&ray_lanes, used));
         match &closest {
             Some(closest) => (self.integrator).li_first_hits(

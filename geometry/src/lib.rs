@@ -21,7 +21,10 @@
 //!   light's surface ([`RayTarget`]). No distance is a fixed epsilon.
 //! - Triangles are intersected watertightly ([`triangle`]): rays through shared
 //!   edges and vertices of a closed mesh never slip through. Hits at exactly equal
-//!   distances go to the lowest object index, with or without the BVH.
+//!   distances go to the lowest object index, with or without the BVH, and a
+//!   ray's closest hit never depends on the order primitives are met in (every
+//!   one is tested up to the query's limit; the nearest so far only prunes
+//!   boxes), so it is the same alone or in lanes.
 //! - The BVH ([`bvh`]) is 4-wide; meshes' triangles sit in its leaves as
 //!   [`TrianglePacket`]s of four, tested together ([`triangle_packet`]).
 //! - Batches of rays ([`ShapeList::closest_primitives`], [`ShapeList::any_hits`])
@@ -48,9 +51,10 @@
 //!   on the surface ([`SurfaceDifferentials`]); [`reflect_differential`] follows it
 //!   through a mirror.
 //! - [`lanes::Vec3Lanes`]: [`lanes::LANES`] (16) 3-vectors in SIMD lanes, each lane bit for bit the
-//!   scalar arithmetic, for shading a point's light samples together; their
-//!   shadow rays as [`RayLanes`], tested 16 at a time against one shape
-//!   ([`Sphere::hits_lanes`]) by [`ShapeList::any_hits_among`].
+//!   scalar arithmetic, for shading a chunk's samples together; their rays as
+//!   [`RayLanes`]: closest hits by [`ShapeList::closest_lanes`], shadow rays by
+//!   [`ShapeList::any_hits_among`], each shape and triangle tested against all
+//!   the lanes at once and the BVH walked by all of them together.
 //! - [`bvh::Bvh`] on its own: a BVH over any primitives given by their bounds.
 
 pub mod bvh;

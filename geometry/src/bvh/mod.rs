@@ -40,8 +40,9 @@
 //! - `prepared_ray`: the ray–node test, four child boxes at once.
 //! - `traversal_stack`: the children still to visit, front to back.
 //! - `traversal`: the single-ray queries.
-//! - `traversal_lanes`: one any-hit query for several rays at once, one ray per
-//!   SIMD lane ([`Bvh::any_hit_lanes`]).
+//! - `traversal_lanes`: several rays walking the tree at once, one ray per
+//!   SIMD lane: any hit ([`Bvh::any_hit_lanes`]) and the leaves for closest
+//!   hits ([`Bvh::traverse_leaves_lanes`]), each lane pruning by its own limit.
 //! - `stream`: traversal of a batch of rays, interleaved.
 //! - `trail`: the steps of one query, recorded for `glint explain`.
 //! - `stats`: [`BvhStats`].

@@ -1,7 +1,9 @@
-//! [`LANES`] shadow rays through the tree together ([`Bvh::any_hit_lanes`]): the
-//! shadow rays of one shading point start at the same point and end on the same
-//! light, so they enter nearly the same nodes, and one walk of the tree with all
-//! them in SIMD lanes replaces as many walks.
+//! [`LANES`] rays through the tree together: shadow rays ([`Bvh::any_hit_lanes`])
+//! and camera or mirror rays looking for their closest hits
+//! ([`Bvh::traverse_leaves_lanes`]). The shadow rays of one shading point, or of a
+//! pixel's points, to one light, and a pixel's camera rays, enter nearly the same
+//! nodes, so one walk of the tree with all of them in SIMD lanes replaces as many
+//! walks.
 //!
 //! The node test is [`PreparedRay::enters`](super::prepared_ray) lane by lane:
 //! each (ray, child) pair performs its scalar operations in the same order, the

@@ -77,7 +77,7 @@ pub use offset::{offset_ray_origin, offset_ray_origins, spawn_ray, spawn_ray_to,
 pub use ray::{Ray, RayLanes};
 pub use shape_list::{
     BvhRef, BvhVisit, ChildVisit, ClosestExplained, ClosestLanes, LeafPrimitive, ObjectRef,
-    ObjectTest, Occluders, PrimitiveHit, ShapeList,
+    ObjectTest, Occluders, PrimitiveHit, ShapeList, PRUNE_SCALE,
 };
 pub(crate) use shapes::triangle_lanes;
 pub use shapes::{triangle, triangle_packet};

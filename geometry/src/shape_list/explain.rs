@@ -86,7 +86,7 @@ pub enum BvhVisit {
         children: Vec<ChildVisit>,
     },
     /// A leaf reached while the query pruned boxes beyond `t_max` (the
-    /// nearest hit so far times [`PRUNE_SCALE`](super::closest::PRUNE_SCALE),
+    /// nearest hit so far times [`PRUNE_SCALE`](crate::PRUNE_SCALE),
     /// or the `t_max` given to [`ShapeList::explain_closest`]); its primitives
     /// are tested up to the `t_max` given.
     Leaf {

@@ -18,7 +18,7 @@ mod frustum;
 mod linear;
 mod occluders;
 
-pub use closest::{ClosestLanes, PrimitiveHit};
+pub use closest::{ClosestLanes, PrimitiveHit, PRUNE_SCALE};
 pub use explain::{BvhRef, BvhVisit, ChildVisit, ClosestExplained, LeafPrimitive, ObjectTest};
 pub use occluders::Occluders;
 

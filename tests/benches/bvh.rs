@@ -13,9 +13,8 @@
 //! Each figure is the median of 3 runs. Rays are traced in parallel (rayon) over
 //! batches; the rays themselves are made before the clock starts.
 
-use glam::Vec3;
 use glint_geometry::{Ray, ShapeList};
-use glint_tests::displaced_grid;
+use glint_tests::{camera_rays, displaced_grid, random_rays};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
@@ -50,7 +49,7 @@ fn main() {
             start.elapsed()
         });
         list.build_bvh();
-        let coherent = camera_rays(RAYS);
+        let coherent = camera_rays(RAYS, false);
         let incoherent = random_rays(RAYS);
         let coherent_time = median(|| trace(&list, &coherent, Query::Primitive));
         let incoherent_time = median(|| trace(&list, &incoherent, Query::Primitive));
@@ -111,42 +110,4 @@ fn median(mut f: impl FnMut() -> Duration) -> Duration {
     let mut times: Vec<Duration> = (0..RUNS).map(|_| f()).collect();
     times.sort();
     times[RUNS / 2]
-}
-
-/// A pinhole camera's rays over a square image, row by row, looking down at the grid.
-fn camera_rays(n: usize) -> Vec<Ray> {
-    let side = (n as f64).sqrt() as usize;
-    let eye = Vec3::new(0.0, 1.5, 2.0);
-    let forward = (Vec3::new(0.0, 0.0, -0.2) - eye).normalize();
-    let right = forward.cross(Vec3::Y).normalize();
-    let up = right.cross(forward);
-    (0..n)
-        .map(|i| {
-            let (x, y) = (
-                (i % side) as f32 / side as f32 - 0.5,
-                (i / side) as f32 / side as f32 - 0.5,
-            );
-            Ray::new(eye, forward + 0.9 * (x * right - y * up))
-        })
-        .collect()
-}
-
-/// Random origins above and around the grid, random directions on the sphere.
-fn random_rays(n: usize) -> Vec<Ray> {
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        state ^= state >> 12;
-        state ^= state << 25;
-        state ^= state >> 27;
-        ((state.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32) / (1u64 << 24) as f32
-    };
-    (0..n)
-        .map(|_| {
-            let origin = Vec3::new(2.0 * next() - 1.0, 0.5 * next() - 0.1, 2.0 * next() - 1.0);
-            let z = 2.0 * next() - 1.0;
-            let phi = std::f32::consts::TAU * next();
-            let r = (1.0 - z * z).sqrt();
-            Ray::new(origin, Vec3::new(r * phi.cos(), z, r * phi.sin()))
-        })
-        .collect()
 }

@@ -5,8 +5,11 @@
 //! # Entry points
 //! - [`scenes_dir`], [`scene_path`] and [`shipped_scenes`]: where the shipped scene
 //!   files are, and their names.
-//! - [`displaced_grid`]: a generated mesh of any size, for the BVH benchmark.
+//! - [`displaced_grid`]: a generated mesh of any size, for the BVH benchmarks;
+//!   [`camera_rays`] and [`random_rays`]: the rays they trace into it.
 
+use glam::Vec3;
+use glint_geometry::Ray;
 use std::path::PathBuf;
 
 /// The repository's `scenes/` directory.
@@ -43,3 +46,63 @@ pub fn displaced_grid(triangles: usize) -> glint_geometry::TriangleMesh {
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
+
+/// xorshift64*: uniform numbers in [0, 1) from a seed, for benchmark rays.
+pub struct XorShift(pub u64);
+
+impl XorShift {
+    /// The next number in [0, 1).
+    pub fn unit(&mut self) -> f32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        ((self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32) / (1u64 << 24) as f32
+    }
+}
+
+/// About `n` rays of a pinhole camera over a square image, looking down at
+/// [`displaced_grid`]: row by row, or (`tiled`) in 4 × 4 pixel tiles, each
+/// sixteen consecutive rays one tile, as the renderer traces a pixel's samples.
+pub fn camera_rays(n: usize, tiled: bool) -> Vec<Ray> {
+    let side = match tiled {
+        true => (n as f64).sqrt() as usize / 4 * 4,
+        false => (n as f64).sqrt() as usize,
+    };
+    let eye = Vec3::new(0.0, 1.5, 2.0);
+    let forward = (Vec3::new(0.0, 0.0, -0.2) - eye).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let count = if tiled { side * side } else { n };
+    (0..count)
+        .map(|i| {
+            let (px, py) = match tiled {
+                true => {
+                    let (tile, k, tiles) = (i / 16, i % 16, side / 4);
+                    ((tile % tiles) * 4 + k % 4, (tile / tiles) * 4 + k / 4)
+                }
+                false => (i % side, i / side),
+            };
+            let (x, y) = (px as f32 / side as f32 - 0.5, py as f32 / side as f32 - 0.5);
+            Ray::new(eye, forward + 0.9 * (x * right - y * up))
+        })
+        .collect()
+}
+
+/// `n` rays from random origins above and around [`displaced_grid`] in
+/// random directions on the sphere.
+pub fn random_rays(n: usize) -> Vec<Ray> {
+    let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
+    (0..n)
+        .map(|_| {
+            let origin = Vec3::new(
+                2.0 * rng.unit() - 1.0,
+                0.5 * rng.unit() - 0.1,
+                2.0 * rng.unit() - 1.0,
+            );
+            let z = 2.0 * rng.unit() - 1.0;
+            let phi = std::f32::consts::TAU * rng.unit();
+            let r = (1.0 - z * z).sqrt();
+            Ray::new(origin, Vec3::new(r * phi.cos(), z, r * phi.sin()))
+        })
+        .collect()
+}

@@ -120,8 +120,8 @@ impl Bvh {
                 Err(_) => &mut own,
             };
             stack.clear();
-            stack.push((Link::ROOT, active, F32Lanes::ZERO));
-            while let Some((link, reach, enter)) = stack.pop() {
+            let mut next = Some((Link::ROOT, active, F32Lanes::ZERO));
+            while let Some((link, reach, enter)) = next.take().or_else(|| stack.pop()) {
                 let reach = reach & enter.simd_lt(*limit).to_bitmask();
                 if reach == 0 {
                     continue;
@@ -134,29 +134,33 @@ impl Bvh {
                 }
                 count(|c| c.bvh_nodes += u64::from(reach.count_ones()));
                 let node = &self.tree.nodes[link.node()];
-                // The children entered, nearest (by the lowest lane's entry) last.
-                let mut entered = [(0.0, Link::ROOT, 0, F32Lanes::ZERO); WIDTH];
-                let mut n = 0;
-                for child in 0..WIDTH {
+                let tests: [(u32, F32Lanes); WIDTH] = std::array::from_fn(|child| {
                     let (hits, enter) = lanes.enter_child_before(&node.planes, child, *limit);
-                    let hits = hits & reach;
-                    if hits == 0 {
+                    (hits & reach, enter)
+                });
+                // The children entered, farthest first (by the lowest lane's
+                // entry): the nearest is visited next, the others stacked.
+                let mut order = [(0.0f32, 0usize); WIDTH];
+                let mut n = 0;
+                for (child, (hits, enter)) in tests.iter().enumerate() {
+                    if *hits == 0 {
                         continue;
                     }
                     let key = enter.as_array()[hits.trailing_zeros() as usize];
                     let mut k = n;
-                    while k > 0 && entered[k - 1].0 < key {
-                        entered[k] = entered[k - 1];
+                    while k > 0 && order[k - 1].0 < key {
+                        order[k] = order[k - 1];
                         k -= 1;
                     }
-                    entered[k] = (key, node.link(child), hits, enter);
+                    order[k] = (key, child);
                     n += 1;
                 }
-                stack.extend(
-                    entered[..n]
-                        .iter()
-                        .map(|&(_, link, hits, enter)| (link, hits, enter)),
-                );
+                let entry =
+                    |&(_, child): &(f32, usize)| (node.link(child), tests[child].0, tests[child].1);
+                if let Some((nearest, farther)) = order[..n].split_last() {
+                    stack.extend(farther.iter().map(entry));
+                    next = Some(entry(nearest));
+                }
             }
         })
     }

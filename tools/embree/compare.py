@@ -93,7 +93,7 @@ def main():
                       f"**{statistics.median(ratios):.2f}×** ({min(ratios):.2f}–{max(ratios):.2f}) |")
             gb = statistics.median(v["build"] for v in glint)
             eb = statistics.median(v["build"] for v in embree)
-            print(f"| BVH build, ms | {gb:.0f} | {eb:.0f} | {eb / gb:.2f}× the speed |")
+            print(f"| BVH build, ms | {gb:.0f} | {eb:.0f} | {gb / eb:.2f}× Embree's time |")
             gbytes = statistics.median(v["bytes per triangle"] for v in glint)
             ebytes = statistics.median(v["bytes per triangle"] for v in embree)
             print(f"| bytes per triangle (mesh and BVH) | {gbytes:.0f} | {ebytes:.0f} | |\n")

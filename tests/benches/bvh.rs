@@ -106,8 +106,6 @@ fn trace(list: &ShapeList, rays: &[Ray], query: Query) -> Duration {
     elapsed
 }
 
-fn median(mut f: impl FnMut() -> Duration) -> Duration {
-    let mut times: Vec<Duration> = (0..RUNS).map(|_| f()).collect();
-    times.sort();
-    times[RUNS / 2]
+fn median(f: impl FnMut() -> Duration) -> Duration {
+    glint_tests::median_time(RUNS, f)
 }

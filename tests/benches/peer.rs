@@ -326,10 +326,8 @@ fn trace(list: &ShapeList, rays: &[Ray], t_max: &[f32], query: Query) -> Duratio
     elapsed
 }
 
-fn median(mut f: impl FnMut() -> Duration) -> Duration {
-    let mut times: Vec<Duration> = (0..RUNS).map(|_| f()).collect();
-    times.sort();
-    times[RUNS / 2]
+fn median(f: impl FnMut() -> Duration) -> Duration {
+    glint_tests::median_time(RUNS, f)
 }
 
 /// From each camera ray's hit on the grid (just above the surface) to a

@@ -6,11 +6,13 @@
 //! - [`scenes_dir`], [`scene_path`] and [`shipped_scenes`]: where the shipped scene
 //!   files are, and their names.
 //! - [`displaced_grid`]: a generated mesh of any size, for the BVH benchmarks;
-//!   [`camera_rays`] and [`random_rays`]: the rays they trace into it.
+//!   [`camera_rays`] and [`random_rays`]: the rays they trace into it;
+//!   [`median_time`]: their timings.
 
 use glam::Vec3;
 use glint_geometry::Ray;
 use std::path::PathBuf;
+use std::time::Duration;
 
 /// The repository's `scenes/` directory.
 pub fn scenes_dir() -> PathBuf {
@@ -105,4 +107,11 @@ pub fn random_rays(n: usize) -> Vec<Ray> {
             Ray::new(origin, Vec3::new(r * phi.cos(), z, r * phi.sin()))
         })
         .collect()
+}
+
+/// The median of `runs` timings by `f` (for the benchmarks).
+pub fn median_time(runs: usize, mut f: impl FnMut() -> Duration) -> Duration {
+    let mut times: Vec<Duration> = (0..runs).map(|_| f()).collect();
+    times.sort();
+    times[runs / 2]
 }

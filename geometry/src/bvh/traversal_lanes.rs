@@ -48,15 +48,7 @@ impl Bvh {
             return 0;
         }
         let lanes = PreparedRayLanes::new(rays, t_max);
-        STACK.with(|cell| {
-            let mut own = Vec::new();
-            let mut borrowed = cell.try_borrow_mut();
-            let stack = match borrowed.as_mut() {
-                Ok(stack) => &mut **stack,
-                // A query made from inside another's leaf visit: a stack of its own.
-                Err(_) => &mut own,
-            };
-            stack.clear();
+        with_stack(&STACK, |stack| {
             stack.push((Link::ROOT, active));
             let mut found = 0u32;
             while let Some((link, reach)) = stack.pop() {
@@ -112,14 +104,7 @@ impl Bvh {
             return;
         }
         let lanes = PreparedRayLanes::new(rays, f32::INFINITY);
-        NEAREST_STACK.with(|cell| {
-            let mut own = Vec::new();
-            let mut borrowed = cell.try_borrow_mut();
-            let stack = match borrowed.as_mut() {
-                Ok(stack) => &mut **stack,
-                Err(_) => &mut own,
-            };
-            stack.clear();
+        with_stack(&NEAREST_STACK, |stack| {
             let mut next = Some((Link::ROOT, active, F32Lanes::ZERO));
             while let Some((link, reach, enter)) = next.take().or_else(|| stack.pop()) {
                 let reach = reach & enter.simd_lt(*limit).to_bitmask();
@@ -164,6 +149,21 @@ impl Bvh {
             }
         })
     }
+}
+
+/// Runs `walk` with this thread's stack `key`, emptied, or a stack of its own
+/// for a query made from inside another's leaf visit.
+fn with_stack<T: 'static, R>(
+    key: &'static std::thread::LocalKey<RefCell<Vec<T>>>,
+    walk: impl FnOnce(&mut Vec<T>) -> R,
+) -> R {
+    key.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut stack) => {
+            stack.clear();
+            walk(&mut stack)
+        }
+        Err(_) => walk(&mut Vec::new()),
+    })
 }
 
 /// The lanes of `rays` with a NaN in the origin or direction.

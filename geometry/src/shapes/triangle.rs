@@ -215,19 +215,11 @@ impl ShearedTriangle<f32> {
         let edge = |px: f32, py: f32, qx: f32, qy: f32| {
             (px as f64 * qy as f64 - py as f64 * qx as f64) as f32
         };
-        let Self {
-            ax,
-            ay,
-            bx,
-            by,
-            cx,
-            cy,
-            ..
-        } = *self;
+        let (a, b, c) = ((self.ax, self.ay), (self.bx, self.by), (self.cx, self.cy));
         [
-            edge(cx, cy, bx, by),
-            edge(ax, ay, cx, cy),
-            edge(bx, by, ax, ay),
+            edge(c.0, c.1, b.0, b.1),
+            edge(a.0, a.1, c.0, c.1),
+            edge(b.0, b.1, a.0, a.1),
         ]
     }
 }

@@ -153,16 +153,21 @@ impl Bvh {
 
 /// Runs `walk` with this thread's stack `key`, emptied, or a stack of its own
 /// for a query made from inside another's leaf visit.
+#[inline(always)]
 fn with_stack<T: 'static, R>(
     key: &'static std::thread::LocalKey<RefCell<Vec<T>>>,
     walk: impl FnOnce(&mut Vec<T>) -> R,
 ) -> R {
-    key.with(|cell| match cell.try_borrow_mut() {
-        Ok(mut stack) => {
-            stack.clear();
-            walk(&mut stack)
-        }
-        Err(_) => walk(&mut Vec::new()),
+    key.with(|cell| {
+        let mut own = Vec::new();
+        let mut borrowed = cell.try_borrow_mut();
+        let stack = match borrowed.as_mut() {
+            Ok(stack) => &mut **stack,
+            Err(_) => &mut own,
+        };
+        stack.clear();
+        // One call: the walk is inlined here, as into the queries before.
+        walk(stack)
     })
 }
 

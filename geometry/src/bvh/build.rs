@@ -17,6 +17,10 @@ use super::{index_u32, Bvh};
 pub(super) const MAX_DEPTH: usize = 64;
 /// Subtrees over more primitives than this are built on two rayon tasks.
 const PARALLEL_THRESHOLD: usize = 4096;
+/// Nodes over this many primitives (those near the root, whose passes would
+/// otherwise run on one thread while the others wait) are binned in chunks
+/// of it on every thread.
+const BINNING_CHUNK: usize = 1 << 15;
 
 impl Bvh {
     /// Builds with binned SAH (Wald 2007; pbrt-v4 §7.3.2), then collapses the
@@ -69,12 +73,16 @@ impl Bvh {
 pub(super) struct BuildOptions {
     pub(super) max_depth: usize,
     pub(super) parallel_threshold: usize,
+    /// Nodes over this many primitives are binned in chunks of it, on every
+    /// thread (the same bins as in one pass).
+    pub(super) binning_chunk: usize,
 }
 
 impl BuildOptions {
     pub(super) const DEFAULT: BuildOptions = BuildOptions {
         max_depth: MAX_DEPTH,
         parallel_threshold: PARALLEL_THRESHOLD,
+        binning_chunk: BINNING_CHUNK,
     };
 }
 
@@ -162,7 +170,9 @@ fn build_subtree(
         build_serial(prims, extents, first, depth_budget, &mut nodes);
         return Subtree::Serial(nodes);
     }
-    let Some((mid, left_extents, right_extents)) = split(prims, extents, depth_budget) else {
+    let chunk = options.binning_chunk;
+    let Some((mid, left_extents, right_extents)) = split(prims, extents, depth_budget, chunk)
+    else {
         let leaf = BvhNode::leaf(&extents.bounds.bounds3(), first, prims.len());
         return Subtree::Serial(vec![leaf]);
     };
@@ -194,7 +204,8 @@ fn build_serial(
     nodes: &mut Vec<BvhNode>,
 ) {
     let bounds = extents.bounds.bounds3();
-    let Some((mid, left_extents, right_extents)) = split(prims, extents, depth_budget) else {
+    let Some((mid, left_extents, right_extents)) = split(prims, extents, depth_budget, usize::MAX)
+    else {
         nodes.push(BvhNode::leaf(&bounds, first, prims.len()));
         return;
     };
@@ -208,12 +219,14 @@ fn build_serial(
 
 /// Decides whether the node over `prims` is split; if so partitions `prims` in
 /// place and returns the number going to the first child and both children's
-/// extents, else `None` for a leaf. A node of at most [`MAX_LEAF_PRIMITIVES`] is a
+/// extents, else `None` for a leaf. Nodes over `binning_chunk` primitives
+/// are binned in chunks of it on every thread. A node of at most [`MAX_LEAF_PRIMITIVES`] is a
 /// leaf: its one packet test costs `C_isect`, and a split at least `C_trav` more.
 fn split(
     prims: &mut [BuildPrimitive],
     extents: &Extents,
     depth_budget: usize,
+    binning_chunk: usize,
 ) -> Option<(usize, Extents, Extents)> {
     let n = prims.len();
     if n <= MAX_LEAF_PRIMITIVES || depth_budget == 0 {
@@ -225,7 +238,7 @@ fn split(
     let cheapest = if n <= SWEEP_MAX_PRIMITIVES {
         sweep_split(prims, extents)
     } else {
-        best_binned_split(prims, extents).map(|plane| {
+        best_binned_split(prims, extents, binning_chunk).map(|plane| {
             let mid = partition(prims, |p| plane.goes_left(p));
             debug_assert_eq!(mid, plane.left.count as usize);
             (mid, plane.left, plane.right)

@@ -179,21 +179,46 @@ impl SplitPlane {
 pub(super) fn best_binned_split(
     prims: &mut [BuildPrimitive],
     extents: &Extents,
+    binning_chunk: usize,
 ) -> Option<SplitPlane> {
     let area = extents.bounds.surface_area();
     if !(area > 0.0 && area.is_finite()) {
         return None;
     }
     let binning = Binning::new(&extents.centroids);
-    let bins = fill_bins(prims, &binning);
+    let bins = fill_bins(prims, &binning, binning_chunk);
     (0..3)
         .filter_map(|axis| cheapest_plane(&bins[axis], area, axis))
         .reduce(|best, plane| if plane.cost < best.cost { plane } else { best })
 }
 
 /// Sorts the primitives into the bins of all three axes in one pass, noting
-/// each one's bins in it.
-fn fill_bins(prims: &mut [BuildPrimitive], binning: &Binning) -> [[Extents; BIN_COUNT]; 3] {
+/// each one's bins in it; over `chunk` primitives, chunk by chunk on every
+/// thread. The bins are the same either way: a bin's bounds are minima and
+/// maxima, and its count a sum.
+fn fill_bins(
+    prims: &mut [BuildPrimitive],
+    binning: &Binning,
+    chunk: usize,
+) -> [[Extents; BIN_COUNT]; 3] {
+    if prims.len() <= chunk {
+        return fill_bins_serial(prims, binning);
+    }
+    use rayon::prelude::*;
+    prims
+        .par_chunks_mut(chunk)
+        .map(|chunk| fill_bins_serial(chunk, binning))
+        .reduce(
+            || [[Extents::EMPTY; BIN_COUNT]; 3],
+            |a, b| {
+                std::array::from_fn(|axis| {
+                    std::array::from_fn(|bin| a[axis][bin].merge(b[axis][bin]))
+                })
+            },
+        )
+}
+
+fn fill_bins_serial(prims: &mut [BuildPrimitive], binning: &Binning) -> [[Extents; BIN_COUNT]; 3] {
     let mut bins = [[Extents::EMPTY; BIN_COUNT]; 3];
     for prim in prims {
         let centroid = prim.centroid();

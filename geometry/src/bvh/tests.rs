@@ -341,6 +341,30 @@ fn build_is_deterministic_across_runs_and_thread_counts() {
         layout(&serial),
         "parallel and serial layouts differ"
     );
+    // Binned in chunks of 1000 on every thread, and in one pass: the same tree.
+    let binned_apart = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let options = BuildOptions {
+                    binning_chunk: 1000,
+                    ..BuildOptions::DEFAULT
+                };
+                Bvh::build_with(&bounds, options)
+            })
+    };
+    let in_one_pass = Bvh::build_with(
+        &bounds,
+        BuildOptions {
+            binning_chunk: usize::MAX,
+            ..BuildOptions::DEFAULT
+        },
+    );
+    assert_eq!(layout(&in_one_pass), layout(&binned_apart(1)));
+    assert_eq!(layout(&in_one_pass), layout(&binned_apart(3)));
+    assert_eq!(layout(&first), layout(&in_one_pass));
 }
 
 // ---- Build time ----

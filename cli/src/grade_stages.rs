@@ -24,7 +24,7 @@ pub(crate) struct StageArgs {
 
 /// Writes the vectors or checks the answers. Exit status (through
 /// [`Failure`]): 0 when written, or when every answered case passes; 1
-/// ([`Failure::Verdict(None)`]) when a case fails; 2 for bad input; 3 for a
+/// ([`Failure::Verdict`], with no message) when a case fails; 2 for bad input; 3 for a
 /// failure of Glint's own.
 pub(crate) fn run(args: &StageArgs) -> Result<(), Failure> {
     let cases = args.cases.unwrap_or(DEFAULT_CASES);

@@ -42,7 +42,7 @@ pub struct RenderSettings {
     /// How those points are mapped to directions: by the map's luminance or
     /// by the cosine about the shading normal.
     pub environment_sampling: EnvironmentSampling,
-    /// Gather the detailed counts of [`RenderStats`] (intersection tests, BVH
+    /// Gather the detailed counts of [`RenderStats`](crate::RenderStats) (intersection tests, BVH
     /// visits, texture lookups by level); the image is the same either way.
     pub stats: bool,
     /// Physical shading: how area lights are sampled.

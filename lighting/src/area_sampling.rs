@@ -113,7 +113,7 @@ impl AreaLight {
     /// The sampler of this light for the shading point `reference` by
     /// `strategy` (solid angle falls back to area for a parallelogram that is
     /// not a rectangle, a point in the light's plane, or a solid angle outside
-    /// [`SOLID_ANGLE_RANGE`]).
+    /// `SOLID_ANGLE_RANGE`).
     pub fn sampler(&self, reference: Vec3, strategy: AreaSampling) -> AreaLightSampler<'_> {
         self.sampler_from(&reference.into(), strategy, true)
     }

@@ -254,7 +254,7 @@ impl EnvironmentLight {
 
     /// A direction cosine-weighted about the unit `normal` for uniform `u`,
     /// with the radiance along it ([`Self::radiance`], no width) and its
-    /// density `cos θ / π` ([`cosine_direction_of`]).
+    /// density `cos θ / π` (`cosine_direction_of`).
     pub fn sample_cosine(&self, normal: Vec3, u: Vec2) -> EnvironmentSample {
         let n = Vector3::new(normal.x, normal.y, normal.z);
         let (d, pdf) = cosine_direction_of(&n, u.x, u.y);

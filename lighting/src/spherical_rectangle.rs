@@ -8,7 +8,7 @@
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{atan2_approx, sin_cos_approx, Float, Vector3};
 
-/// The rectangle `corner + s·ex + t·ey`, s,t ∈ [0,1], (ex ⟂ ey) as seen from `reference`,
+/// The rectangle `corner + s·ex + t·ey`, s, t ∈ `[0, 1]`, (ex ⟂ ey) as seen from `reference`,
 /// from one point (`F = f32`) or from each lane's (`F` lanes of them): one kernel
 /// for both, each lane bit for bit the scalar rectangle. Its angles are the
 /// polynomial [`atan2_approx`] and [`sin_cos_approx`] (within 1e-6 rad and 1e-7
@@ -55,7 +55,7 @@ impl SphericalRectangle {
             .and_then(|(rectangle, seen)| seen.then_some(rectangle))
     }
 
-    /// The point on the rectangle for u ∈ [0,1]², distributed uniformly in solid
+    /// The point on the rectangle for u ∈ `[0, 1]²`, distributed uniformly in solid
     /// angle ([`Self::sample_at`]).
     #[inline]
     pub fn sample(&self, u: Vec2) -> Vec3 {
@@ -162,9 +162,9 @@ impl<F: Float> SphericalRectangle<F> {
         self.solid_angle
     }
 
-    /// The point on the rectangle for `(ux, uy)` ∈ [0,1]², distributed uniformly
+    /// The point on the rectangle for `(ux, uy)` ∈ `[0, 1]²`, distributed uniformly
     /// in solid angle; the map is continuous and area preserving (strata of
-    /// [0,1]² map to equal solid angles).
+    /// `[0, 1]²` map to equal solid angles).
     ///
     /// `ux` moves along `ex` and `uy` along `ey`, both monotonically: `(0,0)` maps to
     /// `corner`, `(1,0)` to `corner + ex`, `(0,1)` to `corner + ey` and `(1,1)` to the

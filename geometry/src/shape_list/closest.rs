@@ -198,12 +198,10 @@ impl ShapeList {
         used: usize,
         candidates: u64,
     ) -> ClosestLanes {
-        let active = lanes::all_bits()
-            & u32::MAX
-                .checked_shl(used.min(LANES) as u32)
-                .map_or(u32::MAX, |m| !m);
+        let active = lanes::bits(lanes::first_lanes(used));
         let tested = u64::from(active.count_ones());
         let mut search = LanesSearch::new();
+        // The rays' triangle tests, prepared once, when a triangle is first met.
         let watertight = OnceCell::new();
         let watertight = || watertight.get_or_init(|| WatertightLanes::new(rays, active));
         let packed = |o: &&u32| **o != u32::MAX && (**o >= 64 || candidates >> **o & 1 == 1);
@@ -230,8 +228,8 @@ impl ShapeList {
         }
         if let Some(bvh) = &self.bvh {
             let mut limit = search.limit();
-            let walked = (rays, watertight());
             bvh.traverse_leaves_lanes(rays, active, &mut limit, |first, _, reach, limit| {
+                let walked = (rays, watertight());
                 self.leaf_hits_lanes(first, walked, f32::INFINITY, reach, |slot, hits, t| {
                     if hits != 0 {
                         let p = self.primitives[first as usize + slot];

@@ -15,7 +15,6 @@ use super::{LinearShapes, ObjectRef, ShapeList};
 use crate::bvh::Bounds3;
 use crate::counters::count;
 use crate::lanes::{self, F32Lanes, LANES};
-use crate::triangle::WatertightRay;
 use crate::triangle_lanes::WatertightLanes;
 use crate::{Ray, RayLanes, Shape};
 use glam::{Vec3, Vec4};
@@ -407,29 +406,34 @@ impl ShapeList {
     }
 
     /// The lanes of `active` whose ray meets an unbounded plane or a primitive
-    /// of the BVH (none without one), the BVH walked by all the lanes at once
+    /// of the BVH (none without one): each plane against all the rays at once,
+    /// the BVH walked by all of them together
     /// ([`Bvh::any_hit_lanes`](crate::bvh::Bvh::any_hit_lanes)).
     fn bvh_hits_lanes(&self, rays: &RayLanes, t_max: f32, active: u32) -> u32 {
         let Some(bvh) = &self.bvh else {
             return 0;
         };
-        let mut blocked = match self.unbounded.is_empty() {
-            true => 0,
-            false => self.lane_by_lane(active, |lane| {
-                let ray = rays.lane(lane);
-                self.unbounded_hit(&ray, &WatertightRay::new(&ray), t_max)
-            }),
-        };
-        let watertight = WatertightLanes::new(rays, active & !blocked);
-        blocked |= bvh.any_hit_lanes(rays, t_max, active & !blocked, |first, _, reach| {
+        let tested = u64::from(active.count_ones());
+        let blocked =
+            (self.unbounded.iter()).fold(0, |blocked, &object| match self.object(object) {
+                ObjectRef::Shape(plane) => {
+                    blocked | plane.hit_distance_lanes(rays, t_max, tested).0
+                }
+                ObjectRef::Mesh(_) => unreachable!("the unbounded objects are planes"),
+            }) & active;
+        // The rays' triangle tests, prepared once, when a leaf is first reached.
+        let watertight = std::cell::OnceCell::new();
+        let leaf_blocked = |first, _, reach| {
+            let watertight =
+                watertight.get_or_init(|| WatertightLanes::new(rays, active & !blocked));
             let mut blocked = 0;
-            self.leaf_hits_lanes(first, (rays, &watertight), t_max, reach, |_, hits, _| {
+            self.leaf_hits_lanes(first, (rays, watertight), t_max, reach, |_, hits, _| {
                 blocked |= hits;
                 blocked == reach
             });
             blocked
-        });
-        blocked
+        };
+        blocked | bvh.any_hit_lanes(rays, t_max, active & !blocked, leaf_blocked)
     }
 
     /// The lanes of `active` for which `blocked(lane)` holds.

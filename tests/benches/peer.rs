@@ -24,7 +24,7 @@
 //! and `t_max` (`f32`, infinite for closest hits).
 
 use glam::Vec3;
-use glint_geometry::lanes::LANES;
+use glint_geometry::lanes::{self, LANES};
 use glint_geometry::{Occluders, Ray, RayLanes, ShapeList, TriangleMesh};
 use glint_tests::{camera_rays, random_rays, XorShift};
 use rayon::prelude::*;
@@ -287,10 +287,9 @@ fn trace(list: &ShapeList, rays: &[Ray], t_max: &[f32], query: Query) -> Duratio
             Query::ClosestLanes => rays
                 .chunks(LANES)
                 .map(|chunk| {
-                    let lanes =
-                        RayLanes::new(std::array::from_fn(|k| chunk[k.min(chunk.len() - 1)]));
+                    let (lanes, active) = in_lanes(chunk);
                     let found = list.closest_lanes(&lanes, chunk.len());
-                    (found.hits & ((1u64 << chunk.len()) - 1) as u32).count_ones() as usize
+                    (found.hits & active).count_ones() as usize
                 })
                 .sum(),
             Query::ClosestStream => {
@@ -306,9 +305,7 @@ fn trace(list: &ShapeList, rays: &[Ray], t_max: &[f32], query: Query) -> Duratio
             Query::AnyLanes => rays
                 .chunks(LANES)
                 .map(|chunk| {
-                    let lanes =
-                        RayLanes::new(std::array::from_fn(|k| chunk[k.min(chunk.len() - 1)]));
-                    let active = ((1u64 << chunk.len()) - 1) as u32;
+                    let (lanes, active) = in_lanes(chunk);
                     // One limit for the lanes: every ray of a set has the same.
                     list.any_hits_among(&Occluders::ALL, &lanes, t_max[0], active)
                         .count_ones() as usize
@@ -324,6 +321,13 @@ fn trace(list: &ShapeList, rays: &[Ray], t_max: &[f32], query: Query) -> Duratio
     let elapsed = start.elapsed();
     assert!(found > 0);
     elapsed
+}
+
+/// Up to [`LANES`] rays in lanes (the last repeated into the unused ones),
+/// and the lanes that hold them.
+fn in_lanes(chunk: &[Ray]) -> (RayLanes, u32) {
+    let lanes = RayLanes::new(std::array::from_fn(|k| chunk[k.min(chunk.len() - 1)]));
+    (lanes, lanes::bits(lanes::first_lanes(chunk.len())))
 }
 
 fn median(f: impl FnMut() -> Duration) -> Duration {

@@ -24,8 +24,17 @@ WORK = os.path.join(ROOT, "target", "embree")
 PEER = os.path.join(WORK, "peer")
 
 
+class Failure(Exception):
+    """A failure reported as one line."""
+
+
 def run(cmd, **kw):
-    return subprocess.run(cmd, check=True, text=True, **kw)
+    try:
+        return subprocess.run(cmd, check=True, text=True, **kw)
+    except FileNotFoundError:
+        raise Failure(f"{cmd[0]} is not installed")
+    except subprocess.CalledProcessError as e:
+        raise Failure(f"`{' '.join(map(str, cmd))}` failed (exit status {e.returncode})")
 
 
 def prepare(sizes):
@@ -101,4 +110,10 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except Failure as e:
+        print(f"compare.py: error: {e}", file=sys.stderr)
+        sys.exit(1)
+    except KeyboardInterrupt:
+        sys.exit(130)

@@ -16,6 +16,8 @@ import math
 import os
 import sys
 
+from obj_file import write_atomically
+
 HALF = 10.0
 OCTAVES = [
     # (direction angle, phase, frequency, amplitude)
@@ -60,21 +62,9 @@ def main():
     default = os.path.join(here, "..", "..", "scenes", "large", "terrain.obj")
     path = os.path.normpath(args[1] if len(args) == 2 else default)
     n = max(1, math.ceil(math.sqrt(triangles / 2)))
-    # Written beside the target and renamed at the end: a failed or interrupted
-    # run leaves no partial OBJ and any existing file untouched.
-    partial = f"{path}.partial-{os.getpid()}"
-    try:
-        write_terrain(n, partial)
-        os.replace(partial, path)
-    except OSError as e:
-        if os.path.exists(partial):
-            os.remove(partial)
-        print(f"terrain.py: error: cannot write {path}: {e.strerror}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        if os.path.exists(partial):
-            os.remove(partial)
-        return 130
+    status = write_atomically(path, lambda partial: write_terrain(n, partial), "terrain.py")
+    if status != 0:
+        return status
     print(f"wrote {path}: {2 * n * n} triangles")
     return 0
 

@@ -11,6 +11,9 @@ import math
 import os
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "meshes"))
+from obj_file import write_atomically  # noqa: E402
+
 
 def main() -> int:
     if len(sys.argv) != 3 or not sys.argv[1].isdigit() or int(sys.argv[1]) < 2:
@@ -18,17 +21,9 @@ def main() -> int:
         return 2
     n = max(1, math.ceil(math.sqrt(int(sys.argv[1]) / 2)))
     path = sys.argv[2]
-    # Written beside the target and renamed at the end: a failed or interrupted
-    # run leaves no partial OBJ and any existing file untouched.
-    partial = f"{path}.partial-{os.getpid()}"
-    try:
-        write_grid(n, partial)
-        os.replace(partial, path)
-    except OSError as e:
-        if os.path.exists(partial):
-            os.remove(partial)
-        print(f"grid_obj.py: error: cannot write {path}: {e.strerror}", file=sys.stderr)
-        return 2
+    status = write_atomically(path, lambda partial: write_grid(n, partial), "grid_obj.py")
+    if status != 0:
+        return status
     print(f"wrote {path}: {2 * n * n} triangles")
     return 0
 

@@ -39,6 +39,8 @@
 //! Sobol sequence, so each sample's radiance and the shading counts are those
 //! of [`DirectIntegrator::li_at`], bit for bit (the tests compare).
 
+mod events;
+
 use crate::direct::{mirror_ray, PairAllocation, SampleContext, ShadingPoint, CULL_REACH};
 use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::physical::{power_heuristic, DiffusePoints};
@@ -47,7 +49,7 @@ use crate::sampling::{
     SobolSequence,
 };
 use crate::texture_lookup::texture_footprint;
-use crate::trace::Tracer;
+use crate::trace::{Event, Tracer};
 use crate::{DirectIntegrator, Scene, ShadingCounters, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Float, I32Lanes, Vec3Lanes, LANES};
@@ -114,6 +116,9 @@ impl DirectIntegrator {
         streams: &mut LaneStreams,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
+        if T::ON {
+            wave.trace_rays(scene, ctx);
+        }
         let hit_lanes = wave.closest.hits & wave.lanes;
         let mut radiance = self.environment_seen_lanes(scene, &wave, wave.lanes & !hit_lanes, ctx);
         if hit_lanes == 0 {
@@ -140,6 +145,10 @@ impl DirectIntegrator {
         // and no local term on a perfect mirror.
         if mirrors.lanes == 0 {
             let plus_zero = radiance + Vec3Lanes::default();
+            if T::ON {
+                let values = (&radiance, &Vec3Lanes::default(), &plus_zero);
+                wave.trace_radiance(shaded, values, ctx);
+            }
             return Vec3Lanes::select(lanes::from_bits(shaded), &plus_zero, &radiance);
         }
         let traced = match wave.depth < self.max_depth {
@@ -152,8 +161,11 @@ impl DirectIntegrator {
         };
         let r = mirrors.reflectivity;
         let value = radiance.scale(F32Lanes::splat(1.0) - r) + mirror.scale(r);
-        let surfaces = lanes::from_bits(shaded | mirrors.perfect);
-        Vec3Lanes::select(surfaces, &value, &radiance)
+        let surfaces = shaded | mirrors.perfect;
+        if T::ON {
+            wave.trace_radiance(surfaces, (&radiance, &mirror, &value), ctx);
+        }
+        Vec3Lanes::select(lanes::from_bits(surfaces), &value, &radiance)
     }
 
     /// The environment's radiance along the rays of `wave` in the lanes
@@ -189,6 +201,9 @@ impl DirectIntegrator {
                 }
             }
         }
+        if T::ON {
+            wave.trace_misses(scene, misses, &radiance, ctx);
+        }
         radiance
     }
 
@@ -216,6 +231,9 @@ impl DirectIntegrator {
                 ShadedLanes::on_one_object(scene, rays, closest, local, on, radiance, ctx)
             }
             FirstHits::OnOneEmitter(area) => {
+                ctx.tracer.record(local, |_| Event::Emitter {
+                    radiance: area.color,
+                });
                 let color = Vec3Lanes::splat(area.color);
                 *radiance = Vec3Lanes::select(lanes::from_bits(local), &color, radiance);
                 return 0;
@@ -226,6 +244,9 @@ impl DirectIntegrator {
             }
         };
         shaded.depth = wave.depth;
+        if T::ON {
+            wave.trace_surfaces(scene, &shaded, radiance, ctx);
+        }
         if shaded.lanes != 0 {
             *radiance = self.with_direct_lighting(scene, &shaded, streams, *radiance, ctx);
         }
@@ -253,6 +274,8 @@ impl DirectIntegrator {
                 light: index as u32,
                 depth: shaded.depth,
             };
+            ctx.tracer
+                .record(shaded.lanes, |_| Event::Light { light: index });
             let term = match light {
                 Light::Area(area) => {
                     let pair = pairs.take(own, self.light_samples);
@@ -280,6 +303,11 @@ impl DirectIntegrator {
                     self.physical_sphere_light_term(scene, shaded, sphere, (pair, streams), ctx)
                 }
             };
+            let total = |k| Event::LightTotal {
+                light: index,
+                value: term.lane(k),
+            };
+            ctx.tracer.record(shaded.lanes, total);
             radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
         }
         if let Some(env) = scene
@@ -288,6 +316,10 @@ impl DirectIntegrator {
             .filter(|_| self.environment_samples > 0)
         {
             let term = self.environment_term_lanes(scene, env, shaded, streams, ctx);
+            let total = |k| Event::EnvironmentTotal {
+                value: term.lane(k),
+            };
+            ctx.tracer.record(shaded.lanes, total);
             radiance = Vec3Lanes::select(shaded_mask, &(radiance + term), &radiance);
         }
         radiance
@@ -307,6 +339,9 @@ impl DirectIntegrator {
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
         let (rays, diffs, traced) = reflected_rays(scene, wave, traced);
+        if T::ON {
+            wave.trace_mirrors(scene, &rays, traced, ctx);
+        }
         ctx.counters.reflection_rays += u64::from(traced.count_ones());
         let used = (u32::BITS - traced.leading_zeros()) as usize;
         let closest = scene.shapes.closest_lanes(&rays, used);
@@ -376,6 +411,11 @@ impl DirectIntegrator {
             let rays = RayLanes { origin, direction };
             let blocked =
                 (scene.shapes).any_hits_among(&Occluders::ALL, &rays, f32::INFINITY, traced);
+            if T::ON {
+                let verdicts = [dense, above, traced, traced & !blocked];
+                let drawn = (&direction, &radiance, pdf);
+                shaded.trace_environment_samples(scene, drawn, verdicts, (&f, &value), ctx);
+            }
             let visible = lanes::from_bits(traced & !blocked);
             sum = sum + Vec3Lanes::select(visible, &value, &Vec3Lanes::default());
         }
@@ -511,6 +551,11 @@ impl DirectIntegrator {
             let (values, traced) = shaded.light_samples(&position, pdf, (lit, mis), ctx);
             let towards = position - shaded.point;
             let visible = traced & !shaded.blocked(scene, occluders, &ends, &towards, traced);
+            if T::ON {
+                let verdicts = [lit, mis, traced, visible];
+                let drawn = (&position, pdf, &ends);
+                shaded.trace_physical_samples(scene, drawn, verdicts, &values, ctx);
+            }
             let zero = Vec3Lanes::default();
             sum = sum + Vec3Lanes::select(lanes::from_bits(visible), &values, &zero);
         }
@@ -559,6 +604,11 @@ impl DirectIntegrator {
             let (l, pdf, drawn) = shaded.lobe_directions(u, mis, &mut ctx.counters);
             let (f, traced) = shaded.lobe_reflections(&l, drawn, &mut ctx.counters);
             if traced == 0 {
+                if T::ON {
+                    let none = (0, None, 0);
+                    let zero = Vec3Lanes::default();
+                    shaded.trace_lobe_samples(scene, (mis, u), none, &light_pdf, &zero, ctx);
+                }
                 continue;
             }
             let pdf = pdf.to_array();
@@ -582,6 +632,10 @@ impl DirectIntegrator {
                 }
             }
             let value = f.scale(F32Lanes::new(weights));
+            if T::ON {
+                let found = (traced, Some((&rays, &closest)), reached);
+                shaded.trace_lobe_samples(scene, (mis, u), found, &light_pdf, &value, ctx);
+            }
             sum = sum + Vec3Lanes::select(lanes::from_bits(reached), &value, &Vec3Lanes::default());
         }
         points.finish(ctx);
@@ -1047,7 +1101,12 @@ impl<'a> ShadedLanes<'a> {
                 continue;
             };
             match scene.surface_of(&hit) {
-                SurfaceKind::Emitter(light) => radiance.set_lane(k, light.emitted()),
+                SurfaceKind::Emitter(light) => {
+                    let emitted = light.emitted();
+                    ctx.tracer
+                        .record(1 << k, |_| Event::Emitter { radiance: emitted });
+                    radiance.set_lane(k, emitted);
+                }
                 SurfaceKind::Material(material) if material.uses_footprint() => {
                     let Some(hit) = scene.shapes.surface_record(&ray, found) else {
                         continue;
@@ -1243,6 +1302,9 @@ impl<'a> ShadedLanes<'a> {
         let (f, traced) = self.light_samples(&position, F32Lanes::ONE, (self.lanes, 0), ctx);
         let towards = position - self.point;
         let visible = traced & !self.blocked(scene, &Occluders::ALL, &position, &towards, traced);
+        if T::ON {
+            self.trace_point_light(scene, &position, [traced, visible], ctx);
+        }
         let distance2 = towards.dot(&towards);
         let lit = Vec3Lanes::scaled_splat_lanes(light.color, &f);
         let value = Vec3Lanes::new(lit.x / distance2, lit.y / distance2, lit.z / distance2);
@@ -1368,6 +1430,10 @@ impl<'a> ShadedLanes<'a> {
             specular,
         );
         let visible = s.traced & !self.blocked(scene, occluders, ends, &s.towards, s.traced);
+        if T::ON {
+            let verdicts = [s.lit, s.shaded, s.traced, visible];
+            self.trace_light_samples(scene, (&s.position, ends), verdicts, &s.reflected, ctx);
+        }
         Vec3Lanes::select(
             lanes::from_bits(visible),
             &s.reflected,

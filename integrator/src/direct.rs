@@ -8,7 +8,7 @@ use crate::sampling::{
 };
 use crate::settings::RenderSettings;
 use crate::texture_lookup::texture_footprint;
-use crate::trace::{Event, Shadow, Skip, Tracer};
+use crate::trace::{Event, Shadow, Tracer};
 use crate::{Scene, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
@@ -195,16 +195,11 @@ impl DirectIntegrator {
         depth: u32,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        ctx.tracer.record(|| Event::Ray {
-            depth,
-            ray: *ray,
-            hit: hit.map(Box::new),
-        });
         let Some(hit) = hit else {
             return self.environment_seen(scene, ray, diff, ctx);
         };
         let material = match scene.surface_of(&hit) {
-            SurfaceKind::Emitter(light) => return emitted(light, ctx),
+            SurfaceKind::Emitter(light) => return light.emitted(),
             SurfaceKind::Material(m) => m,
         };
         let r = material.reflectivity;
@@ -224,14 +219,7 @@ impl DirectIntegrator {
         } else {
             Vec3::ZERO
         };
-        let value = (1.0 - r) * local + r * mirror;
-        ctx.tracer.record(|| Event::Radiance {
-            depth,
-            local,
-            mirror,
-            value,
-        });
-        value
+        (1.0 - r) * local + r * mirror
     }
 
     /// The shapes that may block `point`'s shadow rays to area light `index`:
@@ -300,13 +288,7 @@ impl DirectIntegrator {
             ShadingModel::Phong => diff.angular_width(ray.direction),
             ShadingModel::Physical => 0.0,
         };
-        let radiance = env.radiance(ray.direction.normalize(), width);
-        ctx.tracer.record(|| Event::Environment {
-            direction: ray.direction.normalize(),
-            width,
-            radiance,
-        });
-        radiance
+        env.radiance(ray.direction.normalize(), width)
     }
 
     /// The light reflected at `hit` by its material (ambient, lights and
@@ -326,14 +308,6 @@ impl DirectIntegrator {
             ctx.textures.record(at.material, &tc);
         }
         let point = ShadingPoint::new(at.hit, at.material, at.ray, &tc);
-        ctx.tracer.record(|| Event::Surface {
-            tc,
-            kd: point.kd,
-            ks: point.ks,
-            n: point.n,
-            ng: point.ng,
-            v: point.v,
-        });
         match scene.shading {
             ShadingModel::Phong => self.shade(scene, &point, depth, ctx),
             ShadingModel::Physical => self.shade_physical(scene, &point, depth, ctx),
@@ -351,11 +325,6 @@ impl DirectIntegrator {
     ) -> Vec3 {
         let (reflected, reflected_diff) = mirror_ray(at.hit, at.ray, at.diff);
         ctx.counters.reflection_rays += 1;
-        ctx.tracer.record(|| Event::Mirror {
-            reflectivity: at.material.reflectivity,
-            tint: at.material.mirror_tint,
-            direction: reflected.direction,
-        });
         at.material.mirror_tint * self.li(scene, &reflected, &reflected_diff, depth + 1, ctx)
     }
 
@@ -404,16 +373,9 @@ impl DirectIntegrator {
         mut light_term: impl FnMut(usize, &Light, &mut PairAllocation, &mut SampleContext<T>) -> Vec3,
     ) -> Vec3 {
         let mut radiance = scene.ambient * point.kd;
-        ctx.tracer.record(|| Event::Ambient { value: radiance });
         let mut pairs = PairAllocation::new(depth);
         for (index, light) in scene.lights.iter().enumerate() {
-            ctx.tracer.record(|| Event::Light { light: index });
-            let value = light_term(index, light, &mut pairs, ctx);
-            ctx.tracer.record(|| Event::LightTotal {
-                light: index,
-                value,
-            });
-            radiance += value;
+            radiance += light_term(index, light, &mut pairs, ctx);
         }
         radiance += self.environment_term(scene, point, &mut pairs, depth, ctx);
         radiance
@@ -465,9 +427,7 @@ impl DirectIntegrator {
             DimensionPair::Environment { depth },
             self.environment_samples,
         );
-        let value = self.environment_light(scene, point, pair, ctx);
-        ctx.tracer.record(|| Event::EnvironmentTotal { value });
-        value
+        self.environment_light(scene, point, pair, ctx)
     }
 
     /// The average over the light's samples (the dimension pair `pair` of the
@@ -532,7 +492,7 @@ impl DirectIntegrator {
         };
         let n = self.environment_samples as usize;
         ctx.counters.environment_samples += n as u64;
-        let one_by_one = T::ON || n < LANES_FROM_SAMPLES;
+        let one_by_one = n < LANES_FROM_SAMPLES;
         let mut sum = Vec3::ZERO;
         let mut samples = std::mem::take(&mut ctx.environment_points);
         ctx.fill_points(self.environment_pattern, pair, &mut samples);
@@ -559,34 +519,29 @@ impl ShadingPoint<'_> {
         }
     }
 
-    /// An environment sample short of its shadow ray: its `f · cos θ` and its
-    /// value `L · f · cos θ / p` if unblocked, or `None` (counted, and
-    /// recorded) where it needs no shadow ray. Counts the shadow ray it needs.
+    /// An environment sample's value `L · f · cos θ / p` if unblocked, short
+    /// of its shadow ray, or `None` (counted) where it needs no shadow ray.
+    /// Counts the shadow ray it needs.
     fn environment_sample_unshadowed<T: Tracer>(
         &self,
         s: &EnvironmentSample,
         ctx: &mut SampleContext<T>,
-    ) -> Option<(Vec3, Vec3)> {
+    ) -> Option<Vec3> {
         if s.pdf.is_nan() || s.pdf <= 0.0 || s.radiance == Vec3::ZERO {
             ctx.counters.environment_skips.zero_density += 1;
-            let skipped = Shadow::Skipped(Skip::ZeroPdf);
-            record_environment_sample(ctx, s, Vec3::ZERO, skipped, Vec3::ZERO);
             return None;
         }
         if !self.above_surface(s.direction) {
             ctx.counters.environment_skips.below_surface += 1;
-            let skipped = Shadow::Skipped(Skip::BehindSurface);
-            record_environment_sample(ctx, s, Vec3::ZERO, skipped, Vec3::ZERO);
             return None;
         }
         let f = self.brdf_cos(s.direction, ctx);
         if f == Vec3::ZERO {
             ctx.counters.environment_skips.zero_brdf += 1;
-            record_environment_sample(ctx, s, f, Shadow::Skipped(Skip::ZeroBrdf), Vec3::ZERO);
             return None;
         }
         ctx.counters.environment_shadow_rays += 1;
-        Some((f, s.radiance * f / s.pdf))
+        Some(s.radiance * f / s.pdf)
     }
 
     /// Adds to `sum` the values of the environment samples `drawn` (at most
@@ -604,17 +559,12 @@ impl ShadingPoint<'_> {
     ) {
         if one_by_one {
             for s in drawn {
-                let Some((f, value)) = self.environment_sample_unshadowed(s, ctx) else {
+                let Some(value) = self.environment_sample_unshadowed(s, ctx) else {
                     continue;
                 };
                 let shadow_ray = spawn_ray(self.hit, s.direction);
                 if !scene.shapes.any_hit(&shadow_ray, f32::INFINITY) {
-                    record_environment_sample(ctx, s, f, Shadow::Unoccluded, value);
                     *sum += value;
-                } else if T::ON {
-                    // Finding the blocker costs a query: only when tracing.
-                    let shadow = blocker(scene, &shadow_ray, f32::INFINITY);
-                    record_environment_sample(ctx, s, f, shadow, Vec3::ZERO);
                 }
             }
             return;
@@ -623,7 +573,7 @@ impl ShadingPoint<'_> {
         let mut directions = [self.hit.geometric_normal; LANES];
         let mut traced = 0u32;
         for (k, s) in drawn.iter().enumerate() {
-            if let Some((_, value)) = self.environment_sample_unshadowed(s, ctx) {
+            if let Some(value) = self.environment_sample_unshadowed(s, ctx) {
                 (values[k], directions[k]) = (value, s.direction);
                 traced |= 1 << k;
             }
@@ -683,25 +633,6 @@ fn drawn_together(
         direction: d.lane(k),
         radiance: radiance.lane(k),
         pdf: pdf[k],
-    })
-}
-
-/// Tells the tracer of environment sample `s`: its `f · cos θ`, its shadow
-/// ray's fate and its value.
-fn record_environment_sample<T: Tracer>(
-    ctx: &mut SampleContext<T>,
-    s: &EnvironmentSample,
-    f_cos: Vec3,
-    shadow: Shadow,
-    value: Vec3,
-) {
-    ctx.tracer.record(|| Event::EnvironmentSample {
-        direction: s.direction,
-        pdf: s.pdf,
-        radiance: s.radiance,
-        f_cos,
-        shadow,
-        value,
     })
 }
 
@@ -767,6 +698,14 @@ impl<'a> ShadingPoint<'a> {
     pub(crate) fn brdf_cos<T: Tracer>(&self, l: Vec3, ctx: &mut SampleContext<T>) -> Vec3 {
         if self.has_specular {
             ctx.counters.specular_lobes += 1;
+        }
+        self.f_cos(l)
+    }
+
+    /// [`Self::brdf_cos`], uncounted.
+    #[inline]
+    pub(crate) fn f_cos(&self, l: Vec3) -> Vec3 {
+        if self.has_specular {
             self.material.brdf_cos(self.kd, self.ks, self.n, l, self.v)
         } else {
             self.material.brdf_cos_diffuse(self.kd, self.n, l)
@@ -790,7 +729,6 @@ impl ShadingPoint<'_> {
         let l = (target.point - self.hit.point).normalize_or_zero();
         if !self.above_surface(l) {
             ctx.counters.light_skips.below_surface += 1;
-            self.record_light_sample(target, l, Shadow::Skipped(Skip::BehindSurface), ctx);
             return Vec3::ZERO;
         }
         let reflected = if self.has_specular {
@@ -801,60 +739,42 @@ impl ShadingPoint<'_> {
         };
         if reflected == Vec3::ZERO {
             ctx.counters.light_skips.zero_brdf += 1;
-            self.record_light_sample(target, l, Shadow::Skipped(Skip::ZeroBrdf), ctx);
             return Vec3::ZERO;
         }
         let shadow = spawn_ray_to(self.hit, target);
         ctx.counters.light_shadow_rays += 1;
         if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
-            if T::ON {
-                // Finding the blocker costs a query: only when tracing.
-                self.record_light_sample(target, l, blocker(scene, &shadow, 1.0), ctx);
-            }
             Vec3::ZERO
         } else {
-            self.record_light_sample(target, l, Shadow::Unoccluded, ctx);
             reflected
         }
     }
 
-    /// Records a light sample of the course's model towards `target` along
-    /// `l`: the diffuse and specular parts recomputed apart (their sum is
-    /// the reflection the integrator used, to rounding), zero unless lit.
-    #[inline(always)]
-    pub(crate) fn record_light_sample<T: Tracer>(
+    /// A light sample of the course's model at `position` (on the light), the
+    /// direction to it `l`, as a tracer shows it: its shadow ray's verdict,
+    /// what it adds (`value`), and the diffuse and specular parts recomputed
+    /// apart (their sum is the reflection the integrator used, to rounding).
+    pub(crate) fn light_sample_event(
         &self,
-        target: &RayTarget,
-        l: Vec3,
+        (position, l): (Vec3, Vec3),
         shadow: Shadow,
-        ctx: &mut SampleContext<T>,
-    ) {
-        ctx.tracer.record(|| {
-            let n_dot_l = self.n.dot(l);
-            let lit = shadow == Shadow::Unoccluded;
-            let diffuse = self.material.reflect_diffuse(self.kd, self.n, l);
-            let specular = if self.has_specular {
-                self.material
-                    .reflect(Vec3::ZERO, self.ks, self.n, l, self.v)
-            } else {
-                Vec3::ZERO
-            };
-            let value = match (lit, self.has_specular) {
-                (false, _) => Vec3::ZERO,
-                (true, true) => self.material.reflect(self.kd, self.ks, self.n, l, self.v),
-                (true, false) => diffuse,
-            };
-            Event::LightSample {
-                position: target.point,
-                l,
-                n_dot_l,
-                reflection: 2.0 * n_dot_l * self.n - l,
-                diffuse,
-                specular,
-                shadow,
-                value,
-            }
-        });
+        value: Vec3,
+    ) -> Event {
+        let n_dot_l = self.n.dot(l);
+        let specular = match self.has_specular {
+            true => (self.material).reflect(Vec3::ZERO, self.ks, self.n, l, self.v),
+            false => Vec3::ZERO,
+        };
+        Event::LightSample {
+            position,
+            l,
+            n_dot_l,
+            reflection: 2.0 * n_dot_l * self.n - l,
+            diffuse: self.material.reflect_diffuse(self.kd, self.n, l),
+            specular,
+            shadow,
+            value,
+        }
     }
 }
 
@@ -914,17 +834,9 @@ pub(crate) fn mirror_ray(hit: &Hit, ray: &Ray, diff: &RayDifferential) -> (Ray, 
     (spawn_ray(hit, wi), reflected_diff)
 }
 
-/// The radiance of a light's surface seen directly: its color.
-fn emitted<T: Tracer>(light: &Light, ctx: &mut SampleContext<T>) -> Vec3 {
-    let radiance = light.emitted();
-    ctx.tracer.record(|| Event::Emitter { radiance });
-    radiance
-}
-
 /// The nearest object blocking `shadow` before `t_max`, as a tracer reports
 /// it (the integrator itself only asks whether anything does). A closest-hit
-/// query: call it under `if T::ON`, never as an argument the untraced code
-/// would evaluate.
+/// query: call it in a tracer's hook only.
 pub(crate) fn blocker(scene: &Scene, shadow: &Ray, t_max: f32) -> Shadow {
     match scene.shapes.closest_hit(shadow, t_max) {
         Some(hit) => Shadow::Blocked {

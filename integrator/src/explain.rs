@@ -28,8 +28,8 @@ pub enum ExplainError {
     Outside { x: u32, y: u32, size: UVec2 },
     #[error("sample {sample} does not exist: the pixel has {spp} samples (0 to {})", spp - 1)]
     NoSuchSample { sample: u64, spp: u32 },
-    /// The traced pixel differs from the rendered one: a bug in Glint (the
-    /// scalar path and the SIMD lanes a render takes must agree bit for bit).
+    /// The traced pixel differs from the rendered one: a bug in Glint (a
+    /// tracer's hooks must not change what the lanes compute).
     #[error(
         "internal error: the traced pixel ({traced}) differs from the rendered one ({rendered})"
     )]
@@ -39,9 +39,9 @@ pub enum ExplainError {
 /// Pixel `(x, y)` of `scene` rendered with `settings`, with the steps of the
 /// samples `selection` names. Its radiance is what [`crate::render`] writes
 /// for that pixel (the same code, on one pixel; a render may shade several
-/// pixels' samples in one chunk's lanes, to the same bits): the trace is taken on the
-/// integrator's scalar path, checked against the render's own path bit for
-/// bit ([`ExplainError::Diverged`] otherwise).
+/// pixels' samples in one chunk's lanes, to the same bits): the trace is taken
+/// on the render's own route, in lanes, and checked against the untraced
+/// pixel bit for bit ([`ExplainError::Diverged`] otherwise).
 pub fn explain_pixel(
     scene: &Scene,
     settings: &RenderSettings,

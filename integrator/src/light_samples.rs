@@ -15,7 +15,7 @@
 
 use crate::direct::{SampleContext, ShadingPoint};
 use crate::sampling::SamplePoints;
-use crate::trace::{Shadow, Skip, Tracer};
+use crate::trace::Tracer;
 use crate::{Scene, ShadingCounters};
 use glam::Vec3;
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes};
@@ -98,7 +98,7 @@ impl ShadingPoint<'_> {
         occluders: &Occluders,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        if samples.len() < LANES_FROM_SAMPLES || T::ON {
+        if samples.len() < LANES_FROM_SAMPLES {
             return self.area_light_sum_one_by_one(scene, light, samples, occluders, ctx);
         }
         let point = self.hit.point;
@@ -167,12 +167,6 @@ impl ShadingPoint<'_> {
                 sum += self.unoccluded_reflection(scene, &target, occluders, ctx);
             } else {
                 ctx.counters.light_skips.behind_light += 1;
-                if T::ON {
-                    let target = light.shadow_target(position);
-                    let l = (position - self.hit.point).normalize_or_zero();
-                    let shadow = Shadow::Skipped(Skip::BehindLight);
-                    self.record_light_sample(&target, l, shadow, ctx);
-                }
             }
         }
         sum

@@ -24,10 +24,10 @@
 //! the sharp highlight of a large light, where light samples alone are noisy.
 //! On a purely diffuse material only the light is sampled (weight 1).
 
-use crate::direct::{blocker, SampleContext, ShadingPoint};
+use crate::direct::{SampleContext, ShadingPoint};
 use crate::light_samples::LANES_FROM_SAMPLES;
 use crate::sampling::{DimensionPair, PointChunk, SamplePoints};
-use crate::trace::{Event, Shadow, Skip, Technique, Tracer};
+use crate::trace::{Shadow, Skip, Tracer};
 use crate::{DirectIntegrator, Scene, ShadingCounters, Skips};
 use glam::Vec3;
 use glint_geometry::lanes::{self, F32Lanes, Float, Vec3Lanes, LANES};
@@ -88,7 +88,7 @@ impl DirectIntegrator {
         let mis = self.mis && point.has_specular;
         let samples = self.draw_light_points(pair, ctx);
         let occluders = self.occluders(scene, point, index, light, ctx);
-        let mut sum = if T::ON || samples.len() < LANES_FROM_SAMPLES {
+        let mut sum = if samples.len() < LANES_FROM_SAMPLES {
             let mut sum = Vec3::ZERO;
             for u in samples.iter() {
                 let s = sampler.sample(u);
@@ -293,34 +293,15 @@ impl ShadingPoint<'_> {
             ctx.counters.light_skips.below_surface += 1;
             return Vec3::ZERO;
         };
-        let record = |ctx: &mut SampleContext<T>, f_cos: Vec3, shadow: Shadow, value: Vec3| {
-            ctx.tracer.record(|| Event::PhysicalSample {
-                technique: Technique::PointLight,
-                l,
-                f_cos,
-                light_pdf: 1.0,
-                lobe_pdf: 0.0,
-                weight: 1.0,
-                shadow,
-                value,
-            })
-        };
         let Some(f) = self.reflection_towards(l, light_skips, ctx) else {
-            record(ctx, Vec3::ZERO, self.skip_reason(l), Vec3::ZERO);
             return Vec3::ZERO;
         };
         ctx.counters.light_shadow_rays += 1;
         let shadow = spawn_ray_to(self.hit, &RayTarget::exact(light.position));
         if scene.shapes.any_hit_among(&Occluders::ALL, &shadow, 1.0) {
-            if T::ON {
-                // Finding the blocker costs a query: only when tracing.
-                record(ctx, f, blocker(scene, &shadow, 1.0), Vec3::ZERO);
-            }
             return Vec3::ZERO;
         }
-        let value = light.color * f / distance2;
-        record(ctx, f, Shadow::Unoccluded, f / distance2);
-        value
+        light.color * f / distance2
     }
 
     /// One light sample's `f · cos θ · V · w / p` towards the point
@@ -336,20 +317,14 @@ impl ShadingPoint<'_> {
         occluders: &Occluders,
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
-        let Some((f, value)) = self.light_sample_unshadowed(target, pdf, mis, ctx) else {
+        let Some(value) = self.light_sample_unshadowed(target, pdf, mis, ctx) else {
             return Vec3::ZERO;
         };
         let shadow = spawn_ray_to(self.hit, target);
-        if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
-            if T::ON {
-                // Finding the blocker costs a query: only when tracing.
-                let blocked = blocker(scene, &shadow, 1.0);
-                self.record_physical_sample(ctx, target, pdf, mis, f, blocked, Vec3::ZERO);
-            }
-            return Vec3::ZERO;
+        match scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
+            true => Vec3::ZERO,
+            false => value,
         }
-        self.record_physical_sample(ctx, target, pdf, mis, f, Shadow::Unoccluded, value);
-        value
     }
 
     /// The sum of [`Self::light_sample`] over `samples` (coordinates on
@@ -410,7 +385,7 @@ impl ShadingPoint<'_> {
         for (k, u) in chunk.iter().enumerate() {
             let s = sampler.sample(u);
             let target = light.shadow_target(s.point);
-            if let Some((_, value)) = self.light_sample_unshadowed(&target, s.pdf, mis, ctx) {
+            if let Some(value) = self.light_sample_unshadowed(&target, s.pdf, mis, ctx) {
                 (values[k], positions[k]) = (value, s.point);
                 traced |= 1 << k;
             }
@@ -445,20 +420,18 @@ impl ShadingPoint<'_> {
         (position, values, reflects)
     }
 
-    /// [`Self::light_sample`] short of its shadow ray: the sample's `f · cos θ`
-    /// and its value `f · cos θ · w / p` if unblocked, or `None` (counted, and
-    /// recorded) where it needs no shadow ray. Counts the shadow ray it needs.
+    /// [`Self::light_sample`] short of its shadow ray: the sample's value
+    /// `f · cos θ · w / p` if unblocked, or `None` (counted) where it needs no
+    /// shadow ray. Counts the shadow ray it needs.
     fn light_sample_unshadowed<T: Tracer>(
         &self,
         target: &RayTarget,
         pdf: f32,
         mis: bool,
         ctx: &mut SampleContext<T>,
-    ) -> Option<(Vec3, Vec3)> {
+    ) -> Option<Vec3> {
         if !(pdf > 0.0 && pdf.is_finite()) {
             ctx.counters.light_skips.zero_density += 1;
-            let skipped = Shadow::Skipped(Skip::ZeroPdf);
-            self.record_physical_sample(ctx, target, pdf, mis, Vec3::ZERO, skipped, Vec3::ZERO);
             return None;
         }
         let Some(l) = (target.point - self.hit.point).try_normalize() else {
@@ -466,55 +439,14 @@ impl ShadingPoint<'_> {
             ctx.counters.light_skips.below_surface += 1;
             return None;
         };
-        let Some(f) = self.reflection_towards(l, light_skips, ctx) else {
-            let skipped = self.skip_reason(l);
-            self.record_physical_sample(ctx, target, pdf, mis, Vec3::ZERO, skipped, Vec3::ZERO);
-            return None;
-        };
+        let f = self.reflection_towards(l, light_skips, ctx)?;
         ctx.counters.light_shadow_rays += 1;
         let weight = if mis {
             power_heuristic(pdf, self.material.specular_pdf(self.n, l, self.v))
         } else {
             1.0
         };
-        Some((f, f * (weight / pdf)))
-    }
-
-    /// Tells the tracer of a light sample towards `target` (density `pdf`):
-    /// its `f · cos θ`, its shadow ray's fate and its value.
-    #[allow(clippy::too_many_arguments)]
-    fn record_physical_sample<T: Tracer>(
-        &self,
-        ctx: &mut SampleContext<T>,
-        target: &RayTarget,
-        pdf: f32,
-        mis: bool,
-        f_cos: Vec3,
-        shadow: Shadow,
-        value: Vec3,
-    ) {
-        ctx.tracer.record(|| {
-            let l = (target.point - self.hit.point).normalize_or_zero();
-            let lobe_pdf = if mis {
-                self.material.specular_pdf(self.n, l, self.v)
-            } else {
-                0.0
-            };
-            Event::PhysicalSample {
-                technique: Technique::Light,
-                l,
-                f_cos,
-                light_pdf: pdf,
-                lobe_pdf,
-                weight: if mis {
-                    power_heuristic(pdf, lobe_pdf)
-                } else {
-                    1.0
-                },
-                shadow,
-                value,
-            }
-        })
+        Some(f * (weight / pdf))
     }
 
     /// One specular-lobe sample's `f · cos θ · V · w / p` towards the light
@@ -530,31 +462,11 @@ impl ShadingPoint<'_> {
         ctx: &mut SampleContext<T>,
     ) -> Vec3 {
         let pdf = self.material.specular_pdf(self.n, l, self.v);
-        let record = |ctx: &mut SampleContext<T>, f_cos: Vec3, light: f32, shadow, value| {
-            ctx.tracer.record(|| Event::PhysicalSample {
-                technique: Technique::Lobe,
-                l,
-                f_cos,
-                light_pdf: light,
-                lobe_pdf: pdf,
-                weight: power_heuristic(pdf, light),
-                shadow,
-                value,
-            })
-        };
         if !(pdf > 0.0 && pdf.is_finite()) {
             ctx.counters.lobe_skips.zero_density += 1;
-            record(
-                ctx,
-                Vec3::ZERO,
-                0.0,
-                Shadow::Skipped(Skip::ZeroPdf),
-                Vec3::ZERO,
-            );
             return Vec3::ZERO;
         }
         let Some(f) = self.reflection_towards(l, lobe_skips, ctx) else {
-            record(ctx, Vec3::ZERO, 0.0, self.skip_reason(l), Vec3::ZERO);
             return Vec3::ZERO;
         };
         ctx.counters.brdf_rays += 1;
@@ -562,24 +474,14 @@ impl ShadingPoint<'_> {
         // The light's surface is one-sided: a hit on it is a hit on its front.
         match scene.shapes.closest_hit(&ray, f32::INFINITY) {
             Some(hit) if hit.shape == object => {
-                let light = light_pdf(hit.point);
-                let value = f * (power_heuristic(pdf, light) / pdf);
-                record(ctx, f, light, Shadow::Unoccluded, value);
-                value
+                f * (power_heuristic(pdf, light_pdf(hit.point)) / pdf)
             }
-            other => {
-                let shadow = Shadow::MissedLight {
-                    object: other.map(|hit| hit.shape),
-                    t: other.map_or(f32::INFINITY, |hit| hit.t),
-                };
-                record(ctx, f, 0.0, shadow, Vec3::ZERO);
-                Vec3::ZERO
-            }
+            _ => Vec3::ZERO,
         }
     }
 
     /// Why [`Self::reflection_towards`] gave `None` for `l`.
-    fn skip_reason(&self, l: Vec3) -> Shadow {
+    pub(crate) fn skip_reason(&self, l: Vec3) -> Shadow {
         Shadow::Skipped(if self.above_surface(l) {
             Skip::ZeroBrdf
         } else {

@@ -327,8 +327,7 @@ impl<'a> PixelRenderer<'a> {
     /// The radiance of pixel `(x, y)`: the sum of its finite camera samples
     /// over `spp` (a sample that is not finite counts as zero).
     /// It depends only on the scene, the settings and `(x, y)`. With a tracer
-    /// on (`T::ON`), every sample takes the scalar path and the tracer sees
-    /// each step; the lanes the render takes otherwise give the same bits.
+    /// on (`T::ON`), it sees each step of the samples in their lanes.
     pub(crate) fn pixel<T: Tracer>(
         &self,
         x: u32,
@@ -338,7 +337,7 @@ impl<'a> PixelRenderer<'a> {
     ) -> Vec3 {
         let pixel = self.pixel_index(x, y);
         self.fill_jitters(pixel, pixel_samples);
-        let candidates = self.candidates::<T>(x, 1, y);
+        let candidates = self.candidates(x, 1, y);
         let mut sum = Vec3::ZERO;
         for (chunk, jitters) in pixel_samples.chunks(LANES).enumerate() {
             let first = PixelSample {
@@ -397,7 +396,7 @@ impl<'a> PixelRenderer<'a> {
             jitters: &jitters[..run * spp],
             samples,
         };
-        let values = self.chunk_values(&chunk, self.candidates::<T>(x0, run, y), ctx);
+        let values = self.chunk_values(&chunk, self.candidates(x0, run, y), ctx);
         let mut sums = [Vec3::ZERO; LANES];
         for (i, sum) in sums.iter_mut().enumerate().take(run) {
             accumulate(sum, &values, i * spp..(i + 1) * spp, ctx);
@@ -422,8 +421,8 @@ impl<'a> PixelRenderer<'a> {
     /// The objects the camera rays through pixels `(x0..x0 + count, y)` may
     /// hit, where the whole sample is taken in lanes (else all): those of the
     /// span of [`CANDIDATE_SPAN`] pixels or more that holds them.
-    fn candidates<T: Tracer>(&self, x0: u32, count: usize, y: u32) -> u64 {
-        if !self.all_in_lanes || T::ON {
+    fn candidates(&self, x0: u32, count: usize, y: u32) -> u64 {
+        if !self.all_in_lanes {
             return u64::MAX;
         }
         let x1 = x0 + count as u32;
@@ -446,18 +445,27 @@ impl<'a> PixelRenderer<'a> {
 
     /// The radiance of a chunk's camera samples, all in lanes (with their
     /// rays' differentials where the scene reads footprints); one by one
-    /// only for an AOV or a traced sample.
+    /// only for an AOV.
     fn chunk_values<T: Tracer>(
         &self,
         chunk: &SampleChunk,
         candidates: u64,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        if self.all_in_lanes && !T::ON {
+        let used = chunk.jitters.len();
+        ctx.tracer
+            .start_chunk(used, |k| chunk.samples.lane(k).sample);
+        let values = if self.all_in_lanes {
             self.samples_in_lanes(chunk, candidates, ctx)
         } else {
             self.samples_by_rays(chunk, ctx)
-        }
+        };
+        let value = |k| Event::SampleRadiance {
+            value: values.lane(k),
+        };
+        ctx.tracer
+            .record(lanes::bits(lanes::first_lanes(used)), value);
+        values
     }
 
     /// The radiance of a chunk's camera samples: camera rays, closest hits
@@ -471,13 +479,14 @@ impl<'a> PixelRenderer<'a> {
         let (scene, used) = (self.scene, chunk.jitters.len());
         let (px, py) = chunk.raster_lanes();
         let rays = centre_rays(&scene.camera, px, py);
+        self.record_camera(chunk, &rays, None, ctx);
         let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
         (self.integrator).li_first_hits(scene, &rays, None, &closest, used, &chunk.samples, ctx)
     }
 
     /// The radiance (or AOV) of a chunk's camera samples, each camera ray made
     /// with its differentials: their closest hits found together and then
-    /// shaded together, or, for an AOV or a traced sample, one by one.
+    /// shaded together, or, for an AOV, one by one.
     fn samples_by_rays<T: Tracer>(
         &self,
         chunk: &SampleChunk,
@@ -493,8 +502,9 @@ impl<'a> PixelRenderer<'a> {
                 (rays, diffs)
             }
         };
-        let closest = (settings.aov.is_none() && !T::ON)
-            .then(|| scene.shapes.closest_lanes(&ray_lanes, used));
+        self.record_camera(chunk, &ray_lanes, Some(&diffs), ctx);
+        let closest =
+            (settings.aov.is_none()).then(|| scene.shapes.closest_lanes(&ray_lanes, used));
         match &closest {
             Some(closest) => (self.integrator).li_first_hits(
                 scene,
@@ -505,72 +515,48 @@ impl<'a> PixelRenderer<'a> {
                 &chunk.samples,
                 ctx,
             ),
-            None => self.samples_one_by_one(chunk, (&ray_lanes, &diffs), ctx),
+            None => self.samples_one_by_one(chunk, (&ray_lanes, &diffs)),
         }
     }
 
-    /// Each of a chunk's camera samples traced alone from its ray and
+    /// Each of a chunk's camera samples' AOV, from its ray and
     /// differentials (`rays`).
-    fn samples_one_by_one<T: Tracer>(
+    fn samples_one_by_one(
         &self,
         chunk: &SampleChunk,
         (ray_lanes, diffs): (&RayLanes, &[RayDifferential; LANES]),
-        ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        let used = chunk.jitters.len();
-        Vec3Lanes::from_lanes(std::array::from_fn(|k| {
-            if k >= used {
-                return Vec3::ZERO;
-            }
-            let (ray, diff) = (&ray_lanes.lane(k), &diffs[k]);
-            let sample = chunk.samples.lane(k).sample;
-            let x = chunk.x(k);
-            self.sample((x, chunk.y, chunk.jitters[k]), sample, ray, diff, ctx)
+        let (scene, settings, used) = (self.scene, self.settings, chunk.jitters.len());
+        let aov = settings.aov.expect("one by one for an AOV");
+        Vec3Lanes::from_lanes(std::array::from_fn(|k| match k < used {
+            true => aov.evaluate(scene, &ray_lanes.lane(k), &diffs[k], settings.max_depth),
+            false => Vec3::ZERO,
         }))
     }
 
-    /// The radiance (or AOV) of camera sample `sample` of pixel (x, y), at
-    /// `jitter` in it, along `ray`.
-    fn sample<T: Tracer>(
+    /// The camera stage of the lanes of `chunk`, whose rays are `rays`
+    /// (with their differentials where the scene reads footprints).
+    fn record_camera<T: Tracer>(
         &self,
-        (x, y, jitter): (u32, u32, Vec2),
-        sample: u64,
-        ray: &Ray,
-        diff: &RayDifferential,
+        chunk: &SampleChunk,
+        rays: &RayLanes,
+        diffs: Option<&[RayDifferential; LANES]>,
         ctx: &mut SampleContext<T>,
-    ) -> Vec3 {
-        let (scene, settings, integrator) = (self.scene, self.settings, self.integrator);
-        let pixel = y as u64 * scene.camera.resolution().x as u64 + x as u64;
-        ctx.begin_sample(settings.seed, pixel, sample);
-        ctx.tracer.start_sample(sample);
-        ctx.tracer
-            .record(|| self.camera_event(jitter, x, y, ray, diff));
-        let value = match settings.aov {
-            None => integrator.li(scene, ray, diff, 0, ctx),
-            Some(aov) => aov.evaluate(scene, ray, diff, settings.max_depth),
+    ) {
+        let camera = |k: usize| {
+            let raster = Vec2::new(chunk.x(k) as f32, chunk.y as f32) + chunk.jitters[k];
+            let (ndc, film_point) = self.scene.camera.film_point(raster.x, raster.y);
+            let ray = rays.lane(k);
+            Event::Camera {
+                raster,
+                ndc,
+                film_point,
+                ray,
+                differential: diffs.filter(|_| self.differentials).map(|d| d[k]),
+            }
         };
-        ctx.tracer.record(|| Event::SampleRadiance { value });
-        value
-    }
-
-    /// The camera stage of a sample at `jitter` in pixel `(x, y)`.
-    fn camera_event(
-        &self,
-        jitter: Vec2,
-        x: u32,
-        y: u32,
-        ray: &Ray,
-        diff: &RayDifferential,
-    ) -> Event {
-        let raster = Vec2::new(x as f32, y as f32) + jitter;
-        let (ndc, film_point) = self.scene.camera.film_point(raster.x, raster.y);
-        Event::Camera {
-            raster,
-            ndc,
-            film_point,
-            ray: *ray,
-            differential: self.differentials.then_some(*diff),
-        }
+        ctx.tracer
+            .record(lanes::bits(lanes::first_lanes(chunk.jitters.len())), camera);
     }
 }
 

@@ -5,37 +5,61 @@
 //! [`Tracer::ON`] is `false` and whose hooks are empty and inlined: the events'
 //! closures are never called, and the compiler removes them, so a render does
 //! exactly what it did before tracing existed. [`PixelTrace`] records the
-//! events of the samples it is asked for. The hooks only read what the
-//! integrator computed (or recompute, for display, numbers it does not keep:
-//! `n·l`, the reflection vector, the diffuse and specular parts): nothing a
-//! hook computes flows back into the radiance.
+//! events of the samples it is asked for.
 //!
-//! With a tracer on, a pixel takes the integrator's scalar path, never its
-//! SIMD lanes; the lanes give the scalar path's bits (tested where they are
-//! written), and [`crate::explain_pixel`] checks the traced pixel against the
-//! untraced one bit for bit.
+//! A traced pixel takes the render's own route: its camera samples in the
+//! SIMD lanes of one chunk, each lane one camera sample. Every hook names the
+//! lanes its event happens in, and the tracer keeps the events of the lanes
+//! whose samples it records, each sample's in its own order. The hooks only
+//! read what the integrator computed (or recompute, for display, numbers it
+//! does not keep: `n·l`, the reflection vector, the diffuse and specular
+//! parts, the nearest blocker of a blocked shadow ray): nothing a hook
+//! computes flows back into the radiance, and [`crate::explain_pixel`]
+//! checks the traced pixel against the untraced one bit for bit.
 
 use glam::{Vec2, Vec3};
+use glint_geometry::lanes::{self, LANES};
 use glint_geometry::{Hit, Ray, RayDifferential};
 use glint_texture::TexCoord;
 
 /// Receives the integrator's events. `()` ignores them at no cost.
 pub trait Tracer {
-    /// Whether events are recorded at all: with `false`, the render loop may
-    /// take its SIMD lane paths, and no event closure is ever called.
+    /// Whether events are recorded at all: with `false`, no event closure is
+    /// ever called.
     const ON: bool;
-    /// Camera sample `sample` of the pixel begins.
-    fn start_sample(&mut self, sample: u64);
-    /// An event, built only if it is recorded.
-    fn record(&mut self, event: impl FnOnce() -> Event);
+    /// A chunk of camera samples begins: lane k, for `k < used`, holds camera
+    /// sample `sample(k)` of the pixel.
+    fn start_chunk(&mut self, used: usize, sample: impl Fn(usize) -> u64);
+    /// An event in each lane of `lanes` (bit k for lane k), built only for the
+    /// lanes recorded.
+    fn record(&mut self, lanes: u32, event: impl FnMut(usize) -> Event);
+    /// The surfaces the lanes of `lanes` shade next, kept for the events of
+    /// their shading ([`Self::record_on`]).
+    fn keep_surfaces(&mut self, lanes: u32, surface: impl FnMut(usize) -> Option<TracedSurface>);
+    /// An event, or none, in each lane of `lanes` recorded, made from the
+    /// lane's kept surface.
+    fn record_on(&mut self, lanes: u32, event: impl FnMut(usize, &TracedSurface) -> Option<Event>);
 }
 
 impl Tracer for () {
     const ON: bool = false;
     #[inline(always)]
-    fn start_sample(&mut self, _: u64) {}
+    fn start_chunk(&mut self, _: usize, _: impl Fn(usize) -> u64) {}
     #[inline(always)]
-    fn record(&mut self, _: impl FnOnce() -> Event) {}
+    fn record(&mut self, _: u32, _: impl FnMut(usize) -> Event) {}
+    #[inline(always)]
+    fn keep_surfaces(&mut self, _: u32, _: impl FnMut(usize) -> Option<TracedSurface>) {}
+    #[inline(always)]
+    fn record_on(&mut self, _: u32, _: impl FnMut(usize, &TracedSurface) -> Option<Event>) {}
+}
+
+/// A lane's surface point as its events describe it: the hit's full record,
+/// the ray that found it and the texture lookup made there.
+#[derive(Clone, Debug)]
+pub struct TracedSurface {
+    pub hit: Hit,
+    pub ray: Ray,
+    pub tc: TexCoord,
 }
 
 /// Why a light or environment sample adds nothing without a shadow ray.
@@ -200,40 +224,77 @@ pub struct SampleTrace {
 #[derive(Clone, Debug)]
 pub struct PixelTrace {
     selection: SampleSelection,
-    recording: bool,
     pub samples: Vec<SampleTrace>,
+    /// Each lane's sample's place in `samples`, where it is recorded.
+    slots: [Option<usize>; LANES],
+    /// Each lane's surface being shaded.
+    surfaces: [Option<TracedSurface>; LANES],
 }
 
 impl PixelTrace {
     pub fn new(selection: SampleSelection) -> Self {
         Self {
             selection,
-            recording: false,
             samples: Vec::new(),
+            slots: [None; LANES],
+            surfaces: std::array::from_fn(|_| None),
         }
+    }
+
+    /// The recorded lanes of `lanes`, with their places in `samples`.
+    fn recorded(&self, lanes: u32) -> impl Iterator<Item = (usize, usize)> + '_ {
+        lanes::each_set(lanes).filter_map(|k| self.slots[k].map(|slot| (k, slot)))
     }
 }
 
 impl Tracer for PixelTrace {
     const ON: bool = true;
 
-    fn start_sample(&mut self, sample: u64) {
-        self.recording = match self.selection {
-            SampleSelection::All => true,
-            SampleSelection::One(k) => k == sample,
-        };
-        if self.recording {
-            self.samples.push(SampleTrace {
-                sample,
-                events: Vec::new(),
+    fn start_chunk(&mut self, used: usize, sample: impl Fn(usize) -> u64) {
+        for k in 0..LANES {
+            let sample = (k < used).then(|| sample(k));
+            let recorded = sample.filter(|&s| match self.selection {
+                SampleSelection::All => true,
+                SampleSelection::One(one) => one == s,
             });
+            self.slots[k] = recorded.map(|sample| {
+                self.samples.push(SampleTrace {
+                    sample,
+                    events: Vec::new(),
+                });
+                self.samples.len() - 1
+            });
+            self.surfaces[k] = None;
         }
     }
 
-    fn record(&mut self, event: impl FnOnce() -> Event) {
-        if self.recording {
-            if let Some(s) = self.samples.last_mut() {
-                s.events.push(event());
+    fn record(&mut self, lanes: u32, mut event: impl FnMut(usize) -> Event) {
+        let recorded: Vec<_> = self.recorded(lanes).collect();
+        for (k, slot) in recorded {
+            self.samples[slot].events.push(event(k));
+        }
+    }
+
+    fn keep_surfaces(
+        &mut self,
+        lanes: u32,
+        mut surface: impl FnMut(usize) -> Option<TracedSurface>,
+    ) {
+        let recorded: Vec<_> = self.recorded(lanes).collect();
+        for (k, _) in recorded {
+            self.surfaces[k] = surface(k);
+        }
+    }
+
+    fn record_on(
+        &mut self,
+        lanes: u32,
+        mut event: impl FnMut(usize, &TracedSurface) -> Option<Event>,
+    ) {
+        let recorded: Vec<_> = self.recorded(lanes).collect();
+        for (k, slot) in recorded {
+            if let Some(event) = self.surfaces[k].as_ref().and_then(|s| event(k, s)) {
+                self.samples[slot].events.push(event);
             }
         }
     }

@@ -139,6 +139,11 @@ impl<'a> PhongLanes<'a> {
         &self.kd
     }
 
+    /// Each lane's specular reflectance.
+    pub fn ks(&self) -> &Vec3Lanes {
+        &self.ks
+    }
+
     /// Each lane's unit shading normal, on the viewer's side.
     pub fn normals(&self) -> &Vec3Lanes {
         &self.n

@@ -1,7 +1,7 @@
 //! `glint explain`'s guarantees over the shipped scenes: an explained pixel
-//! is the rendered pixel, bit for bit, whatever path the render took (SIMD
-//! lanes or scalar); the recorded steps add up to it; a crop renders the same
-//! pixels as the whole image.
+//! is the rendered pixel, bit for bit, its steps recorded in the render's own
+//! lanes; the recorded steps add up to it; a crop renders the same pixels as
+//! the whole image.
 
 use glam::{UVec2, Vec3};
 use glint_integrator::trace::{Event, SampleSelection};
@@ -30,13 +30,10 @@ fn bits(v: Vec3) -> [u32; 3] {
     v.to_array().map(f32::to_bits)
 }
 
-/// Each case takes another of the render loop's paths: whole samples in
-/// lanes (one light sample), several pixels' samples in one chunk's lanes,
-/// first hits in lanes with light samples in lanes,
-/// the scalar path with footprints, mirrors and environment samples, the BVH,
-/// physical shading with MIS and without (its light samples' shadow rays
-/// in lanes when rendered, one by one when explained), and every pattern of
-/// light and environment points.
+/// Each case takes another of the lanes' routes: one light sample and
+/// several, several pixels' samples in one chunk's lanes, footprints read
+/// lane by lane, mirrors and environment samples, the BVH, physical shading
+/// with MIS and without, and every pattern of light and environment points.
 fn cases() -> Vec<(&'static str, Scene, RenderSettings)> {
     let size = UVec2::new(24, 18);
     let few = |s: &mut RenderSettings| {
@@ -326,4 +323,25 @@ fn pixels_and_samples_outside_the_render_are_refused() {
         ..RenderControl::default()
     };
     assert!(render_with(&scene, &settings, &|_, _| {}, control).is_err());
+}
+
+#[test]
+fn a_sample_traced_alone_has_the_steps_it_has_among_all_the_pixels_samples() {
+    for (name, scene, settings) in cases() {
+        let all = explain_pixel(&scene, &settings, 12, 12, SampleSelection::All).unwrap();
+        for (k, traced) in all.samples.iter().enumerate() {
+            let alone = SampleSelection::One(k as u64);
+            let one = explain_pixel(&scene, &settings, 12, 12, alone).unwrap();
+            assert_eq!(
+                one.samples,
+                std::slice::from_ref(traced),
+                "{name}: sample {k}"
+            );
+            assert!(
+                matches!(traced.events.first(), Some(Event::Camera { .. }))
+                    && matches!(traced.events.last(), Some(Event::SampleRadiance { .. })),
+                "{name}: sample {k} starts at the camera and ends with its radiance"
+            );
+        }
+    }
 }

@@ -156,7 +156,7 @@ fn li(c: &mut Criterion) {
                     ctx.begin_sample(0, pixel, 0);
                     // A render of 16 samples per pixel shrinks differentials to ¼.
                     let (ray, diff) = camera_ray(&scene.camera, raster, 0.25);
-                    black_box(integrator.li(&scene, black_box(&ray), &diff, 0, &mut ctx));
+                    black_box(integrator.li(&scene, black_box(&ray), &diff, &mut ctx));
                 }
             })
         });

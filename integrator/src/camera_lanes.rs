@@ -37,7 +37,8 @@
 //! repeats the scalar path's operations in its order, and its random numbers
 //! come from its own camera sample's stream or its own points of its pixel's
 //! Sobol sequence, so each sample's radiance and the shading counts are those
-//! of [`DirectIntegrator::li_at`], bit for bit (the tests compare).
+//! of `li_at`, the integrator one ray at a time that the tests hold the
+//! lanes to (`reference.rs`, in test builds), bit for bit.
 
 mod events;
 
@@ -54,8 +55,8 @@ use crate::{DirectIntegrator, Scene, ShadingCounters, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Float, I32Lanes, Vec3Lanes, LANES};
 use glint_geometry::{
-    offset_ray_origins, reflect, spawn_ray, ClosestLanes, ObjectRef, Occluders, RayDifferential,
-    RayLanes, Shape, Sphere, SurfaceLanes, SPHERE_UV_APPROX_ERROR,
+    offset_ray_origins, reflect, spawn_ray, ClosestLanes, ObjectRef, Occluders, Ray,
+    RayDifferential, RayLanes, Shape, Sphere, SurfaceLanes, SPHERE_UV_APPROX_ERROR,
 };
 use glint_lighting::{
     sample_specular_at, specular_pdf_at, AreaLight, EnvironmentLight, Light, PhongLanes,
@@ -65,10 +66,30 @@ use glint_texture::{Checkerboard, TexCoord, Texture};
 use std::cell::OnceCell;
 
 impl DirectIntegrator {
+    /// The radiance arriving along the camera ray `ray`, whose footprint is
+    /// given by the ray differentials `diff` (read where the scene filters
+    /// textures over footprints), for the camera sample `ctx` was started on
+    /// ([`SampleContext::begin_sample`]): the render's own route, in one lane.
+    pub fn li<T: Tracer>(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        diff: &RayDifferential,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
+        let rays = RayLanes::new([*ray; LANES]);
+        let diffs = [*diff; LANES];
+        let closest = scene.shapes.closest_lanes(&rays, 1);
+        let samples = LaneSamples::of_pixel(ctx.sample);
+        let footprints = scene.needs_differentials().then_some(&diffs);
+        self.li_first_hits(scene, &rays, footprints, &closest, 1, &samples, ctx)
+            .lane(0)
+    }
+
     /// The radiance of the first `used` of [`LANES`] camera samples, lane k
     /// sample `samples.lane(k)`, whose camera rays `rays` (with their
     /// differentials `diffs` where the scene reads footprints) have the
-    /// closest hits `closest`: for each, what [`Self::li_at`] gives it alone (with
+    /// closest hits `closest`: for each, what `li_at` gives it alone (with
     /// [`SampleContext::begin_sample`] for that sample), bit for bit.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn li_first_hits<T: Tracer>(
@@ -1313,7 +1334,7 @@ impl<'a> ShadedLanes<'a> {
 
     /// The light samples at `position` with solid-angle densities `pdf`, one
     /// a lane, in the lanes `used`, short of their shadow rays: each lane's
-    /// `f · cos θ · w / p` ([`ShadingPoint::light_sample_unshadowed`] bit for
+    /// `f · cos θ · w / p` (`ShadingPoint::light_sample_unshadowed` bit for
     /// bit, `w` the power heuristic's weight in the lanes `mis`, else 1) and
     /// the lanes that need a shadow ray, the others counted as skipped.
     #[inline(always)]

@@ -40,6 +40,8 @@ mod direct;
 mod explain;
 mod light_samples;
 mod physical;
+#[cfg(test)]
+mod reference;
 mod render;
 mod report_level;
 pub mod sampling;

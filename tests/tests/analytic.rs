@@ -43,7 +43,7 @@ fn estimates(scene: &Scene, settings: &RenderSettings, ray: &Ray, seeds: u64) ->
     (0..seeds)
         .map(|seed| {
             ctx.begin_sample(seed, 0, 0);
-            let radiance = integrator.li(scene, ray, &RayDifferential::none(ray), 0, &mut ctx);
+            let radiance = integrator.li(scene, ray, &RayDifferential::none(ray), &mut ctx);
             assert!(radiance.is_finite(), "{radiance}");
             f64::from(radiance.x)
         })

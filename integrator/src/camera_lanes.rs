@@ -503,14 +503,47 @@ impl DirectIntegrator {
             let pdf = F32Lanes::select(lit_lanes, pdf, F32Lanes::ZERO);
             (position, pdf, area.shadow_ends(&position))
         };
+        let light_pdf = |k: usize, y: Vec3| sampler.pdf_in_lane(k, y);
+        let sampled = (draw, light_pdf);
+        let light = (index, area.color);
+        self.sampled_light_term(
+            scene,
+            shaded,
+            light,
+            (lit, &occluders),
+            sampled,
+            (pair, streams),
+            ctx,
+        )
+    }
+
+    /// `L · Σ (f · cos θ / p · V · w) / n` at the lanes `lit` for light
+    /// `index` of radiance `L`: its `n` samples drawn by `draw`
+    /// ([`Self::light_sum`], their shadow rays tested against `occluders`)
+    /// and, on glossy points, as many of the lobe's ([`Self::lobe_sum`]),
+    /// weighted by the power heuristic against `light_pdf`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn sampled_light_term<T: Tracer>(
+        &self,
+        scene: &Scene,
+        shaded: &ShadedLanes,
+        (index, color): (usize, Vec3),
+        (lit, occluders): (u32, &Occluders),
+        (draw, light_pdf): (
+            impl FnMut((F32Lanes, F32Lanes)) -> (Vec3Lanes, F32Lanes, Vec3Lanes),
+            impl Fn(usize, Vec3) -> f32,
+        ),
+        (pair, streams): (DimensionPair, &mut LaneStreams),
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3Lanes {
         let mis = self.mis_lanes(shaded, lit);
-        let shadowed = (lit, mis, &occluders);
+        let shadowed = (lit, mis, occluders);
         let mut sum = self.light_sum(scene, shaded, shadowed, (pair, streams), draw, ctx);
         if mis != 0 {
-            let light_pdf = |k: usize, y: Vec3| sampler.pdf_in_lane(k, y);
             sum = sum + self.lobe_sum(scene, shaded, (mis, index), light_pdf, streams, ctx);
         }
-        Vec3Lanes::scaled_splat_lanes(area.color, &sum).div_splat(n as f32)
+        Vec3Lanes::scaled_splat_lanes(color, &sum).div_splat(self.light_samples as f32)
     }
 
     /// `physical_sphere_light`'s `L · Σ (f · cos θ / p · V · w) / n` for
@@ -539,14 +572,10 @@ impl DirectIntegrator {
             let (_, [point, error, normal], pdf) = light.sample_lanes(&shaded.point, u);
             (point, pdf, offset_ray_origins(&point, &error, &normal))
         };
-        let mis = self.mis_lanes(shaded, lit);
-        let all = (lit, mis, &Occluders::ALL);
-        let mut sum = self.light_sum(scene, shaded, all, (pair, streams), draw, ctx);
-        if mis != 0 {
-            let light_pdf = |k: usize, _: Vec3| light.pdf(shaded.point.lane(k));
-            sum = sum + self.lobe_sum(scene, shaded, (mis, index), light_pdf, streams, ctx);
-        }
-        Vec3Lanes::scaled_splat_lanes(light.color, &sum).div_splat(n as f32)
+        let light_pdf = |k: usize, _: Vec3| light.pdf(shaded.point.lane(k));
+        let (sampled, all) = ((draw, light_pdf), (lit, &Occluders::ALL));
+        let light = (index, light.color);
+        self.sampled_light_term(scene, shaded, light, all, sampled, (pair, streams), ctx)
     }
 
     /// `Σ_j f · cos θ / p · V · w` over a light's `light_samples` samples at

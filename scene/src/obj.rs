@@ -4,6 +4,7 @@ use glam::{Vec2, Vec3};
 use glint_lighting::PhongMaterial;
 use glint_texture::{load_image, ImageTexture, Texture, TextureFilter, TextureImage, WrapMode};
 use std::collections::HashMap;
+use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -31,6 +32,16 @@ pub struct ObjMesh {
 /// (or `map_Kd`, an image relative to the OBJ, filtered trilinearly), `Ks` →
 /// specular, `Ns` → shininess. Errors are one line naming the file.
 pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
+    load_obj_bounded(path, with_materials, FACES_PER_MODEL)
+}
+
+/// [`load_obj`], tobj given at most `faces_per_model` faces a model
+/// ([`ModelsBounded`]).
+fn load_obj_bounded(
+    path: &Path,
+    with_materials: bool,
+    faces_per_model: usize,
+) -> Result<ObjMesh, String> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -50,19 +61,19 @@ pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
     // would panic on is refused first (the loader is `Fn`: the reason is kept
     // in a cell).
     let refused = std::cell::RefCell::new(None);
-    let (models, materials) =
-        tobj::load_obj_buf(&mut std::io::BufReader::new(file), &options, |library| {
-            if !with_materials {
-                return Ok(Default::default());
-            }
-            let library = base.join(library);
-            if let Err(e) = check_material_library(&library) {
-                *refused.borrow_mut() = Some(e);
-                return Err(tobj::LoadError::MaterialParseError);
-            }
-            tobj::load_mtl(library)
-        })
-        .map_err(|e| cannot_read(&e))?;
+    let mut reader = ModelsBounded::new(std::io::BufReader::new(file), faces_per_model);
+    let (models, materials) = tobj::load_obj_buf(&mut reader, &options, |library| {
+        if !with_materials {
+            return Ok(Default::default());
+        }
+        let library = base.join(library);
+        if let Err(e) = check_material_library(&library) {
+            *refused.borrow_mut() = Some(e);
+            return Err(tobj::LoadError::MaterialParseError);
+        }
+        tobj::load_mtl(library)
+    })
+    .map_err(|e| cannot_read(&e))?;
     if let Some(why) = refused.into_inner() {
         return Err(format!(
             "{}: cannot read its material library {why}",
@@ -111,7 +122,15 @@ pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
             path.display()
         ));
     }
-    for model in &models {
+    mesh.positions.reserve_exact(vertices);
+    mesh.normals
+        .reserve_exact(if keep_normals { vertices } else { 0 });
+    mesh.uvs.reserve_exact(if keep_uvs { vertices } else { 0 });
+    mesh.indices.reserve_exact(triangles);
+    mesh.triangle_materials.reserve_exact(triangles);
+    // Each model is dropped once copied: tobj's copy and this one are not
+    // both held whole.
+    for model in models {
         let m = &model.mesh;
         let first = mesh.positions.len() as u32;
         let vertices = m.positions.len() / 3;
@@ -152,6 +171,91 @@ pub fn load_obj(path: &Path, with_materials: bool) -> Result<ObjMesh, String> {
         return Err(format!("{}: the OBJ file has no faces", path.display()));
     }
     Ok(mesh)
+}
+
+/// The faces of one model tobj is given at most: it holds a model's faces
+/// (about 100 bytes each, in a list grown by doubling) until the model ends.
+const FACES_PER_MODEL: usize = 1 << 16;
+
+/// An OBJ file as tobj reads it, with the current object or group line (the
+/// last `o` or `g` line, or tobj's default name before one) said again before
+/// every `limit`-th face of a model, where tobj then ends the model and starts
+/// another of the same name and material. The triangles, their order, their
+/// corners and their materials are the file's; a vertex used on both sides of
+/// such a break is stored once on each (tobj gathers vertices per model).
+struct ModelsBounded<R> {
+    inner: R,
+    /// What is served: the next line of the file, after a group line said again.
+    served: Vec<u8>,
+    at: usize,
+    /// The last `o` or `g` line, with its line end.
+    group: Vec<u8>,
+    faces: usize,
+    limit: usize,
+}
+
+impl<R: BufRead> ModelsBounded<R> {
+    fn new(inner: R, limit: usize) -> Self {
+        Self {
+            inner,
+            served: Vec::new(),
+            at: 0,
+            group: b"g unnamed_object\n".to_vec(),
+            faces: 0,
+            limit,
+        }
+    }
+
+    /// Reads the file's next line into `served`, the group line before it
+    /// where a model has `limit` faces already.
+    fn next_line(&mut self) -> std::io::Result<()> {
+        self.served.clear();
+        self.at = 0;
+        self.inner.read_until(b'\n', &mut self.served)?;
+        // tobj's first word: of the line as UTF-8 (one that is not fails tobj).
+        let first = std::str::from_utf8(&self.served)
+            .ok()
+            .and_then(|l| l.split_whitespace().next());
+        match first {
+            Some("o" | "g") => {
+                self.group.clone_from(&self.served);
+                if !self.group.ends_with(b"\n") {
+                    self.group.push(b'\n');
+                }
+                self.faces = 0;
+            }
+            Some("f") if self.faces == self.limit => {
+                self.served.splice(0..0, self.group.iter().copied());
+                self.faces = 1;
+            }
+            Some("f") => self.faces += 1,
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+impl<R: BufRead> Read for ModelsBounded<R> {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        let available = self.fill_buf()?;
+        let n = available.len().min(out.len());
+        out[..n].copy_from_slice(&available[..n]);
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl<R: BufRead> BufRead for ModelsBounded<R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        if self.at == self.served.len() {
+            self.next_line()?;
+        }
+        Ok(&self.served[self.at..])
+    }
+
+    fn consume(&mut self, n: usize) {
+        self.at += n;
+    }
 }
 
 /// Why the material libraries of the OBJ at `path` could not be read: the
@@ -421,5 +525,64 @@ mod tests {
             "{e}"
         );
         assert!(load_obj(&short, false).is_ok());
+    }
+
+    /// Each triangle's corners (position, normal, uv) and material.
+    fn corners(mesh: &ObjMesh) -> Vec<([[f32; 8]; 3], Option<u32>)> {
+        let corner = |v: u32| {
+            let (v, p) = (v as usize, mesh.positions[v as usize]);
+            let n = mesh.normals.get(v).copied().unwrap_or_default();
+            let t = mesh.uvs.get(v).copied().unwrap_or_default();
+            [p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y]
+        };
+        let triangles = mesh.indices.iter().map(|tri| tri.map(corner));
+        triangles
+            .zip(mesh.triangle_materials.iter().copied())
+            .collect()
+    }
+
+    #[test]
+    fn models_ended_every_few_faces_give_the_same_triangles() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("two.mtl"),
+            "newmtl red\nKd 0.8 0.1 0.1\nnewmtl blue\nKd 0.1 0.1 0.8\n",
+        )
+        .unwrap();
+        let grid = |z: f32| {
+            let mut s = String::new();
+            for j in 0..3 {
+                for i in 0..3 {
+                    s += &format!(
+                        "v {i} {j} {z}\nvt {} {}\nvn 0 0.{} 1\n",
+                        i as f32 / 2.0,
+                        j as f32 / 2.0,
+                        i + j
+                    );
+                }
+            }
+            s
+        };
+        // Two objects of shared vertices, a material switch inside one,
+        // quads (two triangles each), a pentagon and negative indices; the
+        // first faces come before any `o` line.
+        let obj = format!(
+            "mtllib two.mtl\n{}{}f 1/1/1 2/2/2 5/5/5\no first part\nusemtl red\n\
+             f 1/1/1 2/2/2 5/5/5 4/4/4\nf 2/2/2 3/3/3 6/6/6 5/5/5\nf 4/4/4 5/5/5 8/8/8 7/7/7\n\
+             usemtl blue\nf 5/5/5 6/6/6 9/9/9 8/8/8\nf 1/1/1 3/3/3 9/9/9 8/8/8 7/7/7\n\
+             g second\nf -1/-1/-1 -2/-2/-2 -5/-5/-5\nf 10/10/10 11/11/11 14/14/14 13/13/13\n\
+             f 11/11/11 12/12/12 15/15/15 14/14/14\nf 13/13/13 14/14/14 17/17/17\n",
+            grid(0.0),
+            grid(1.0)
+        );
+        let path = dir.path().join("parts.obj");
+        std::fs::write(&path, obj).unwrap();
+        let whole = load_obj_bounded(&path, true, usize::MAX).unwrap();
+        assert_eq!(whole.indices.len(), 18);
+        for limit in [1, 2, 3] {
+            let bounded = load_obj_bounded(&path, true, limit).unwrap();
+            assert_eq!(corners(&bounded), corners(&whole), "{limit} faces a model");
+            assert!(bounded.positions.len() > whole.positions.len(), "{limit}");
+        }
     }
 }

@@ -53,8 +53,19 @@ impl Bvh {
         Self::build_with(bounds, BuildOptions::DEFAULT)
     }
 
+    /// [`Self::build`] taking the bounds, which are freed before the tree is
+    /// built: on a large mesh they are a sixth of the build's memory.
+    pub fn build_owned(bounds: Vec<Bounds3>) -> Bvh {
+        let prims = buildable_primitives(&bounds);
+        drop(bounds);
+        Self::build_from(prims, BuildOptions::DEFAULT)
+    }
+
     pub(super) fn build_with(bounds: &[Bounds3], options: BuildOptions) -> Bvh {
-        let mut prims = buildable_primitives(bounds);
+        Self::build_from(buildable_primitives(bounds), options)
+    }
+
+    fn build_from(mut prims: Vec<BuildPrimitive>, options: BuildOptions) -> Bvh {
         if prims.is_empty() {
             return Bvh::default();
         }
@@ -86,21 +97,26 @@ impl BuildOptions {
     };
 }
 
-/// The primitives with finite, non-empty bounds, in input order.
+/// The primitives with finite, non-empty bounds, in input order (in a list
+/// of the exact size: grown by doubling, it would briefly hold half again).
 pub(super) fn buildable_primitives(bounds: &[Bounds3]) -> Vec<BuildPrimitive> {
-    bounds
-        .iter()
-        .enumerate()
-        .filter(|(_, b)| b.is_finite() && !b.is_empty())
-        .map(|(i, b)| BuildPrimitive {
-            bounds: Aabb {
-                min: b.min.into(),
-                max: b.max.into(),
-            },
-            index: index_u32(i),
-            bins: [0; 3],
-        })
-        .collect()
+    let buildable = |b: &&Bounds3| b.is_finite() && !b.is_empty();
+    let mut prims = Vec::with_capacity(bounds.iter().filter(buildable).count());
+    prims.extend(
+        bounds
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| buildable(b))
+            .map(|(i, b)| BuildPrimitive {
+                bounds: Aabb {
+                    min: b.min.into(),
+                    max: b.max.into(),
+                },
+                index: index_u32(i),
+                bins: [0; 3],
+            }),
+    );
+    prims
 }
 
 /// A subtree under construction: built sequentially into one node array (child

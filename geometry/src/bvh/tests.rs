@@ -334,6 +334,7 @@ fn build_is_deterministic_across_runs_and_thread_counts() {
         },
     );
     assert_eq!(layout(&first), layout(&again));
+    assert_eq!(layout(&first), layout(&Bvh::build_owned(bounds.clone())));
     assert_eq!(layout(&first), layout(&one));
     assert_eq!(layout(&first), layout(&two));
     assert_eq!(

@@ -70,8 +70,16 @@ impl ShapeList {
     /// takes, and drops the linear layout.
     fn build_bvh_over(&mut self, include: impl Fn(&ShapeList, u32) -> bool) {
         self.linear = None;
-        let mut primitives = Vec::new();
-        let mut bounds = Vec::new();
+        // Sized up front: a mesh's millions of triangles, grown by doubling,
+        // would briefly hold half again.
+        let most: usize = (self.objects.iter())
+            .map(|kind| match *kind {
+                Object::Shape(_) => 1,
+                Object::Mesh(m) => self.meshes[m as usize].triangle_count(),
+            })
+            .sum();
+        let mut primitives = Vec::with_capacity(most);
+        let mut bounds = Vec::with_capacity(most);
         self.unbounded.clear();
         for (object, kind) in self.objects.iter().enumerate() {
             let object = object as u32;
@@ -99,7 +107,7 @@ impl ShapeList {
                 }
             }
         }
-        let mut bvh = Bvh::build(&bounds);
+        let mut bvh = Bvh::build_owned(bounds);
         let order = bvh.take_primitive_order();
         self.primitives = order
             .iter()

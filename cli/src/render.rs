@@ -390,27 +390,44 @@ fn fingerprint(
     resolution: UVec2,
 ) -> Result<String, Failure> {
     let mut hasher = blake3::Hasher::new();
-    let mut add = |bytes: &[u8]| {
+    let add = |hasher: &mut blake3::Hasher, bytes: &[u8]| {
         hasher.update(&(bytes.len() as u64).to_le_bytes());
         hasher.update(bytes);
     };
-    add(env!("CARGO_PKG_VERSION").as_bytes());
+    add(&mut hasher, env!("CARGO_PKG_VERSION").as_bytes());
     for path in std::iter::once(&args.scene.scene).chain(assets) {
-        let bytes = std::fs::read(path)
-            .map_err(|e| Failure::Input(format!("{}: cannot read: {e}", path.display())))?;
-        add(&bytes);
+        add_file(&mut hasher, path)?;
     }
     let pixels_depend_on = RenderSettings {
         threads: None,
         stats: false,
         ..settings.clone()
     };
-    add(format!(
+    let settings = format!(
         "{pixels_depend_on:?} {resolution} {:?} {:?}",
         args.scene.texture_filter, args.crop
-    )
-    .as_bytes());
+    );
+    add(&mut hasher, settings.as_bytes());
     Ok(format!("blake3 {}", hasher.finalize().to_hex()))
+}
+
+/// Adds the file at `path` to `hasher` as `fingerprint` adds bytes (its
+/// length, then its bytes), streamed: a mesh's OBJ file can be hundreds of
+/// megabytes, beside the scene built from it.
+fn add_file(hasher: &mut blake3::Hasher, path: &Path) -> Result<(), Failure> {
+    let cannot_read =
+        |e: std::io::Error| Failure::Input(format!("{}: cannot read: {e}", path.display()));
+    let mut file = std::fs::File::open(path).map_err(cannot_read)?;
+    let length = file.metadata().map_err(cannot_read)?.len();
+    hasher.update(&length.to_le_bytes());
+    let read = std::io::copy(&mut file, hasher).map_err(cannot_read)?;
+    if read != length {
+        return Err(Failure::Input(format!(
+            "{}: changed while being read ({length} bytes long, then {read} bytes read)",
+            path.display()
+        )));
+    }
+    Ok(())
 }
 
 /// Refuses to resume a partial render of another size, scene or settings

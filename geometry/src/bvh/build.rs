@@ -98,15 +98,14 @@ impl BuildOptions {
 }
 
 /// The primitives with finite, non-empty bounds, in input order (in a list
-/// of the exact size: grown by doubling, it would briefly hold half again).
+/// sized for all of them: grown by doubling, it would briefly hold half again).
 pub(super) fn buildable_primitives(bounds: &[Bounds3]) -> Vec<BuildPrimitive> {
-    let buildable = |b: &&Bounds3| b.is_finite() && !b.is_empty();
-    let mut prims = Vec::with_capacity(bounds.iter().filter(buildable).count());
+    let mut prims = Vec::with_capacity(bounds.len());
     prims.extend(
         bounds
             .iter()
             .enumerate()
-            .filter(|(_, b)| buildable(b))
+            .filter(|(_, b)| b.is_finite() && !b.is_empty())
             .map(|(i, b)| BuildPrimitive {
                 bounds: Aabb {
                     min: b.min.into(),

@@ -78,8 +78,10 @@ impl ShapeList {
                 Object::Mesh(m) => self.meshes[m as usize].triangle_count(),
             })
             .sum();
-        let mut primitives = Vec::with_capacity(most);
         let mut bounds = Vec::with_capacity(most);
+        // Each object's first primitive, in the order of `bounds`: a list of
+        // the primitives themselves would be held through the build.
+        let mut runs = Vec::new();
         self.unbounded.clear();
         for (object, kind) in self.objects.iter().enumerate() {
             let object = object as u32;
@@ -89,33 +91,37 @@ impl ShapeList {
             match *kind {
                 Object::Shape(s) => match self.shapes[s as usize].bounds() {
                     Some(b) => {
-                        primitives.push(Primitive {
-                            object,
-                            triangle: 0,
-                        });
+                        runs.push((bounds.len(), object));
                         bounds.push(b);
                     }
                     None => self.unbounded.push(object),
                 },
                 Object::Mesh(m) => {
                     let mesh = &self.meshes[m as usize];
+                    runs.push((bounds.len(), object));
                     for triangle in 0..mesh.triangle_count() as u32 {
                         let (lo, hi) = mesh.triangle_bounds(triangle);
-                        primitives.push(Primitive { object, triangle });
                         bounds.push(Bounds3::new(lo, hi));
                     }
                 }
             }
         }
+        let count = bounds.len();
         let mut bvh = Bvh::build_owned(bounds);
         let order = bvh.take_primitive_order();
+        // Primitive `i` is triangle `i − first` of the last run starting at
+        // or before it (a shape's run has one); past the end, padding.
+        let primitive = |i: usize| {
+            let run = runs.partition_point(|&(first, _)| first <= i) - 1;
+            let (first, object) = runs[run];
+            let triangle = (i - first) as u32;
+            Primitive { object, triangle }
+        };
         self.primitives = order
             .iter()
-            .map(|&i| {
-                primitives
-                    .get(i as usize)
-                    .copied()
-                    .unwrap_or(Primitive::PADDING)
+            .map(|&i| match (i as usize) < count {
+                true => primitive(i as usize),
+                false => Primitive::PADDING,
             })
             .collect();
         let leaves = self.primitives.chunks_exact(LEAF_WIDTH);

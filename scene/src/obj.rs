@@ -576,13 +576,25 @@ mod tests {
             grid(1.0)
         );
         let path = dir.path().join("parts.obj");
-        std::fs::write(&path, obj).unwrap();
+        std::fs::write(&path, &obj).unwrap();
         let whole = load_obj_bounded(&path, true, usize::MAX).unwrap();
         assert_eq!(whole.indices.len(), 18);
         for limit in [1, 2, 3] {
             let bounded = load_obj_bounded(&path, true, limit).unwrap();
             assert_eq!(corners(&bounded), corners(&whole), "{limit} faces a model");
             assert!(bounded.positions.len() > whole.positions.len(), "{limit}");
+        }
+        // Windows line ends, and a last line without one: the same triangles.
+        let crlf = dir.path().join("crlf.obj");
+        let windows = obj.replace('\n', "\r\n");
+        std::fs::write(&crlf, windows.trim_end()).unwrap();
+        for limit in [1, 2, usize::MAX] {
+            let bounded = load_obj_bounded(&crlf, true, limit).unwrap();
+            assert_eq!(
+                corners(&bounded),
+                corners(&whole),
+                "CRLF, {limit} faces a model"
+            );
         }
     }
 }

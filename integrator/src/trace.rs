@@ -242,8 +242,9 @@ impl PixelTrace {
     }
 
     /// The recorded lanes of `lanes`, with their places in `samples`.
-    fn recorded(&self, lanes: u32) -> impl Iterator<Item = (usize, usize)> + '_ {
-        lanes::each_set(lanes).filter_map(|k| self.slots[k].map(|slot| (k, slot)))
+    fn recorded(&self, lanes: u32) -> impl Iterator<Item = (usize, usize)> {
+        let slots = self.slots;
+        lanes::each_set(lanes).filter_map(move |k| slots[k].map(|slot| (k, slot)))
     }
 }
 
@@ -269,8 +270,7 @@ impl Tracer for PixelTrace {
     }
 
     fn record(&mut self, lanes: u32, mut event: impl FnMut(usize) -> Event) {
-        let recorded: Vec<_> = self.recorded(lanes).collect();
-        for (k, slot) in recorded {
+        for (k, slot) in self.recorded(lanes) {
             self.samples[slot].events.push(event(k));
         }
     }
@@ -280,8 +280,7 @@ impl Tracer for PixelTrace {
         lanes: u32,
         mut surface: impl FnMut(usize) -> Option<TracedSurface>,
     ) {
-        let recorded: Vec<_> = self.recorded(lanes).collect();
-        for (k, _) in recorded {
+        for (k, _) in self.recorded(lanes) {
             self.surfaces[k] = surface(k);
         }
     }
@@ -291,8 +290,7 @@ impl Tracer for PixelTrace {
         lanes: u32,
         mut event: impl FnMut(usize, &TracedSurface) -> Option<Event>,
     ) {
-        let recorded: Vec<_> = self.recorded(lanes).collect();
-        for (k, slot) in recorded {
+        for (k, slot) in self.recorded(lanes) {
             if let Some(event) = self.surfaces[k].as_ref().and_then(|s| event(k, s)) {
                 self.samples[slot].events.push(event);
             }

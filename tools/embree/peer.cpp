@@ -154,6 +154,14 @@ size_t trace_batch(RTCScene scene, const std::vector<Ray>& rays, size_t first, s
     rtcInitIntersectContext(&context);
     context.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     size_t found = 0;
+    // Rays i..i+15 into the lanes of a packet (the last ray repeated past the
+    // batch's end, where the lanes are not valid).
+    auto load16 = [&](auto& packet, int* valid, size_t i) {
+        for (int k = 0; k < 16; ++k) {
+            valid[k] = i + k < first + count ? -1 : 0;
+            set_lane(packet, k, rays[std::min(i + k, first + count - 1)]);
+        }
+    };
     switch (q) {
         case Query::ClosestOne:
             for (size_t i = first; i < first + count; ++i) {
@@ -176,11 +184,8 @@ size_t trace_batch(RTCScene scene, const std::vector<Ray>& rays, size_t first, s
             for (size_t i = first; i < first + count; i += 16) {
                 alignas(64) RTCRayHit16 rh;
                 alignas(64) int valid[16];
-                for (int k = 0; k < 16; ++k) {
-                    valid[k] = i + k < first + count ? -1 : 0;
-                    set_lane(rh.ray, k, rays[std::min(i + k, first + count - 1)]);
-                    rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-                }
+                load16(rh.ray, valid, i);
+                for (int k = 0; k < 16; ++k) rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
                 rtcIntersect16(valid, scene, &context, &rh);
                 for (int k = 0; k < 16; ++k) found += valid[k] && rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
             }
@@ -189,10 +194,7 @@ size_t trace_batch(RTCScene scene, const std::vector<Ray>& rays, size_t first, s
             for (size_t i = first; i < first + count; i += 16) {
                 alignas(64) RTCRay16 r;
                 alignas(64) int valid[16];
-                for (int k = 0; k < 16; ++k) {
-                    valid[k] = i + k < first + count ? -1 : 0;
-                    set_lane(r, k, rays[std::min(i + k, first + count - 1)]);
-                }
+                load16(r, valid, i);
                 rtcOccluded16(valid, scene, &context, &r);
                 for (int k = 0; k < 16; ++k) found += valid[k] && r.tfar[k] < 0.0f;
             }

@@ -179,7 +179,6 @@ impl ShadedLanes<'_> {
     /// area light, else a point light), of the lanes lit `lit`, shaded
     /// `shaded` and traced `traced`, towards `ends`, adding `reflected` where
     /// `visible`.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn trace_light_samples<T: Tracer>(
         &self,
         scene: &Scene,
@@ -213,7 +212,6 @@ impl ShadedLanes<'_> {
     /// drawn with density `pdf` (weighted against its lobe in the lanes
     /// `mis`), towards `ends`, adding `values` where `visible` (of the lanes
     /// `traced`).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn trace_physical_samples<T: Tracer>(
         &self,
         scene: &Scene,

@@ -16,7 +16,10 @@
 //! rays) and as an interleaved stream (`ShapeList::closest_primitives`); any
 //! hits one at a time, sixteen in lanes (`ShapeList::any_hits_among`, as the
 //! renderer traces shadow rays) and as a stream; with `ONLY`, the queries whose
-//! line starts with it (`"coherent closest, 16"`), for profiling one.
+//! line starts with it (`"coherent closest, 16"`), for profiling one; the
+//! environment variable `GLINT_PEER_RUNS` sets how many times each query runs
+//! (default 3: the median is printed), so that a profile of one query is not
+//! the build's.
 //!
 //! File formats (little-endian): a mesh is `u32 vertices, u32 triangles`, then
 //! the positions (`3 × f32` each) and the corner indices (`3 × u32` each); a
@@ -236,7 +239,8 @@ fn run(dir: &Path, size: &str, only: &str) {
             if !line.starts_with(only) {
                 continue;
             }
-            let time = median(|| trace(&list, &rays, &t_max, query));
+            let time =
+                glint_tests::median_time(query_runs(), || trace(&list, &rays, &t_max, query));
             println!(
                 "{line}\t{:.2} M rays/s",
                 rays.len() as f64 / time.as_secs_f64() / 1e6
@@ -328,6 +332,15 @@ fn trace(list: &ShapeList, rays: &[Ray], t_max: &[f32], query: Query) -> Duratio
 fn in_lanes(chunk: &[Ray]) -> (RayLanes, u32) {
     let lanes = RayLanes::new(std::array::from_fn(|k| chunk[k.min(chunk.len() - 1)]));
     (lanes, lanes::bits(lanes::first_lanes(chunk.len())))
+}
+
+/// How many times each query runs: `GLINT_PEER_RUNS`, or [`RUNS`].
+fn query_runs() -> usize {
+    std::env::var("GLINT_PEER_RUNS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or(RUNS)
 }
 
 fn median(f: impl FnMut() -> Duration) -> Duration {

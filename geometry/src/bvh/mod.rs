@@ -71,6 +71,7 @@ pub use bounds::Bounds3;
 pub use stats::BvhStats;
 pub use stream::{RayStream, LEAF_PREFETCH_LINES, STREAM_LANES};
 pub use trail::{record_steps, BvhChild, BvhStep, ChildTest};
+pub use traversal_lanes::LeavesLanes;
 use wide::WideBvh;
 pub use wide::LEAF_WIDTH;
 

@@ -13,10 +13,12 @@
 //! reaches, so each lane's answer is the one its ray gets alone.
 
 use super::bounds::EXIT_SCALE;
+use super::stream::LEAF_PREFETCH_LINES;
 use super::wide::{Link, WIDTH};
 use super::Bvh;
 use crate::counters::count;
 use crate::lanes::{self, F32Lanes};
+use crate::prefetch::{prefetch, prefetch_lines};
 use crate::RayLanes;
 use std::cell::RefCell;
 
@@ -33,7 +35,9 @@ impl Bvh {
     /// meet a primitive in (0, `t_max`): `blocked(first, count, reach)` gives
     /// the lanes of `reach` whose ray meets a primitive of the leaf with
     /// positions `first..first + count` (as the visit of
-    /// [`Bvh::traverse_leaves`] would find for each alone).
+    /// [`Bvh::traverse_leaves`] would find for each alone), and
+    /// `leaf_address(first)` where that leaf's primitives are, to be
+    /// prefetched ([`RayStream::leaf_address`](super::RayStream::leaf_address)).
     /// Lanes whose ray has a NaN component meet nothing, as alone.
     pub fn any_hit_lanes(
         &self,
@@ -41,6 +45,7 @@ impl Bvh {
         t_max: f32,
         active: u32,
         mut blocked: impl FnMut(u32, u32, u32) -> u32,
+        leaf_address: impl Fn(u32) -> *const u8,
     ) -> u32 {
         let finite = !(nan_lanes(rays));
         let active = active & finite & lanes::all_bits();
@@ -70,6 +75,7 @@ impl Bvh {
                 for child in 0..WIDTH {
                     let hits = reach & lanes.enter_child(&node.planes, child);
                     if hits != 0 {
+                        self.prefetch_child(node.link(child), &leaf_address);
                         stack.push((node.link(child), hits));
                     }
                 }
@@ -77,6 +83,17 @@ impl Bvh {
             found
         })
     }
+}
+
+/// What a walk of rays in lanes ([`Bvh::traverse_leaves_lanes`]) does with
+/// the leaves it reaches.
+pub trait LeavesLanes {
+    /// The lanes `reach` reach the leaf with positions `first..first + count`
+    /// in leaf order; the visit may lower their `limit`.
+    fn leaf(&mut self, first: u32, count: u32, reach: u32, limit: &mut F32Lanes);
+    /// Where the leaf at `first` keeps its primitives, to be prefetched
+    /// ([`RayStream::leaf_address`](super::RayStream::leaf_address)).
+    fn leaf_address(&self, first: u32) -> *const u8;
 }
 
 impl Bvh {
@@ -97,7 +114,7 @@ impl Bvh {
         rays: &RayLanes,
         active: u32,
         limit: &mut F32Lanes,
-        mut visit: impl FnMut(u32, u32, u32, &mut F32Lanes),
+        visit: &mut impl LeavesLanes,
     ) {
         let active = active & !nan_lanes(rays) & lanes::all_bits();
         if active == 0 || self.is_empty() {
@@ -114,7 +131,7 @@ impl Bvh {
                 if link.is_leaf() {
                     count(|c| c.bvh_leaves += u64::from(reach.count_ones()));
                     let (first, n) = link.leaf_range();
-                    visit(first, n, reach, limit);
+                    visit.leaf(first, n, reach, limit);
                     continue;
                 }
                 count(|c| c.bvh_nodes += u64::from(reach.count_ones()));
@@ -140,6 +157,9 @@ impl Bvh {
                     order[k] = (key, child);
                     n += 1;
                 }
+                for &(_, child) in &order[..n] {
+                    self.prefetch_child(node.link(child), |first| visit.leaf_address(first));
+                }
                 let entry =
                     |&(_, child): &(f32, usize)| (node.link(child), tests[child].0, tests[child].1);
                 if let Some((nearest, farther)) = order[..n].split_last() {
@@ -148,6 +168,19 @@ impl Bvh {
                 }
             }
         })
+    }
+}
+
+impl Bvh {
+    /// Prefetches what a walk reads next at `link`: the node, or the
+    /// primitives of the leaf (at `leaf_address(first)`), so that the lanes'
+    /// tests of the nodes before overlap the wait.
+    #[inline(always)]
+    fn prefetch_child(&self, link: Link, leaf_address: impl FnOnce(u32) -> *const u8) {
+        match link.is_leaf() {
+            true => prefetch_lines(leaf_address(link.leaf_range().0), LEAF_PREFETCH_LINES),
+            false => prefetch(&self.tree.nodes[link.node()]),
+        }
     }
 }
 
@@ -230,14 +263,35 @@ impl PreparedRayLanes {
             let far_plane = self.min_first[axis].select(hi, lo);
             let near = (near_plane - self.origin[axis]) * self.inv_dir[axis];
             let far = (far_plane - self.origin[axis]) * self.inv_dir[axis];
-            // `maxps`/`minps` semantics: the first operand if it compares
-            // greater (less), else the second, NaN included.
-            enter = near.simd_gt(enter).select(near, enter);
-            exit = far.simd_lt(exit).select(far, exit);
+            enter = max_or_second(near, enter);
+            exit = min_or_second(far, exit);
         }
         let hit = enter.simd_le(exit * F32Lanes::splat(EXIT_SCALE)) & enter.simd_lt(t_max);
         (hit.to_bitmask(), enter)
     }
+}
+
+/// `a > b ? a : b` in each lane (`b` where either is NaN), as the scalar
+/// test's `max_or_second` (`maxps`; `wide`'s `fast_max` compiles to it).
+/// Measured against the compare-and-select it replaces (1M triangles, one
+/// core, four alternated runs): shadow rays 1.17×, camera rays 1.04×.
+#[inline(always)]
+fn max_or_second(a: F32Lanes, b: F32Lanes) -> F32Lanes {
+    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    let max = a.fast_max(b);
+    #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+    let max = a.simd_gt(b).select(a, b);
+    max
+}
+
+/// `a < b ? a : b` in each lane (`b` where either is NaN): `minps`.
+#[inline(always)]
+fn min_or_second(a: F32Lanes, b: F32Lanes) -> F32Lanes {
+    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    let min = a.fast_min(b);
+    #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+    let min = a.simd_lt(b).select(a, b);
+    min
 }
 
 #[cfg(test)]

@@ -212,8 +212,12 @@ impl ShapeList {
                     self.shapes[s as usize].hit_distance_lanes(rays, t_max, tested)
                 }
                 _ => {
-                    let coordinate =
-                        |vertex: usize, axis: usize| packet.corners[vertex][axis][slot];
+                    // Through the array: indexing a `Vec4` by a lane not known
+                    // at compile time compiles to a jump table.
+                    let coordinate = |vertex: usize, axis: usize| {
+                        let lanes: &[f32; 4] = packet.corners[vertex][axis].as_ref();
+                        lanes[slot]
+                    };
                     // Padding (NaN) ends a leaf's run.
                     if coordinate(0, 0).is_nan() {
                         break;

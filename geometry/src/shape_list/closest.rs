@@ -16,7 +16,7 @@
 //! the distance itself.)
 
 use super::{LinearShapes, Object, ObjectRef, Primitive, ShapeList};
-use crate::bvh::RayStream;
+use crate::bvh::{LeavesLanes, RayStream};
 use crate::counters::count;
 use crate::lanes::I32Lanes;
 use crate::lanes::{self, F32Lanes, LANES};
@@ -228,17 +228,14 @@ impl ShapeList {
         }
         if let Some(bvh) = &self.bvh {
             let mut limit = search.limit();
-            bvh.traverse_leaves_lanes(rays, active, &mut limit, |first, _, reach, limit| {
-                let walked = (rays, watertight());
-                self.leaf_hits_lanes(first, walked, f32::INFINITY, reach, |slot, hits, t| {
-                    if hits != 0 {
-                        let p = self.primitives[first as usize + slot];
-                        search.consider(hits, t, (p.object, p.triangle));
-                    }
-                    false
-                });
-                *limit = search.limit();
-            });
+            let mut leaves = ClosestLeaves {
+                list: self,
+                rays,
+                watertight,
+                search,
+            };
+            bvh.traverse_leaves_lanes(rays, active, &mut limit, &mut leaves);
+            search = leaves.search;
         }
         search.finish()
     }
@@ -508,6 +505,37 @@ impl LanesSearch {
             object: bytemuck::cast(self.object),
             primitive: bytemuck::cast(self.primitive),
         }
+    }
+}
+
+/// The BVH's leaves in a [`ShapeList::closest_lanes_among`] query, tested
+/// against the lanes that reach them together.
+struct ClosestLeaves<'a, W> {
+    list: &'a ShapeList,
+    rays: &'a RayLanes,
+    /// The rays' triangle tests in lanes, prepared on first use.
+    watertight: W,
+    search: LanesSearch,
+}
+
+impl<'a, W: Fn() -> &'a WatertightLanes<'a>> LeavesLanes for ClosestLeaves<'a, W> {
+    #[inline(always)]
+    fn leaf(&mut self, first: u32, _: u32, reach: u32, limit: &mut F32Lanes) {
+        let (list, search) = (self.list, &mut self.search);
+        let walked = (self.rays, (self.watertight)());
+        list.leaf_hits_lanes(first, walked, f32::INFINITY, reach, |slot, hits, t| {
+            if hits != 0 {
+                let p = list.primitives[first as usize + slot];
+                search.consider(hits, t, (p.object, p.triangle));
+            }
+            false
+        });
+        *limit = search.limit();
+    }
+
+    #[inline(always)]
+    fn leaf_address(&self, first: u32) -> *const u8 {
+        self.list.leaf_address(first)
     }
 }
 

@@ -433,7 +433,8 @@ impl ShapeList {
             });
             blocked
         };
-        blocked | bvh.any_hit_lanes(rays, t_max, active & !blocked, leaf_blocked)
+        let leaf_address = |first| self.leaf_address(first);
+        blocked | bvh.any_hit_lanes(rays, t_max, active & !blocked, leaf_blocked, leaf_address)
     }
 
     /// The lanes of `active` for which `blocked(lane)` holds.

@@ -9,7 +9,7 @@ mod ppm;
 mod read;
 
 pub use checks::{MAX_EXPANSION, MAX_LOAD_SIDE};
-pub use partial::PartialFilm;
+pub use partial::{PartialFilm, Placement, Tile};
 pub use read::SampleEncoding;
 
 use glam::{UVec2, Vec3};

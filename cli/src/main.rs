@@ -9,17 +9,21 @@
 //!
 //! # Entry points
 //! The command line is the clap parser [`Cli`]; each subcommand has a file of its
-//! own: `render` ([`render::RenderArgs`], [`render::render`]), `diff`
+//! own: `render` ([`render::RenderArgs`], [`render::render`]), `assemble`
+//! ([`assemble::AssembleArgs`], [`assemble::assemble`]), `farm`
+//! ([`farm::FarmArgs`], [`farm::farm`]), `diff`
 //! ([`diff::DiffArgs`], [`diff::diff`]), `bench` ([`bench::BenchArgs`],
 //! [`bench::bench`]), `stress` ([`stress::StressArgs`], [`stress::stress`]),
 //! `export` ([`export::ExportArgs`], [`export::export`]).
 //! [`main`] maps every
 //! failure to its exit status; [`output`] checks output paths before any work.
 
+mod assemble;
 mod bench;
 mod diff;
 mod explain;
 mod export;
+mod farm;
 mod grade;
 mod grade_stages;
 mod interrupt;
@@ -53,6 +57,12 @@ struct Cli {
 enum Command {
     /// Render a scene file to an image
     Render(render::RenderArgs),
+    /// Put the tiles or windows of one render (glint render --tile or --crop)
+    /// together into the whole image, checking they cover it exactly once
+    Assemble(assemble::AssembleArgs),
+    /// Write a render in tiles as a job for Slurm (a job array and a merge
+    /// job) or GNU parallel (local cores or machines over ssh)
+    Farm(farm::FarmArgs),
     /// Compare two images (metrics, heat map); exit status 1 beyond a tolerance
     Diff(diff::DiffArgs),
     /// Run time against error: sample patterns and filters over a ladder of
@@ -124,6 +134,8 @@ fn main() -> ExitCode {
     };
     let result = std::panic::catch_unwind(|| match &cli.command {
         Command::Render(args) => render::render(args),
+        Command::Assemble(args) => assemble::assemble(args),
+        Command::Farm(args) => farm::farm(args),
         Command::Diff(args) => diff::diff(args),
         Command::Bench(args) => bench::bench(args),
         Command::Stress(args) => stress::stress(args),

@@ -5,7 +5,7 @@ use crate::stats::StatsReport;
 use crate::{named, progress_bar, Failure};
 use clap::Args;
 use glam::UVec2;
-use glint_camera::{ImageFormat, PartialFilm};
+use glint_camera::{Film, ImageFormat, PartialFilm, Placement, Tile};
 use glint_integrator::{
     Aov, AreaSampling, Crop, EnvironmentSampling, RenderControl, RenderSettings, SamplePattern,
 };
@@ -26,9 +26,20 @@ pub(crate) struct RenderArgs {
 
     /// Render only this window of the image, half-open: columns x0..x1, rows
     /// y0..y1 from the top (e.g. 100,50,164,114). The output is the window's
-    /// size, and its pixels are the same pixels of the whole render, bit for bit
+    /// size, and its pixels are the same pixels of the whole render, bit for
+    /// bit; an .exr output also records where the window belongs and the
+    /// render's fingerprint, for `glint assemble`
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop)]
     crop: Option<Crop>,
+
+    /// Render only tile I of N (counted from 0): rows I, I+N, I+2N, ... of the
+    /// image, dealt out in turn so that the tiles cost about the same. The
+    /// output is an .exr that records where its pixels belong (its data
+    /// window in the image's display window, alpha marking its rows) and the
+    /// render's fingerprint; `glint assemble` puts the N tiles together into
+    /// the whole render, bit for bit
+    #[arg(long, value_name = "I/N", value_parser = Tile::parse, conflicts_with = "crop")]
+    tile: Option<Tile>,
 
     /// Worker threads [default: one per core]; the image is identical for any count
     #[arg(long, value_name = "N")]
@@ -190,22 +201,34 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
     settings
         .validate()
         .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
+    let image = scene.camera.resolution();
     if let Some(crop) = args.crop {
-        let size = scene.camera.resolution();
-        if crop.x1 > size.x || crop.y1 > size.y {
+        if crop.x1 > image.x || crop.y1 > image.y {
             return Err(Failure::Input(format!(
                 "--crop: the window {},{},{},{} reaches past the {}x{} image",
-                crop.x0, crop.y0, crop.x1, crop.y1, size.x, size.y
+                crop.x0, crop.y0, crop.x1, crop.y1, image.x, image.y
+            )));
+        }
+    }
+    if let Some(tile) = args.tile {
+        if tile.row_span(image.y).is_none() {
+            return Err(Failure::Input(format!(
+                "--tile {tile}: the image has {} rows, one per tile at most, so tile {} would be empty; use at most {} tiles",
+                image.y, tile.index, image.y
             )));
         }
     }
 
     // Taken now, of the bytes just loaded: a scene edited during the render
     // must not label its partial image.
-    let window = args
-        .crop
-        .map_or(scene.camera.resolution(), |crop| crop.size());
-    let render_id = fingerprint(args, &assets, &settings, scene.camera.resolution())?;
+    let window = args.crop.map_or(image, |crop| crop.size());
+    let placement = Placement {
+        image,
+        origin: args
+            .crop
+            .map_or(glam::UVec2::ZERO, |c| glam::UVec2::new(c.x0, c.y0)),
+    };
+    let render_id = fingerprint(args, &assets, &settings, image)?;
     let partial_file = partial_path(&output);
     let partial = match args.resume {
         true => {
@@ -218,10 +241,12 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
             }
             let partial = PartialFilm::load(&partial_file)
                 .map_err(|e| Failure::Input(format!("--resume: {e}")))?;
-            check_same_render(&partial_file, &partial, window, &render_id)?;
+            check_same_render(&partial_file, &partial, (window, placement), &render_id)?;
+            check_same_piece(&partial_file, &partial, args.tile)?;
             Some(partial)
         }
-        false => None,
+        // A tile's other rows count as finished from the start.
+        false => args.tile.map(|tile| other_rows_finished(tile, image)),
     };
     let interrupts =
         Interrupts::install().map_err(|e| Failure::Other(format!("cannot handle Ctrl-C: {e}")))?;
@@ -255,20 +280,45 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
             .exit_status()
             .expect("only a signal stops a render early");
         let _writing = interrupts.writing();
+        let partial = PartialFilm {
+            fingerprint: Some(render_id),
+            placement,
+            tile: args.tile,
+            interrupted: true,
+            ..PartialFilm::new(film, rendered.finished)
+        };
+        // A tile's other rows were never its to render.
+        let others = args.tile.map_or(0, |tile| {
+            let rows = (0..image.y).filter(|&y| !tile.has_row(y)).count();
+            rows * image.x as usize
+        });
         return Err(write_partial(
             &output,
             &partial_file,
-            film,
-            rendered.finished,
-            render_id,
+            (partial, others),
             status,
         ));
     }
     let write_start = std::time::Instant::now();
+    let piece = match (args.tile, args.crop) {
+        (Some(tile), _) => Some(tile_piece(&film, tile, render_id)),
+        (None, Some(_)) if ImageFormat::from_path(&output).ok() == Some(ImageFormat::Exr) => {
+            let held = vec![true; film.pixels().len()];
+            Some(PartialFilm {
+                fingerprint: Some(render_id),
+                placement,
+                ..PartialFilm::new(film.clone(), held)
+            })
+        }
+        _ => None,
+    };
     {
         let _writing = interrupts.writing();
-        film.save(&output)
-            .map_err(|e| Failure::Other(e.to_string()))?;
+        match &piece {
+            Some(piece) => piece.save(&output),
+            None => film.save(&output),
+        }
+        .map_err(|e| Failure::Other(e.to_string()))?;
         if partial.is_some() {
             // Finished: the partial render has served.
             let _ = std::fs::remove_file(&partial_file);
@@ -282,11 +332,18 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         Some(_) => format!(", {} environment samples", settings.environment_samples),
         None => String::new(),
     };
+    let size = match args.tile {
+        Some(tile) => format!(
+            "tile {tile} of {}x{} ({} rows)",
+            image.x,
+            image.y,
+            (0..image.y).filter(|&y| tile.has_row(y)).count()
+        ),
+        None => format!("{}x{}", resolution.x, resolution.y),
+    };
     crate::output::say(&format!(
-        "wrote {}: {}x{}, {} spp, {} light samples{environment_samples}, {:.3} s wall ({:.3} s rendering), {} rays ({:.2} M rays/s)\n",
+        "wrote {}: {size}, {} spp, {} light samples{environment_samples}, {:.3} s wall ({:.3} s rendering), {} rays ({:.2} M rays/s)\n",
         output.display(),
-        resolution.x,
-        resolution.y,
         settings.spp,
         settings.light_samples,
         start.elapsed().as_secs_f64(),
@@ -326,23 +383,17 @@ fn partial_path(output: &Path) -> PathBuf {
     output.with_file_name(format!("{stem}.partial.exr"))
 }
 
-/// Writes the pixels an interrupted render finished to `partial` (atomically)
-/// and says so; `output` is left as it was.
+/// Writes the pixels an interrupted render finished (`film`, of whose pixels
+/// `others` were not its to render) to `partial` (atomically) and says so;
+/// `output` is left as it was.
 fn write_partial(
     output: &Path,
     partial: &Path,
-    film: glint_camera::Film,
-    finished: Vec<bool>,
-    fingerprint: String,
+    (film, others): (PartialFilm, usize),
     status: u8,
 ) -> Failure {
-    let total = finished.len();
-    let film = PartialFilm {
-        film,
-        finished,
-        fingerprint: Some(fingerprint),
-    };
-    let done = film.finished_count();
+    let total = film.finished.len() - others;
+    let done = film.finished_count() - others;
     if let Err(e) = film.save(partial) {
         return Failure::Other(format!(
             "interrupted, and could not write the partial image: {e}"
@@ -361,6 +412,39 @@ fn write_partial(
     }
 }
 
+/// The start of a render of `tile`: the whole image, with every row but the
+/// tile's counted as finished (and black), so that only the tile's are
+/// rendered.
+fn other_rows_finished(tile: Tile, image: glam::UVec2) -> PartialFilm {
+    let finished = (0..image.y)
+        .flat_map(|y| std::iter::repeat_n(!tile.has_row(y), image.x as usize))
+        .collect();
+    PartialFilm::new(Film::new(image), finished)
+}
+
+/// The rows from the tile's first to its last of the rendered image `film`,
+/// with alpha marking the tile's own, placed in the image and named.
+fn tile_piece(film: &Film, tile: Tile, fingerprint: String) -> PartialFilm {
+    let image = film.resolution();
+    let (y0, y1) = tile.row_span(image.y).expect("checked before the render");
+    let width = image.x as usize;
+    let rows = &film.pixels()[y0 as usize * width..y1 as usize * width];
+    let mut piece = Film::new(glam::UVec2::new(image.x, y1 - y0));
+    piece.pixels_mut().copy_from_slice(rows);
+    let held = (y0..y1)
+        .flat_map(|y| std::iter::repeat_n(tile.has_row(y), width))
+        .collect();
+    PartialFilm {
+        fingerprint: Some(fingerprint),
+        placement: Placement {
+            image,
+            origin: glam::UVec2::new(0, y0),
+        },
+        tile: Some(tile),
+        ..PartialFilm::new(piece, held)
+    }
+}
+
 /// The output path: `-o`, or SCENE-NAME.png in the current directory; its
 /// extension must name a format, and its directory must be writable.
 fn output_path(args: &RenderArgs) -> Result<PathBuf, Failure> {
@@ -371,7 +455,13 @@ fn output_path(args: &RenderArgs) -> Result<PathBuf, Failure> {
             Path::new(stem).with_extension("png")
         }
     };
-    ImageFormat::from_path(&path).map_err(|e| Failure::Input(e.to_string()))?;
+    let format = ImageFormat::from_path(&path).map_err(|e| Failure::Input(e.to_string()))?;
+    if let (Some(tile), false) = (args.tile, format == ImageFormat::Exr) {
+        return Err(Failure::Input(format!(
+            "{}: --tile {tile} writes OpenEXR (.exr), which records where the tile's pixels belong; name an .exr output",
+            path.display()
+        )));
+    }
     crate::output::check_writable(&path)?;
     // An interrupted render writes beside it: that must be possible too.
     crate::output::check_writable(&partial_path(&path))?;
@@ -381,8 +471,11 @@ fn output_path(args: &RenderArgs) -> Result<PathBuf, Failure> {
 /// A name for everything a render's pixels depend on: a BLAKE3 hash of Glint's
 /// version, the scene file and every asset it read (their bytes), the render
 /// settings that change pixels (not the thread count nor `--stats`), the
-/// resolution and the texture filter override. An interrupted render stores it
-/// in its partial EXR; `--resume` continues only a render with the same one.
+/// resolution and the texture filter override: the whole image's, whatever
+/// window or tile of it is rendered. An interrupted render stores it in its
+/// partial EXR, and `--resume` continues only a render with the same one;
+/// tiles and windows store it, and `glint assemble` puts together only pieces
+/// with the same one.
 fn fingerprint(
     args: &RenderArgs,
     assets: &[PathBuf],
@@ -404,8 +497,8 @@ fn fingerprint(
         ..settings.clone()
     };
     let settings = format!(
-        "{pixels_depend_on:?} {resolution} {:?} {:?}",
-        args.scene.texture_filter, args.crop
+        "{pixels_depend_on:?} {resolution} {:?}",
+        args.scene.texture_filter
     );
     add(&mut hasher, settings.as_bytes());
     Ok(format!("blake3 {}", hasher.finalize().to_hex()))
@@ -435,7 +528,7 @@ fn add_file(hasher: &mut blake3::Hasher, path: &Path) -> Result<(), Failure> {
 fn check_same_render(
     output: &Path,
     partial: &PartialFilm,
-    resolution: UVec2,
+    (resolution, placement): (UVec2, Placement),
     expected: &str,
 ) -> Result<(), Failure> {
     let film = partial.film.resolution();
@@ -447,6 +540,21 @@ fn check_same_render(
             film.y,
             resolution.x,
             resolution.y
+        )));
+    }
+    let (at, whole) = (partial.placement.origin, partial.placement.image);
+    if partial.placement != placement {
+        return Err(Failure::Input(format!(
+            "--resume: {}: the partial image is the window at {},{} of a {}x{} image, this render the one at {},{} of {}x{}",
+            output.display(),
+            at.x,
+            at.y,
+            whole.x,
+            whole.y,
+            placement.origin.x,
+            placement.origin.y,
+            placement.image.x,
+            placement.image.y
         )));
     }
     match partial.fingerprint.as_deref() {
@@ -463,6 +571,40 @@ fn check_same_render(
             output.display()
         ))),
     }
+}
+
+/// Refuses to resume as a tile what is not that tile's partial render, or as
+/// the whole image (or a window) a tile's.
+fn check_same_piece(
+    output: &Path,
+    partial: &PartialFilm,
+    tile: Option<Tile>,
+) -> Result<(), Failure> {
+    let name = |tile: Option<Tile>| match tile {
+        Some(tile) => format!("tile {tile}"),
+        None => "no tile".into(),
+    };
+    if partial.tile != tile {
+        return Err(Failure::Input(format!(
+            "--resume: {} is a partial render of {}, this command renders {}; run the command that wrote it",
+            output.display(),
+            name(partial.tile),
+            name(tile)
+        )));
+    }
+    if !partial.interrupted {
+        return Err(Failure::Input(format!(
+            "--resume: {} is not an interrupted render's (it was not written by a stopped glint render); render again without --resume",
+            output.display()
+        )));
+    }
+    Ok(())
+}
+
+/// The size of the image `args` would render: its scene loaded, with the
+/// command's overrides.
+pub(crate) fn image_size(args: &RenderArgs) -> Result<UVec2, Failure> {
+    Ok(args.scene.load()?.scene.camera.resolution())
 }
 
 impl SceneArgs {

@@ -246,11 +246,10 @@ fn resume_refuses_what_is_not_a_partial_render() {
         Some(0)
     );
     common::assert_input_error(&run("done.exr"), "no coverage (alpha) channel");
-    let unnamed = glint_camera::PartialFilm {
-        film: glint_camera::Film::new(glam::UVec2::new(64, 64)),
-        finished: vec![false; 64 * 64],
-        fingerprint: None,
-    };
+    let unnamed = glint_camera::PartialFilm::new(
+        glint_camera::Film::new(glam::UVec2::new(64, 64)),
+        vec![false; 64 * 64],
+    );
     unnamed
         .save(&dir.path().join("unnamed.partial.exr"))
         .unwrap();

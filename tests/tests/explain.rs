@@ -274,11 +274,7 @@ fn a_resumed_render_is_the_whole_render_where_runs_are_broken() {
             let (x, y) = (i as u32 % size.x, i as u32 / size.x);
             film.set_pixel(x, y, whole.pixel(x, y));
         }
-        let partial = glint_camera::PartialFilm {
-            film,
-            finished,
-            fingerprint: None,
-        };
+        let partial = glint_camera::PartialFilm::new(film, finished);
         let control = RenderControl {
             resume: Some(&partial),
             ..RenderControl::default()

@@ -1,39 +1,136 @@
-//! A partly rendered film: what an interrupted render writes, and what a
-//! resumed one reads back. In OpenEXR the coverage is the alpha channel (1 for
-//! a rendered pixel, 0 for one not reached), so viewers show the unfinished
-//! pixels as transparent; the colour channels are the film's, 32-bit float. A
-//! text naming the render (its fingerprint) goes in the header, as the string
-//! attribute [`FINGERPRINT_ATTRIBUTE`].
+//! A partly rendered film: what an interrupted render writes and a resumed
+//! one reads back, and a piece of an image rendered on its own (`glint
+//! render --tile` or `--crop`) that `glint assemble` puts together with the
+//! others. In OpenEXR the coverage is the alpha channel (1 for a pixel the
+//! file holds, 0 for one it does not), so viewers show the missing pixels as
+//! transparent; the colour channels are the film's, 32-bit float. The file
+//! describes itself: its data window sits where the film belongs in the whole
+//! image, its display window, and header attributes name the render (its
+//! fingerprint, [`FINGERPRINT_ATTRIBUTE`]), the tile ([`TILE_ATTRIBUTE`]) and
+//! whether it is an interrupted render's ([`INTERRUPTED_ATTRIBUTE`]).
 
-use super::read::decode;
+use super::checks::{check_expansion, check_size, regular_file};
 use super::{Film, FilmError, ImageFormat};
-use glam::Vec3;
+use glam::{UVec2, Vec3};
 use std::path::Path;
 
 /// The OpenEXR header attribute that holds a partial film's fingerprint.
 pub const FINGERPRINT_ATTRIBUTE: &str = "glintRender";
+/// The OpenEXR header attribute that says which tile of how many a film is
+/// (`"3/64"`).
+pub const TILE_ATTRIBUTE: &str = "glintTile";
+/// The OpenEXR header attribute that marks an interrupted render's pixels
+/// (`"yes"`): alpha then says which were finished, not which the file is
+/// meant to hold.
+pub const INTERRUPTED_ATTRIBUTE: &str = "glintInterrupted";
 
-/// A film and, per pixel (row-major from the top left), whether it was rendered.
+/// A film and, per pixel (row-major from the top left), whether it holds it:
+/// for an interrupted render, whether the pixel was rendered; for a piece of
+/// an image, whether the piece covers it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PartialFilm {
     pub film: Film,
     pub finished: Vec<bool>,
     /// What was being rendered, in a text of the writer's choosing (Glint's
     /// command line hashes the scene, its assets and the settings), so that a
-    /// resumed render can check it continues the same one. Printable ASCII;
-    /// only OpenEXR keeps it.
+    /// resumed render can check it continues the same one, and pieces that
+    /// they belong together. Printable ASCII; only OpenEXR keeps it.
     pub fingerprint: Option<String>,
+    /// Where the film sits in the whole image: the whole image's size and the
+    /// film's top-left pixel in it (OpenEXR's display and data windows).
+    pub placement: Placement,
+    /// Which tile of how many the film is (`glint render --tile I/N`).
+    pub tile: Option<Tile>,
+    /// Whether the film is an interrupted render's, for `--resume`.
+    pub interrupted: bool,
+}
+
+/// Where a film sits in the image it is part of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Placement {
+    /// The whole image's size.
+    pub image: UVec2,
+    /// The film's top-left pixel in the whole image.
+    pub origin: UVec2,
+}
+
+/// Tile `index` of `count`, counted from 0.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tile {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl std::fmt::Display for Tile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl Tile {
+    /// Parses `I/N` (0 ≤ I < N).
+    pub fn parse(text: &str) -> Result<Tile, String> {
+        let (index, count) = text
+            .split_once('/')
+            .ok_or_else(|| format!("expected I/N, e.g. 3/64, got \"{text}\""))?;
+        let number = |s: &str| {
+            s.trim()
+                .parse::<u32>()
+                .map_err(|_| format!("expected I/N with whole numbers, e.g. 3/64, got \"{text}\""))
+        };
+        let (index, count) = (number(index)?, number(count)?);
+        if count == 0 || index >= count {
+            return Err(format!(
+                "expected I/N with 0 ≤ I < N (tiles count from 0), got \"{text}\""
+            ));
+        }
+        Ok(Tile { index, count })
+    }
+
+    /// Whether row `y` of the image is this tile's: rows are dealt out in
+    /// turn (tile I has rows I, I + N, I + 2N, ...), so that every tile has
+    /// rows from the whole height, and costs about the same.
+    pub fn has_row(&self, y: u32) -> bool {
+        y % self.count == self.index
+    }
+
+    /// The tile's first and last rows plus one in an image `height` rows
+    /// high, if it has any.
+    pub fn row_span(&self, height: u32) -> Option<(u32, u32)> {
+        if self.index >= height {
+            return None;
+        }
+        let last = self.index + (height - 1 - self.index) / self.count * self.count;
+        Some((self.index, last + 1))
+    }
 }
 
 impl PartialFilm {
+    /// `film` as a whole image, with the pixels `finished`, unnamed.
+    pub fn new(film: Film, finished: Vec<bool>) -> Self {
+        let image = film.resolution();
+        Self {
+            film,
+            finished,
+            fingerprint: None,
+            placement: Placement {
+                image,
+                origin: UVec2::ZERO,
+            },
+            tile: None,
+            interrupted: false,
+        }
+    }
+
     /// The pixels rendered.
     pub fn finished_count(&self) -> usize {
         self.finished.iter().filter(|&&f| f).count()
     }
 
     /// Writes the film to `path` (atomically, as [`Film::save`]): in OpenEXR
-    /// with the coverage as alpha; in PNG and PFM, which keep no coverage, with
-    /// the pixels not rendered black.
+    /// with the coverage as alpha and the placement and attributes in the
+    /// header; in PNG and PFM, which keep none of them, the film alone, with
+    /// the pixels not held black.
     pub fn save(&self, path: &Path) -> Result<(), FilmError> {
         if ImageFormat::from_path(path)? != ImageFormat::Exr {
             let mut film = self.film.clone();
@@ -45,8 +142,8 @@ impl PartialFilm {
             return film.save(path);
         }
         use exr::prelude::{
-            AttributeValue, Encoding, Image, Layer, LayerAttributes, SpecificChannels, Text, Vec2,
-            WritableImage,
+            Encoding, Image, ImageAttributes, IntegerBounds, Layer, LayerAttributes,
+            SpecificChannels, Vec2, WritableImage,
         };
         let width = self.film.resolution().x as usize;
         let (pixels, finished) = (self.film.pixels(), &self.finished);
@@ -56,23 +153,30 @@ impl PartialFilm {
             (p.x, p.y, p.z, alpha)
         });
         let mut attributes = LayerAttributes::default();
-        if let Some(fingerprint) = &self.fingerprint {
-            let printable = fingerprint
-                .bytes()
-                .all(|b| b.is_ascii_graphic() || b == b' ');
-            let text = Text::new_or_none(fingerprint)
-                .filter(|_| printable)
-                .ok_or_else(|| FilmError::Encode {
-                    path: path.to_path_buf(),
-                    message: "the render's fingerprint is not printable ASCII".into(),
+        let texts = [
+            (FINGERPRINT_ATTRIBUTE, self.fingerprint.clone()),
+            (TILE_ATTRIBUTE, self.tile.map(|t| t.to_string())),
+            (
+                INTERRUPTED_ATTRIBUTE,
+                self.interrupted.then(|| "yes".into()),
+            ),
+        ];
+        for (name, value) in texts {
+            if let Some(value) = value {
+                insert_text(&mut attributes, name, &value).map_err(|message| {
+                    FilmError::Encode {
+                        path: path.to_path_buf(),
+                        message,
+                    }
                 })?;
-            attributes.other.insert(
-                Text::from(FINGERPRINT_ATTRIBUTE),
-                AttributeValue::Text(text),
-            );
+            }
         }
+        let Placement { image, origin } = self.placement;
+        attributes.layer_position = Vec2(origin.x as i32, origin.y as i32);
         let size = (width, self.film.resolution().y as usize);
-        let image = Image::from_layer(Layer::new(size, attributes, Encoding::FAST_LOSSLESS, rgba));
+        let display = IntegerBounds::new(Vec2(0, 0), (image.x as usize, image.y as usize));
+        let layer = Layer::new(size, attributes, Encoding::FAST_LOSSLESS, rgba);
+        let image = Image::new(ImageAttributes::new(display), layer);
         let io_err = |source| FilmError::Io {
             path: path.to_path_buf(),
             source,
@@ -89,8 +193,8 @@ impl PartialFilm {
     }
 
     /// Reads an OpenEXR film with a coverage (alpha) channel, as
-    /// [`PartialFilm::save`] writes it: alpha 1 is a rendered pixel, anything
-    /// else one to render. A file without alpha is refused (it is not partial).
+    /// [`PartialFilm::save`] writes it: alpha 1 is a pixel held, anything
+    /// else one missing. A file without alpha is refused (it is not partial).
     pub fn load(path: &Path) -> Result<Self, FilmError> {
         let fail = |message: String| FilmError::Read {
             path: path.to_path_buf(),
@@ -101,42 +205,108 @@ impl PartialFilm {
                 "a partial render is an OpenEXR file (.exr), whose alpha channel says which pixels are rendered".into(),
             ));
         }
-        let decoded = decode(path, image::ImageFormat::OpenExr).map_err(fail)?;
-        let (w, h) = (decoded.width(), decoded.height());
-        if !decoded.color().has_alpha() {
+        regular_file(path).map_err(fail)?;
+        check_header(path).map_err(fail)?;
+        let read = exr::prelude::read_first_rgba_layer_from_file(
+            path,
+            |size, _| {
+                (
+                    size.width(),
+                    vec![(0.0f32, 0.0f32, 0.0f32, 0.0f32); size.area()],
+                )
+            },
+            |(width, pixels): &mut (usize, Vec<(f32, f32, f32, f32)>), at, rgba| {
+                pixels[at.y() * *width + at.x()] = rgba;
+            },
+        )
+        .map_err(|e| fail(e.to_string()))?;
+        let layer = &read.layer_data;
+        if layer.channel_data.channels.3.is_none() {
             return Err(fail(
                 "it has no coverage (alpha) channel: not the output of an interrupted render"
                     .into(),
             ));
         }
-        let rgba = decoded.into_rgba32f();
-        let mut film = Film::new(glam::UVec2::new(w, h));
+        let (w, h) = (layer.size.width() as u32, layer.size.height() as u32);
+        let mut film = Film::new(UVec2::new(w, h));
         let mut finished = Vec::with_capacity(film.pixels().len());
-        for (pixel, p) in film.pixels_mut().iter_mut().zip(rgba.pixels()) {
-            *pixel = Vec3::new(p.0[0], p.0[1], p.0[2]);
-            finished.push(p.0[3] == 1.0);
+        for (pixel, &(r, g, b, a)) in film
+            .pixels_mut()
+            .iter_mut()
+            .zip(&layer.channel_data.pixels.1)
+        {
+            *pixel = Vec3::new(r, g, b);
+            finished.push(a == 1.0);
         }
-        let fingerprint = read_fingerprint(path).map_err(fail)?;
+        let display = read.attributes.display_window;
+        let position = layer.attributes.layer_position - display.position;
+        let (image, origin) = (display.size, position);
+        let fits = origin.x() >= 0
+            && origin.y() >= 0
+            && origin.x() as usize + w as usize <= image.width()
+            && origin.y() as usize + h as usize <= image.height();
+        if !fits {
+            return Err(fail(format!(
+                "its pixels ({w}x{h} from {},{}) lie outside its image ({}x{})",
+                origin.x(),
+                origin.y(),
+                image.width(),
+                image.height()
+            )));
+        }
+        let text = |name: &str| match layer.attributes.other.get(&exr::prelude::Text::from(name)) {
+            Some(exr::prelude::AttributeValue::Text(t)) => Some(t.to_string()),
+            _ => None,
+        };
+        let tile = match text(TILE_ATTRIBUTE) {
+            Some(t) => Some(Tile::parse(&t).map_err(|e| fail(format!("{TILE_ATTRIBUTE}: {e}")))?),
+            None => None,
+        };
         Ok(Self {
             film,
             finished,
-            fingerprint,
+            fingerprint: text(FINGERPRINT_ATTRIBUTE),
+            placement: Placement {
+                image: UVec2::new(image.width() as u32, image.height() as u32),
+                origin: UVec2::new(origin.x() as u32, origin.y() as u32),
+            },
+            tile,
+            interrupted: text(INTERRUPTED_ATTRIBUTE).is_some(),
         })
     }
 }
 
-/// The fingerprint in the header of the OpenEXR file at `path`, if any.
-fn read_fingerprint(path: &Path) -> Result<Option<String>, String> {
-    use exr::prelude::{AttributeValue, Text};
+/// Refuses, before any pixel memory is taken, a file whose header claims an
+/// image too large to render or more pixels than the file could hold.
+fn check_header(path: &Path) -> Result<(), String> {
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
-    let key = Text::from(FINGERPRINT_ATTRIBUTE);
-    Ok(meta
-        .headers
-        .iter()
-        .find_map(|h| match h.own_attributes.other.get(&key) {
-            Some(AttributeValue::Text(t)) => Some(t.to_string()),
-            _ => None,
-        }))
+    let header = meta.headers.first().ok_or("it holds no image")?;
+    let file_len = std::fs::metadata(path).map_err(|e| e.to_string())?.len();
+    let display = header.shared_attributes.display_window.size;
+    for size in [header.layer_size, display] {
+        let (w, h) = (size.width() as u64, size.height() as u64);
+        check_size(w, h)?;
+        // Decoded as four 32-bit floats a pixel.
+        check_expansion(w as u32, h as u32, w * h * 16, file_len)?;
+    }
+    Ok(())
+}
+
+/// Adds the text attribute `name` = `value` (printable ASCII) to `attributes`.
+fn insert_text(
+    attributes: &mut exr::prelude::LayerAttributes,
+    name: &str,
+    value: &str,
+) -> Result<(), String> {
+    use exr::prelude::{AttributeValue, Text};
+    let printable = value.bytes().all(|b| b.is_ascii_graphic() || b == b' ');
+    let text = Text::new_or_none(value)
+        .filter(|_| printable)
+        .ok_or_else(|| format!("the attribute {name} is not printable ASCII"))?;
+    attributes
+        .other
+        .insert(Text::from(name), AttributeValue::Text(text));
+    Ok(())
 }
 
 #[cfg(test)]
@@ -151,9 +321,8 @@ mod tests {
         }
         let finished = (0..15).map(|k| k % 3 != 1).collect();
         PartialFilm {
-            film,
-            finished,
             fingerprint: Some("scene 0123abcd, 16 spp".into()),
+            ..PartialFilm::new(film, finished)
         }
     }
 

@@ -1,0 +1,627 @@
+//! `glint farm`: a render split into tiles, written as a job for an engine
+//! that already runs work across machines, not run by a scheduler of
+//! Glint's own: a Slurm job array (`sbatch`) with a merge job that waits for
+//! it, or a GNU parallel command over local cores or machines reached by ssh.
+//!
+//! Both engines drive one script per tile (`render-tile.sh I`): it renders
+//! tile I with `glint render --tile I/N`, continuing the tile's partial
+//! render with `--resume` when an earlier run was stopped (Slurm's requeue,
+//! a time limit's SIGTERM, GNU parallel's `--resume-failed`). A tile rendered
+//! again gives the same bytes. `assemble.sh` then puts the tiles together
+//! (`glint assemble`), which refuses an incomplete set and names the tiles
+//! to render again. docs/cluster.md walks through both engines.
+
+use crate::render::RenderArgs;
+use crate::{Cli, Command, Failure};
+use clap::{Args, Parser, Subcommand};
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+pub(crate) struct FarmArgs {
+    #[command(subcommand)]
+    engine: Engine,
+}
+
+#[derive(Subcommand)]
+enum Engine {
+    /// A Slurm job array, one task per tile (render.sbatch), and a merge job
+    /// that runs once every task has succeeded (assemble.sbatch)
+    Slurm {
+        #[command(flatten)]
+        options: SlurmOptions,
+        #[command(subcommand)]
+        job: Job,
+    },
+    /// A GNU parallel command, one job per tile, on this machine's cores or
+    /// on machines reached by ssh (run-parallel.sh), then the merge
+    Parallel {
+        #[command(flatten)]
+        options: ParallelOptions,
+        #[command(subcommand)]
+        job: Job,
+    },
+}
+
+#[derive(Subcommand)]
+enum Job {
+    /// One frame in tiles: glint render --tile I/N for each I, then glint assemble
+    Render(FarmRender),
+}
+
+#[derive(Args)]
+struct FarmRender {
+    /// The scene file
+    scene: PathBuf,
+
+    /// How many tiles (tasks): tile I renders rows I, I+N, I+2N, ...
+    #[arg(long, value_name = "N")]
+    tiles: u32,
+
+    /// The assembled image [default: SCENE-NAME.png in the current directory]
+    #[arg(short, long, value_name = "OUT")]
+    output: Option<PathBuf>,
+
+    /// Where the scripts, tiles (tiles/) and logs (logs/) go [default:
+    /// SCENE-NAME.farm in the current directory]
+    #[arg(long, value_name = "DIR")]
+    dir: Option<PathBuf>,
+
+    /// Options for every tile's glint render (after --, e.g. -- --spp 256)
+    #[arg(last = true, value_name = "RENDER-OPTIONS")]
+    render_options: Vec<String>,
+}
+
+#[derive(Args)]
+struct SlurmOptions {
+    /// Tasks of the array running at once (sbatch --array=0-N%M)
+    #[arg(long, value_name = "M", global = true)]
+    max_running: Option<u32>,
+
+    /// Time limit of each task, as sbatch takes it (MM, HH:MM:SS or D-HH:MM:SS)
+    #[arg(long, value_name = "TIME", global = true, value_parser = parse_slurm_time)]
+    time: Option<String>,
+
+    /// Memory of each task, as sbatch takes it (e.g. 2G, 500M)
+    #[arg(long, value_name = "SIZE", global = true, value_parser = parse_slurm_memory)]
+    mem: Option<String>,
+
+    /// CPUs of each task; glint renders with as many threads
+    #[arg(long, value_name = "N", global = true, default_value_t = 1)]
+    cpus: u32,
+
+    /// The partition (queue) to submit to
+    #[arg(long, value_name = "NAME", global = true, value_parser = parse_slurm_name)]
+    partition: Option<String>,
+
+    /// Submit the two jobs (sbatch) instead of printing the commands
+    #[arg(long, global = true)]
+    submit: bool,
+}
+
+#[derive(Args)]
+struct ParallelOptions {
+    /// Jobs at once on each machine, as GNU parallel takes it (e.g. 2, 100%)
+    /// [default: one per core]; each renders on one thread
+    #[arg(long, value_name = "N", global = true, value_parser = parse_jobs)]
+    jobs: Option<String>,
+
+    /// Machines to run on, one ssh login per line (GNU parallel's
+    /// --sshloginfile; ":" for this machine). They must see the scene, glint
+    /// and the farm directory at the same paths (a shared file system)
+    #[arg(long, value_name = "FILE", global = true)]
+    sshloginfile: Option<PathBuf>,
+
+    /// Run the command now instead of printing it
+    #[arg(long, global = true)]
+    run: bool,
+}
+
+/// Options `glint farm` sets for every tile itself.
+const MANAGED: [&str; 7] = [
+    "-o",
+    "--output",
+    "--tile",
+    "--crop",
+    "--resume",
+    "--threads",
+    "--stats-json",
+];
+
+pub(crate) fn farm(args: &FarmArgs) -> Result<(), Failure> {
+    match &args.engine {
+        Engine::Slurm {
+            options,
+            job: Job::Render(render),
+        } => {
+            let plan = Plan::new(render)?;
+            plan.write_common()?;
+            let (array, merge) = (
+                plan.dir.join("render.sbatch"),
+                plan.dir.join("assemble.sbatch"),
+            );
+            write_script(&array, &plan.slurm_array(options))?;
+            write_script(&merge, &plan.slurm_merge(options))?;
+            let commands = format!(
+                "job=$(sbatch --parsable {})\nsbatch --dependency=afterok:${{job%%;*}} {}\n",
+                quote(&array),
+                quote(&merge)
+            );
+            match options.submit {
+                true => submit(&array, &merge),
+                false => {
+                    crate::output::say(&format!(
+                        "wrote {}: {} tiles of {}; submit with\n{commands}",
+                        plan.dir.display(),
+                        plan.tiles,
+                        plan.scene.display()
+                    ));
+                    Ok(())
+                }
+            }
+        }
+        Engine::Parallel {
+            options,
+            job: Job::Render(render),
+        } => {
+            let plan = Plan::new(render)?;
+            plan.write_common()?;
+            let script = plan.dir.join("run-parallel.sh");
+            write_script(&script, &plan.parallel(options))?;
+            match options.run {
+                true => run_parallel(&script),
+                false => {
+                    crate::output::say(&format!(
+                        "wrote {}: {} tiles of {}; run with\n{}\n",
+                        plan.dir.display(),
+                        plan.tiles,
+                        plan.scene.display(),
+                        quote(&script)
+                    ));
+                    Ok(())
+                }
+            }
+        }
+    }
+}
+
+/// A render in tiles, checked, with every path absolute.
+struct Plan {
+    glint: PathBuf,
+    scene: PathBuf,
+    tiles: u32,
+    output: PathBuf,
+    dir: PathBuf,
+    render_options: Vec<String>,
+}
+
+impl Plan {
+    /// Checks everything before any file is written: the render options (as
+    /// `glint render` parses them), the scene (loaded), the tile count
+    /// against the image's rows, and the paths.
+    fn new(args: &FarmRender) -> Result<Plan, Failure> {
+        if args.tiles == 0 {
+            return Err(Failure::Input(
+                "--tiles: expected at least 1 tile, got 0".into(),
+            ));
+        }
+        if let Some(option) = args.render_options.iter().find(|o| {
+            let name = o.split('=').next().unwrap_or(o);
+            MANAGED.contains(&name)
+        }) {
+            return Err(Failure::Input(format!(
+                "render options after --: {option} is set by glint farm for each tile (managed: {})",
+                MANAGED.join(", ")
+            )));
+        }
+        let stem = args
+            .scene
+            .file_stem()
+            .map_or("render".into(), |s| s.to_string_lossy().into_owned());
+        let dir = args
+            .dir
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("{stem}.farm")));
+        let output = args
+            .output
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
+        glint_camera::ImageFormat::from_path(&output).map_err(|e| Failure::Input(e.to_string()))?;
+        let output_folder = output.parent().filter(|p| !p.as_os_str().is_empty());
+        glint_camera::check_output_folder(output_folder.unwrap_or(Path::new(".")))
+            .map_err(|e| Failure::Input(format!("-o {}: its folder {e}", output.display())))?;
+        glint_camera::check_output_folder(&dir)
+            .map_err(|e| Failure::Input(format!("--dir {}: {e}", dir.display())))?;
+        let render = parse_render(&args.scene, &dir, &args.render_options)?;
+        let image = crate::render::image_size(&render)?;
+        if args.tiles > image.y {
+            return Err(Failure::Input(format!(
+                "--tiles {}: the image has {} rows, one per tile at most; use at most {} tiles",
+                args.tiles, image.y, image.y
+            )));
+        }
+        let absolute = |path: &Path| std::path::absolute(path).unwrap_or_else(|_| path.to_owned());
+        let glint = std::env::current_exe()
+            .map_err(|e| Failure::Other(format!("cannot find the glint executable: {e}")))?;
+        Ok(Plan {
+            glint,
+            scene: absolute(&args.scene),
+            tiles: args.tiles,
+            output: absolute(&output),
+            dir: absolute(&dir),
+            render_options: args.render_options.clone(),
+        })
+    }
+
+    /// Makes the directory, `tiles/` and `logs/`, and writes the scripts
+    /// both engines run: `render-tile.sh` and `assemble.sh`.
+    fn write_common(&self) -> Result<(), Failure> {
+        let output_folder = self.output.parent().map(Path::to_owned);
+        let folders = [self.dir.clone(), self.tiles_dir(), self.dir.join("logs")];
+        for dir in folders.into_iter().chain(output_folder) {
+            std::fs::create_dir_all(&dir)
+                .map_err(|e| Failure::Other(format!("{}: cannot make it: {e}", dir.display())))?;
+        }
+        write_script(&self.dir.join("render-tile.sh"), &self.render_tile())?;
+        write_script(&self.dir.join("assemble.sh"), &self.assemble())
+    }
+
+    fn tiles_dir(&self) -> PathBuf {
+        self.dir.join("tiles")
+    }
+
+    /// `render-tile.sh I`: tile I, continued where a stopped run left it, on
+    /// as many threads as Slurm gave the task CPUs, else one (GNU parallel
+    /// runs one job per core).
+    fn render_tile(&self) -> String {
+        let options: Vec<String> = self.render_options.iter().map(|o| quote_str(o)).collect();
+        format!(
+            r#"#!/bin/bash
+# Renders tile I of {tiles} of {scene} (written by glint farm).
+# Usage: render-tile.sh I
+set -euo pipefail
+tile="$1"
+out={tiles_dir}/tile-"$tile".exr
+resume=()
+# A run stopped earlier (SIGTERM at a time limit, a requeue) left the tile's
+# finished pixels here: continue it. The result is the same bytes.
+if [ -e {tiles_dir}/tile-"$tile".partial.exr ]; then resume=(--resume); fi
+threads="${{SLURM_CPUS_PER_TASK:-1}}"
+exec {glint} render {scene} --tile "$tile/{tiles}" -o "$out" --threads "$threads" "${{resume[@]}}"{options}
+"#,
+            tiles = self.tiles,
+            scene = quote(&self.scene),
+            tiles_dir = quote(&self.tiles_dir()),
+            glint = quote(&self.glint),
+            options = options.iter().map(|o| format!(" {o}")).collect::<String>(),
+        )
+    }
+
+    /// `assemble.sh`: the tiles there are, put together; `glint assemble`
+    /// names any missing.
+    fn assemble(&self) -> String {
+        format!(
+            r#"#!/bin/bash
+# Puts the {tiles} tiles of {scene} together (written by glint farm).
+set -euo pipefail
+files=()
+for tile in $(seq 0 {last}); do
+  f={tiles_dir}/tile-"$tile".exr
+  if [ -e "$f" ]; then files+=("$f"); fi
+done
+if [ ${{#files[@]}} -eq 0 ]; then echo "no tiles in "{tiles_dir} >&2; exit 2; fi
+exec {glint} assemble "${{files[@]}}" -o {output}
+"#,
+            tiles = self.tiles,
+            last = self.tiles - 1,
+            scene = quote(&self.scene),
+            tiles_dir = quote(&self.tiles_dir()),
+            glint = quote(&self.glint),
+            output = quote(&self.output),
+        )
+    }
+
+    /// `render.sbatch`: the job array, task I rendering tile I.
+    fn slurm_array(&self, options: &SlurmOptions) -> String {
+        let throttle = options
+            .max_running
+            .map_or(String::new(), |m| format!("%{m}"));
+        let mut lines = vec![
+            "#!/bin/bash".to_owned(),
+            format!("#SBATCH --job-name=glint-render-{}", self.name()),
+            format!("#SBATCH --array=0-{}{throttle}", self.tiles - 1),
+            format!(
+                "#SBATCH --output={}/logs/render_%A_%a.log",
+                self.dir.display()
+            ),
+            // A requeued task adds to its log instead of replacing it.
+            "#SBATCH --open-mode=append".to_owned(),
+            format!("#SBATCH --cpus-per-task={}", options.cpus),
+            // Requeued after a node failure or preemption; the tile then
+            // continues from its partial render.
+            "#SBATCH --requeue".to_owned(),
+        ];
+        lines.extend(self.slurm_limits(options));
+        lines.push(format!(
+            "# Tile $SLURM_ARRAY_TASK_ID of {} of {} (written by glint farm).",
+            self.tiles,
+            self.scene.display()
+        ));
+        lines.push(format!(
+            "exec {} \"$SLURM_ARRAY_TASK_ID\"",
+            quote(&self.dir.join("render-tile.sh"))
+        ));
+        lines.join("\n") + "\n"
+    }
+
+    /// `assemble.sbatch`: the merge, submitted to wait for the array.
+    fn slurm_merge(&self, options: &SlurmOptions) -> String {
+        let mut lines = vec![
+            "#!/bin/bash".to_owned(),
+            format!("#SBATCH --job-name=glint-assemble-{}", self.name()),
+            format!(
+                "#SBATCH --output={}/logs/assemble_%j.log",
+                self.dir.display()
+            ),
+            "#SBATCH --cpus-per-task=1".to_owned(),
+        ];
+        lines.extend(self.slurm_limits(options));
+        lines.push(format!("exec {}", quote(&self.dir.join("assemble.sh"))));
+        lines.join("\n") + "\n"
+    }
+
+    fn slurm_limits(&self, options: &SlurmOptions) -> Vec<String> {
+        let mut lines = Vec::new();
+        if let Some(time) = &options.time {
+            lines.push(format!("#SBATCH --time={time}"));
+        }
+        if let Some(mem) = &options.mem {
+            lines.push(format!("#SBATCH --mem={mem}"));
+        }
+        if let Some(partition) = &options.partition {
+            lines.push(format!("#SBATCH --partition={partition}"));
+        }
+        lines
+    }
+
+    /// `run-parallel.sh`: every tile through GNU parallel, then the merge.
+    /// Run again, it renders only the tiles whose job failed (the job log
+    /// and `--resume-failed`), each continuing its partial render.
+    fn parallel(&self, options: &ParallelOptions) -> String {
+        let mut engine = vec![
+            "parallel".to_owned(),
+            format!("--joblog {}", quote(&self.dir.join("parallel.joblog"))),
+            "--resume-failed".to_owned(),
+            "--halt never".to_owned(),
+        ];
+        if let Some(jobs) = &options.jobs {
+            engine.push(format!("--jobs {jobs}"));
+        }
+        if let Some(logins) = &options.sshloginfile {
+            let logins = std::path::absolute(logins).unwrap_or_else(|_| logins.clone());
+            engine.push(format!("--sshloginfile {}", quote(&logins)));
+        }
+        format!(
+            r#"#!/bin/bash
+# Renders the {tiles} tiles of {scene} with GNU parallel, then puts them
+# together (written by glint farm). Run again after a failure: only the
+# failed tiles are rendered again.
+set -uo pipefail
+{engine} {render_tile} {{}} ::: $(seq 0 {last})
+status=$?
+if [ $status -ne 0 ]; then
+  echo "glint farm: $status tile job(s) failed (see {joblog}); run this script again to render them" >&2
+  exit $status
+fi
+exec {assemble}
+"#,
+            tiles = self.tiles,
+            scene = quote(&self.scene),
+            engine = engine.join(" "),
+            render_tile = quote(&self.dir.join("render-tile.sh")),
+            last = self.tiles - 1,
+            joblog = self.dir.join("parallel.joblog").display(),
+            assemble = quote(&self.dir.join("assemble.sh")),
+        )
+    }
+
+    /// A name for the jobs: the scene's.
+    fn name(&self) -> String {
+        let stem = self.scene.file_stem().unwrap_or_default().to_string_lossy();
+        stem.chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect()
+    }
+}
+
+/// The tiles' `glint render` command line as `glint render` parses it: the
+/// options' errors are caught here, before any job exists.
+fn parse_render(scene: &Path, dir: &Path, options: &[String]) -> Result<RenderArgs, Failure> {
+    let tile = dir.join("tiles").join("tile-0.exr");
+    let mut words: Vec<std::ffi::OsString> = vec!["glint".into(), "render".into()];
+    words.push(scene.as_os_str().to_owned());
+    words.extend([
+        "-o".into(),
+        tile.into_os_string(),
+        "--tile".into(),
+        "0/1".into(),
+    ]);
+    words.extend(options.iter().map(Into::into));
+    let parsed = Cli::try_parse_from(words).map_err(|e| {
+        let rendered = e.render().to_string();
+        let first = rendered
+            .lines()
+            .next()
+            .unwrap_or("invalid options")
+            .to_owned();
+        Failure::Input(format!(
+            "render options after --: {}",
+            first.strip_prefix("error: ").unwrap_or(&first)
+        ))
+    })?;
+    match parsed.command {
+        Command::Render(args) => Ok(args),
+        _ => unreachable!("parsed as glint render"),
+    }
+}
+
+fn write_script(path: &Path, text: &str) -> Result<(), Failure> {
+    crate::output::write_text(path, text)?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o755))
+            .map_err(|e| Failure::Other(format!("{}: {e}", path.display())))?;
+    }
+    Ok(())
+}
+
+/// Submits the array, then the merge with a dependency on it.
+fn submit(array: &Path, merge: &Path) -> Result<(), Failure> {
+    let sbatch = |args: &[&std::ffi::OsStr]| -> Result<String, Failure> {
+        let out = std::process::Command::new("sbatch")
+            .arg("--parsable")
+            .args(args)
+            .output()
+            .map_err(|e| Failure::Other(format!("cannot run sbatch: {e} (is Slurm installed?)")))?;
+        if !out.status.success() {
+            return Err(Failure::Other(format!(
+                "sbatch failed: {}",
+                String::from_utf8_lossy(&out.stderr).trim()
+            )));
+        }
+        let id = String::from_utf8_lossy(&out.stdout);
+        Ok(id.trim().split(';').next().unwrap_or_default().to_owned())
+    };
+    let job = sbatch(&[array.as_os_str()])?;
+    let dependency = format!("--dependency=afterok:{job}");
+    let merge_job = sbatch(&[dependency.as_ref(), merge.as_os_str()])?;
+    crate::output::say(&format!(
+        "submitted job array {job} (render) and job {merge_job} (assemble, after the array succeeds)\n"
+    ));
+    Ok(())
+}
+
+fn run_parallel(script: &Path) -> Result<(), Failure> {
+    let status = std::process::Command::new(script)
+        .status()
+        .map_err(|e| Failure::Other(format!("cannot run {}: {e}", script.display())))?;
+    match status.code() {
+        Some(0) => Ok(()),
+        code => Err(Failure::Other(format!(
+            "{} failed (exit status {}); run it again to render the failed tiles",
+            script.display(),
+            code.map_or("none".into(), |c| c.to_string())
+        ))),
+    }
+}
+
+/// `path` quoted for bash.
+fn quote(path: &Path) -> String {
+    quote_str(&path.to_string_lossy())
+}
+
+/// `text` as one bash word: as is where it is plainly safe, else in single quotes.
+fn quote_str(text: &str) -> String {
+    let plain = !text.is_empty()
+        && text
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "/._-+=:,%@".contains(c));
+    match plain {
+        true => text.to_owned(),
+        false => format!("'{}'", text.replace('\'', r"'\''")),
+    }
+}
+
+/// A Slurm time limit: minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS.
+fn parse_slurm_time(text: &str) -> Result<String, String> {
+    let (days, rest) = match text.split_once('-') {
+        Some((d, rest)) => (Some(d), rest),
+        None => (None, text),
+    };
+    let parts: Vec<&str> = rest.split(':').collect();
+    let numbers = days.into_iter().chain(parts.iter().copied());
+    let valid = parts.len() <= 3
+        && numbers
+            .into_iter()
+            .all(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()));
+    match valid {
+        true => Ok(text.to_owned()),
+        false => Err(format!(
+            "expected a Slurm time limit (MM, HH:MM:SS or D-HH:MM:SS), got \"{text}\""
+        )),
+    }
+}
+
+/// A Slurm memory size: a whole number with an optional K, M, G or T.
+fn parse_slurm_memory(text: &str) -> Result<String, String> {
+    let digits = text.trim_end_matches(['K', 'M', 'G', 'T', 'k', 'm', 'g', 't']);
+    let valid = !digits.is_empty()
+        && digits.bytes().all(|b| b.is_ascii_digit())
+        && text.len() - digits.len() <= 1;
+    match valid {
+        true => Ok(text.to_owned()),
+        false => Err(format!(
+            "expected a memory size such as 2G or 500M, got \"{text}\""
+        )),
+    }
+}
+
+/// A partition name: letters, digits, `-`, `_`, `.` and `,` (a list).
+fn parse_slurm_name(text: &str) -> Result<String, String> {
+    let valid = !text.is_empty()
+        && text
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_.,".contains(c));
+    match valid {
+        true => Ok(text.to_owned()),
+        false => Err(format!("expected a partition name, got \"{text}\"")),
+    }
+}
+
+/// GNU parallel's job count: a whole number, or a percentage of the cores.
+fn parse_jobs(text: &str) -> Result<String, String> {
+    let digits = text.strip_suffix('%').unwrap_or(text);
+    let valid = !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit());
+    match valid {
+        true => Ok(text.to_owned()),
+        false => Err(format!(
+            "expected a job count such as 2 or 100%, got \"{text}\""
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn words_are_quoted_for_bash_only_where_needed() {
+        assert_eq!(quote_str("/a/b-c_d.toml"), "/a/b-c_d.toml");
+        assert_eq!(quote_str("a b"), "'a b'");
+        assert_eq!(quote_str("it's"), r"'it'\''s'");
+        assert_eq!(quote_str("$HOME"), "'$HOME'");
+        assert_eq!(quote_str(""), "''");
+    }
+
+    #[test]
+    fn slurm_values_are_checked() {
+        for good in ["10", "00:10:00", "1-00:00:00", "1-12", "30:00"] {
+            assert!(parse_slurm_time(good).is_ok(), "{good}");
+        }
+        for bad in ["", "ten", "1:2:3:4", "1-", "00:1a:00"] {
+            assert!(parse_slurm_time(bad).is_err(), "{bad}");
+        }
+        assert!(parse_slurm_memory("2G").is_ok() && parse_slurm_memory("500").is_ok());
+        for bad in ["", "G", "2GG", "two"] {
+            assert!(parse_slurm_memory(bad).is_err(), "{bad}");
+        }
+        assert!(parse_jobs("100%").is_ok() && parse_jobs("2").is_ok());
+        assert!(parse_jobs("x").is_err() && parse_slurm_name("a b").is_err());
+    }
+}

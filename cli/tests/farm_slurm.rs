@@ -1,0 +1,179 @@
+//! `glint farm slurm` on a real Slurm cluster: a tiled render submitted with
+//! `sbatch` (a job array and a merge job that waits for it) gives the single
+//! render's bytes, also when one task is stopped mid-render and requeued
+//! (`scontrol requeue`: SIGTERM, then the task runs again and resumes its
+//! tile). Runs where `sinfo` answers; elsewhere it is skipped with a message.
+//! One command starts a one-node cluster here: `sudo
+//! tools/cluster/slurm-one-node.sh` (docs/testing.md).
+
+mod common;
+
+use common::{glint, scene, stderr, stdout};
+use std::path::Path;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+/// Whether a Slurm cluster answers, else why not.
+fn slurm_answers() -> Result<(), String> {
+    let out = Command::new("sinfo")
+        .args(["--noheader", "--format=%T"])
+        .output()
+        .map_err(|e| format!("sinfo does not run ({e})"))?;
+    let states = String::from_utf8_lossy(&out.stdout);
+    let up = ["idle", "mixed", "allocated"];
+    match out.status.success()
+        && states
+            .lines()
+            .any(|s| up.contains(&s.trim_end_matches('*')))
+    {
+        true => Ok(()),
+        false => Err(format!("no Slurm node is up ({})", stderr(&out).trim())),
+    }
+}
+
+/// Samples per pixel of the render stopped mid-way: a few seconds a tile.
+const LONG_SPP: &str = "32768";
+
+fn render_options(spp: &str) -> Vec<String> {
+    [
+        "--resolution",
+        "64x64",
+        "--spp",
+        spp,
+        "--light-samples",
+        "1",
+    ]
+    .map(str::to_owned)
+    .to_vec()
+}
+
+/// Submits the farm of `tiles` tiles into `dir/NAME`; returns the job ids
+/// (the array, the merge).
+fn submit(d: &Path, name: &str, tiles: u32, spp: &str) -> (String, String) {
+    let cornell = scene("cornell-set1");
+    let tiles = tiles.to_string();
+    let output = format!("{name}.exr");
+    let mut args = vec!["farm", "slurm", "render", &cornell, "--tiles", &tiles];
+    args.extend([
+        "--dir", name, "-o", &output, "--cpus", "1", "--submit", "--",
+    ]);
+    let options = render_options(spp);
+    args.extend(options.iter().map(String::as_str));
+    let out = glint(&args, d);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let said = stdout(&out);
+    let words: Vec<&str> = said.split_whitespace().collect();
+    // "submitted job array A (render) and job M (assemble, ...)"
+    let after = |word: &str, skip: usize| {
+        let k = words.iter().position(|w| *w == word).expect(word);
+        words[k + skip].to_owned()
+    };
+    (after("array", 1), after("and", 2))
+}
+
+/// Waits until none of `jobs` is queued or running.
+fn wait_for(jobs: &[&str], logs: &Path) {
+    let start = Instant::now();
+    loop {
+        let out = Command::new("squeue")
+            .args(["--noheader", "--format=%i", "--jobs", &jobs.join(",")])
+            .output()
+            .unwrap();
+        if stdout(&out).trim().is_empty() {
+            return;
+        }
+        if start.elapsed() > Duration::from_secs(300) {
+            let listing = std::fs::read_dir(logs).map(|d| d.count()).unwrap_or(0);
+            panic!("jobs {jobs:?} still queued after 5 minutes ({listing} logs in {logs:?})");
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
+/// The state of job `id` (`JOBID_TASK` for a task), if queued or running.
+fn state(id: &str) -> String {
+    let out = Command::new("squeue")
+        .args(["--noheader", "--format=%T", "--jobs", id])
+        .output()
+        .unwrap();
+    stdout(&out).trim().to_owned()
+}
+
+fn logs_text(dir: &Path) -> String {
+    let mut text = String::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        text += &std::fs::read_to_string(entry.unwrap().path()).unwrap_or_default();
+    }
+    text
+}
+
+#[test]
+fn a_tiled_render_through_sbatch_is_the_single_render_also_after_a_requeue() {
+    if let Err(why) = slurm_answers() {
+        eprintln!(
+            "skipped: {why}; start a one-node cluster with `sudo tools/cluster/slurm-one-node.sh`, then `cargo test -p glint-cli --test farm_slurm` (docs/testing.md)"
+        );
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (name, spp) in [("quick", "4"), ("long", LONG_SPP)] {
+        let mut args = vec!["render".to_owned(), scene("cornell-set1")];
+        args.extend(render_options(spp));
+        args.extend(["-o".to_owned(), format!("{name}-whole.exr")]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = glint(&args, d);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    }
+
+    let (array, merge) = submit(d, "quick", 4, "4");
+    wait_for(&[&array, &merge], &d.join("quick/logs"));
+    let (farmed, whole) = (d.join("quick.exr"), d.join("quick-whole.exr"));
+    assert!(
+        farmed.exists(),
+        "no image; logs:\n{}",
+        logs_text(&d.join("quick/logs"))
+    );
+    assert!(std::fs::read(&farmed).unwrap() == std::fs::read(&whole).unwrap());
+
+    // One task stopped mid-render: requeued, it resumes its tile.
+    let (array, merge) = submit(d, "long", 2, LONG_SPP);
+    let task = format!("{array}_1");
+    let start = Instant::now();
+    while state(&task) != "RUNNING" {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "task {task} never ran"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    std::thread::sleep(Duration::from_millis(1000));
+    let requeue = Command::new("scontrol")
+        .args(["requeue", &task])
+        .output()
+        .unwrap();
+    assert!(requeue.status.success(), "{}", stderr(&requeue));
+    // Slurm holds a requeued job back for a while (its begin time): let it
+    // start as soon as it is pending again.
+    while state(&task) != "PENDING" {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "task {task} was not requeued"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let release = Command::new("scontrol")
+        .args(["update", &format!("JobId={task}"), "StartTime=now"])
+        .output()
+        .unwrap();
+    assert!(release.status.success(), "{}", stderr(&release));
+    wait_for(&[&array, &merge], &d.join("long/logs"));
+    let logs = logs_text(&d.join("long/logs"));
+    assert!(
+        logs.contains("glint: interrupted: wrote") && logs.contains("tile-1.partial.exr"),
+        "the requeued task was not stopped mid-render:\n{logs}"
+    );
+    let (farmed, whole) = (d.join("long.exr"), d.join("long-whole.exr"));
+    assert!(farmed.exists(), "no image; logs:\n{logs}");
+    assert!(std::fs::read(&farmed).unwrap() == std::fs::read(&whole).unwrap());
+}

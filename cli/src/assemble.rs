@@ -34,23 +34,37 @@ pub(crate) fn assemble(args: &AssembleArgs) -> Result<(), Failure> {
     crate::output::check_writable(&args.output)?;
     let inputs: Vec<&Path> = args.tiles.iter().map(PathBuf::as_path).collect();
     crate::output::check_outputs_apart(&[("-o", args.output.as_path())], &inputs)?;
-    let pieces = args
-        .tiles
-        .iter()
-        .map(|path| load_piece(path))
-        .collect::<Result<Vec<_>, _>>()?;
-    check_one_render(&args.tiles, &pieces)?;
-    let image = pieces[0].placement.image;
-    let mut film = Film::new(image);
+    // One piece in memory at a time, beside the image: a tile's data window
+    // spans nearly the whole image.
+    let mut first: Option<PartialFilm> = None;
+    let mut film = Film::new(UVec2::ONE);
     // Per pixel, which piece holds it (its index plus one; 0 for none).
-    let mut holder = vec![0u32; film.pixels().len()];
-    for (k, piece) in pieces.iter().enumerate() {
-        place(&mut film, &mut holder, k, piece)
+    let mut holder = Vec::new();
+    let mut tiles = Vec::with_capacity(args.tiles.len());
+    for (k, path) in args.tiles.iter().enumerate() {
+        let piece = load_piece(path)?;
+        match &first {
+            None => {
+                film = Film::new(piece.placement.image);
+                holder = vec![0u32; film.pixels().len()];
+            }
+            Some(first) => check_one_render((&args.tiles[0], first), (path, &piece))?,
+        }
+        place(&mut film, &mut holder, k, &piece)
             .map_err(|(other, count, at)| overlap(&args.tiles, other, k, count, at))?;
+        tiles.push(piece.tile);
+        if first.is_none() {
+            first = Some(PartialFilm {
+                film: Film::new(UVec2::ONE),
+                finished: Vec::new(),
+                ..piece
+            });
+        }
     }
+    let image = film.resolution();
     let missing = holder.iter().filter(|&&h| h == 0).count();
     if missing > 0 {
-        return Err(Failure::Input(incomplete(&pieces, &holder, image, missing)));
+        return Err(Failure::Input(incomplete(&tiles, &holder, image, missing)));
     }
     film.save(&args.output)
         .map_err(|e| Failure::Other(e.to_string()))?;
@@ -59,7 +73,7 @@ pub(crate) fn assemble(args: &AssembleArgs) -> Result<(), Failure> {
         args.output.display(),
         image.x,
         image.y,
-        pieces.len()
+        args.tiles.len()
     ));
     Ok(())
 }
@@ -88,30 +102,30 @@ fn load_piece(path: &Path) -> Result<PartialFilm, Failure> {
     Ok(piece)
 }
 
-/// Refuses pieces of different renders: other scenes, assets or settings
-/// (their fingerprints), or other image sizes.
-fn check_one_render(paths: &[PathBuf], pieces: &[PartialFilm]) -> Result<(), Failure> {
-    let first = &pieces[0];
-    for (path, piece) in paths.iter().zip(pieces).skip(1) {
-        if piece.fingerprint != first.fingerprint {
-            return Err(Failure::Input(format!(
-                "{}: a piece of another render than {} (the scene, its assets, the settings or Glint's version differ): assemble the pieces of one render",
-                path.display(),
-                paths[0].display()
-            )));
-        }
-        let (a, b) = (piece.placement.image, first.placement.image);
-        if a != b {
-            return Err(Failure::Input(format!(
-                "{}: a piece of a {}x{} image, {} of a {}x{} one",
-                path.display(),
-                a.x,
-                a.y,
-                paths[0].display(),
-                b.x,
-                b.y
-            )));
-        }
+/// Refuses a piece of another render than the first piece: another scene,
+/// assets or settings (its fingerprint), or another image size.
+fn check_one_render(
+    (first_path, first): (&Path, &PartialFilm),
+    (path, piece): (&Path, &PartialFilm),
+) -> Result<(), Failure> {
+    if piece.fingerprint != first.fingerprint {
+        return Err(Failure::Input(format!(
+            "{}: a piece of another render than {} (the scene, its assets, the settings or Glint's version differ): assemble the pieces of one render",
+            path.display(),
+            first_path.display()
+        )));
+    }
+    let (a, b) = (piece.placement.image, first.placement.image);
+    if a != b {
+        return Err(Failure::Input(format!(
+            "{}: a piece of a {}x{} image, {} of a {}x{} one",
+            path.display(),
+            a.x,
+            a.y,
+            first_path.display(),
+            b.x,
+            b.y
+        )));
     }
     Ok(())
 }
@@ -160,19 +174,15 @@ fn overlap(paths: &[PathBuf], other: usize, k: usize, count: usize, at: UVec2) -
 }
 
 /// What is missing, said so that it can be rendered: the tiles not given
-/// where the pieces are tiles of one count, else the rows that lack pixels.
-fn incomplete(pieces: &[PartialFilm], holder: &[u32], image: UVec2, missing: usize) -> String {
-    let counts: Vec<u32> = pieces
-        .iter()
-        .filter_map(|p| p.tile.map(|t| t.count))
-        .collect();
-    let all_tiles = counts.len() == pieces.len() && counts.iter().all(|&n| n == counts[0]);
+/// where the pieces (`tiles`, as each says) are tiles of one count, else the
+/// rows that lack pixels.
+fn incomplete(tiles: &[Option<Tile>], holder: &[u32], image: UVec2, missing: usize) -> String {
+    let counts: Vec<u32> = tiles.iter().filter_map(|t| t.map(|t| t.count)).collect();
+    let all_tiles = counts.len() == tiles.len() && counts.iter().all(|&n| n == counts[0]);
     if all_tiles {
         let count = counts[0];
-        let given: std::collections::HashSet<u32> = pieces
-            .iter()
-            .filter_map(|p| p.tile.map(|t| t.index))
-            .collect();
+        let given: std::collections::HashSet<u32> =
+            tiles.iter().filter_map(|t| t.map(|t| t.index)).collect();
         let absent: Vec<String> = (0..count)
             .filter(|i| !given.contains(i))
             .map(|index| Tile { index, count }.to_string())

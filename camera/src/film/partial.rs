@@ -4,25 +4,24 @@
 //! others. In OpenEXR the coverage is the alpha channel (1 for a pixel the
 //! file holds, 0 for one it does not), so viewers show the missing pixels as
 //! transparent; the colour channels are the film's, 32-bit float. The file
-//! describes itself: its data window sits where the film belongs in the whole
-//! image, its display window, and header attributes name the render (its
-//! fingerprint, [`FINGERPRINT_ATTRIBUTE`]), the tile ([`TILE_ATTRIBUTE`]) and
-//! whether it is an interrupted render's ([`INTERRUPTED_ATTRIBUTE`]).
+//! describes itself: its data window sits where the film belongs in the
+//! image's display window, and one header attribute, [`FINGERPRINT_ATTRIBUTE`],
+//! names the render, followed (after `; `) by the tile (`tile 3/64`) and by
+//! `interrupted` for an interrupted render's pixels. One attribute, not
+//! three: the OpenEXR writer orders several in no fixed way, and a tile
+//! rendered again must be the same bytes.
 
 use super::checks::{check_expansion, check_size, regular_file};
 use super::{Film, FilmError, ImageFormat};
 use glam::{UVec2, Vec3};
 use std::path::Path;
 
-/// The OpenEXR header attribute that holds a partial film's fingerprint.
+/// The OpenEXR header attribute that holds a partial film's fingerprint, its
+/// tile and whether it is an interrupted render's.
 pub const FINGERPRINT_ATTRIBUTE: &str = "glintRender";
-/// The OpenEXR header attribute that says which tile of how many a film is
-/// (`"3/64"`).
-pub const TILE_ATTRIBUTE: &str = "glintTile";
-/// The OpenEXR header attribute that marks an interrupted render's pixels
-/// (`"yes"`): alpha then says which were finished, not which the file is
-/// meant to hold.
-pub const INTERRUPTED_ATTRIBUTE: &str = "glintInterrupted";
+
+/// What follows the fingerprint in [`FINGERPRINT_ATTRIBUTE`].
+const SEPARATOR: &str = "; ";
 
 /// A film and, per pixel (row-major from the top left), whether it holds it:
 /// for an interrupted render, whether the pixel was rendered; for a piece of
@@ -153,23 +152,23 @@ impl PartialFilm {
             (p.x, p.y, p.z, alpha)
         });
         let mut attributes = LayerAttributes::default();
-        let texts = [
-            (FINGERPRINT_ATTRIBUTE, self.fingerprint.clone()),
-            (TILE_ATTRIBUTE, self.tile.map(|t| t.to_string())),
-            (
-                INTERRUPTED_ATTRIBUTE,
-                self.interrupted.then(|| "yes".into()),
-            ),
-        ];
-        for (name, value) in texts {
-            if let Some(value) = value {
-                insert_text(&mut attributes, name, &value).map_err(|message| {
-                    FilmError::Encode {
-                        path: path.to_path_buf(),
-                        message,
-                    }
-                })?;
-            }
+        if self
+            .fingerprint
+            .as_deref()
+            .is_some_and(|f| f.contains(SEPARATOR))
+        {
+            return Err(FilmError::Encode {
+                path: path.to_path_buf(),
+                message: format!("the render's fingerprint holds \"{SEPARATOR}\""),
+            });
+        }
+        if let Some(record) = self.record() {
+            insert_text(&mut attributes, FINGERPRINT_ATTRIBUTE, &record).map_err(|message| {
+                FilmError::Encode {
+                    path: path.to_path_buf(),
+                    message,
+                }
+            })?;
         }
         let Placement { image, origin } = self.placement;
         attributes.layer_position = Vec2(origin.x as i32, origin.y as i32);
@@ -254,26 +253,58 @@ impl PartialFilm {
                 image.height()
             )));
         }
-        let text = |name: &str| match layer.attributes.other.get(&exr::prelude::Text::from(name)) {
+        let record = match layer
+            .attributes
+            .other
+            .get(&exr::prelude::Text::from(FINGERPRINT_ATTRIBUTE))
+        {
             Some(exr::prelude::AttributeValue::Text(t)) => Some(t.to_string()),
             _ => None,
         };
-        let tile = match text(TILE_ATTRIBUTE) {
-            Some(t) => Some(Tile::parse(&t).map_err(|e| fail(format!("{TILE_ATTRIBUTE}: {e}")))?),
-            None => None,
+        let (fingerprint, tile, interrupted) = match record {
+            Some(record) => {
+                parse_record(&record).map_err(|e| fail(format!("{FINGERPRINT_ATTRIBUTE}: {e}")))?
+            }
+            None => (None, None, false),
         };
         Ok(Self {
             film,
             finished,
-            fingerprint: text(FINGERPRINT_ATTRIBUTE),
+            fingerprint,
             placement: Placement {
                 image: UVec2::new(image.width() as u32, image.height() as u32),
                 origin: UVec2::new(origin.x() as u32, origin.y() as u32),
             },
             tile,
-            interrupted: text(INTERRUPTED_ATTRIBUTE).is_some(),
+            interrupted,
         })
     }
+}
+
+impl PartialFilm {
+    /// The text of [`FINGERPRINT_ATTRIBUTE`]: the fingerprint, then the tile
+    /// and whether the render was interrupted; none if there is nothing to say.
+    fn record(&self) -> Option<String> {
+        let mut parts = vec![self.fingerprint.clone().unwrap_or_default()];
+        parts.extend(self.tile.map(|t| format!("tile {t}")));
+        parts.extend(self.interrupted.then(|| "interrupted".to_owned()));
+        (parts.len() > 1 || !parts[0].is_empty()).then(|| parts.join(SEPARATOR))
+    }
+}
+
+/// The fingerprint, tile and interruption [`PartialFilm::record`] wrote.
+fn parse_record(record: &str) -> Result<(Option<String>, Option<Tile>, bool), String> {
+    let mut parts = record.split(SEPARATOR);
+    let fingerprint = parts.next().filter(|f| !f.is_empty()).map(str::to_owned);
+    let (mut tile, mut interrupted) = (None, false);
+    for part in parts {
+        match part.strip_prefix("tile ") {
+            Some(t) => tile = Some(Tile::parse(t)?),
+            None if part == "interrupted" => interrupted = true,
+            None => return Err(format!("unknown entry \"{part}\"")),
+        }
+    }
+    Ok((fingerprint, tile, interrupted))
 }
 
 /// Refuses, before any pixel memory is taken, a file whose header claims an
@@ -359,6 +390,54 @@ mod tests {
             PartialFilm::load(&path).unwrap().fingerprint.as_deref(),
             Some("a")
         );
+    }
+
+    /// A piece's place, tile and interruption survive the file, and the same
+    /// piece is the same bytes every time (a re-rendered tile must be).
+    #[test]
+    fn exr_keeps_the_placement_tile_and_interruption_in_the_same_bytes() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut original = partial();
+        original.placement = Placement {
+            image: UVec2::new(9, 40),
+            origin: UVec2::new(3, 17),
+        };
+        original.tile = Some(Tile { index: 2, count: 7 });
+        original.interrupted = true;
+        let path = dir.path().join("piece.exr");
+        original.save(&path).unwrap();
+        let first = std::fs::read(&path).unwrap();
+        assert_eq!(PartialFilm::load(&path).unwrap(), original);
+        for _ in 0..8 {
+            original.save(&path).unwrap();
+            assert!(std::fs::read(&path).unwrap() == first, "other bytes");
+        }
+        for (tile, interrupted) in [(None, true), (Some(Tile { index: 0, count: 1 }), false)] {
+            let piece = PartialFilm {
+                tile,
+                interrupted,
+                fingerprint: None,
+                ..original.clone()
+            };
+            piece.save(&path).unwrap();
+            assert_eq!(PartialFilm::load(&path).unwrap(), piece);
+        }
+        original.fingerprint = Some("a; b".into());
+        let e = original.save(&path).unwrap_err().to_string();
+        assert!(e.contains("fingerprint holds"), "{e}");
+    }
+
+    #[test]
+    fn tiles_deal_out_the_rows_in_turn() {
+        let tile = Tile::parse("2/5").unwrap();
+        let rows: Vec<u32> = (0..13).filter(|&y| tile.has_row(y)).collect();
+        assert_eq!(rows, [2, 7, 12]);
+        assert_eq!(tile.row_span(13), Some((2, 13)));
+        assert_eq!(tile.row_span(12), Some((2, 8)));
+        assert_eq!(tile.row_span(2), None);
+        for bad in ["5/5", "1/0", "1", "a/2", "-1/2"] {
+            assert!(Tile::parse(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]

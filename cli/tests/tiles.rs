@@ -11,22 +11,21 @@ use common::{assert_input_error, glint, scene, stderr, stdout};
 use std::path::Path;
 use std::process::Command;
 
-/// A quick render of the bunny in the box at 48 × 41 pixels (a row count
-/// no tile count used here divides).
+/// The flags of a quick render: 48 × 41 pixels (a row count no tile count
+/// used here divides), 2 samples and 2 light samples.
+const QUICK: [&str; 6] = [
+    "--resolution",
+    "48x41",
+    "--spp",
+    "2",
+    "--light-samples",
+    "2",
+];
+
+/// A quick render of the bunny in the box.
 fn render_args(extra: &[&str]) -> Vec<String> {
-    let mut args: Vec<String> = [
-        "render",
-        &scene("bunny-cornell"),
-        "--resolution",
-        "48x41",
-        "--spp",
-        "2",
-        "--light-samples",
-        "2",
-    ]
-    .map(str::to_owned)
-    .to_vec();
-    args.extend(extra.iter().map(|s| s.to_string()));
+    let mut args = vec!["render".to_owned(), scene("bunny-cornell")];
+    args.extend(QUICK.iter().chain(extra).map(|s| s.to_string()));
     args
 }
 
@@ -192,15 +191,8 @@ fn write_farm(engine: &str, d: &Path, extra: &[&str]) -> String {
         "out/farmed.exr",
     ]);
     args.extend(extra);
-    args.extend([
-        "--",
-        "--resolution",
-        "48x41",
-        "--spp",
-        "2",
-        "--light-samples",
-        "2",
-    ]);
+    args.push("--");
+    args.extend(QUICK);
     let out = glint(&args, d);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     stdout(&out)

@@ -134,6 +134,15 @@ pub(crate) fn farm(args: &FarmArgs) -> Result<(), Failure> {
             job: Job::Render(render),
         } => {
             let plan = Plan::new(render)?;
+            if plan.dir.to_string_lossy().chars().any(char::is_whitespace) {
+                return Err(Failure::Input(format!(
+                    "--dir {}: Slurm's #SBATCH lines cannot hold a path with spaces; choose another folder",
+                    plan.dir.display()
+                )));
+            }
+            if options.submit {
+                needs("sbatch", "--version", "Slurm's sbatch")?;
+            }
             plan.write_common()?;
             let (array, merge) = (
                 plan.dir.join("render.sbatch"),
@@ -164,6 +173,9 @@ pub(crate) fn farm(args: &FarmArgs) -> Result<(), Failure> {
             job: Job::Render(render),
         } => {
             let plan = Plan::new(render)?;
+            if options.run {
+                needs("parallel", "--version", "GNU parallel")?;
+            }
             plan.write_common()?;
             let script = plan.dir.join("run-parallel.sh");
             write_script(&script, &plan.parallel(options))?;
@@ -479,6 +491,23 @@ fn write_script(path: &Path, text: &str) -> Result<(), Failure> {
             .map_err(|e| Failure::Other(format!("{}: {e}", path.display())))?;
     }
     Ok(())
+}
+
+/// Refuses, before anything is written, to start an engine that is not
+/// installed: `program` must run with `argument`.
+fn needs(program: &str, argument: &str, name: &str) -> Result<(), Failure> {
+    let runs = std::process::Command::new(program)
+        .arg(argument)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok();
+    match runs {
+        true => Ok(()),
+        false => Err(Failure::Input(format!(
+            "{name} ({program}) is not installed here: write the job without starting it, and start it where {program} runs"
+        ))),
+    }
 }
 
 /// Submits the array, then the merge with a dependency on it.

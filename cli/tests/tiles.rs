@@ -342,6 +342,31 @@ fn farm_options_are_checked_before_anything_is_written() {
         all.extend(args);
         assert_input_error(&glint(&all, d), expected);
     }
+    let spaced = [
+        "farm", "slurm", "render", &bunny, "--tiles", "4", "--dir", "a b",
+    ];
+    assert_input_error(&glint(&spaced, d), "cannot hold a path with spaces");
+    // An engine that is not there, asked to start: refused before writing.
+    for (engine, start, expected) in [
+        (
+            "parallel",
+            "--run",
+            "GNU parallel (parallel) is not installed here",
+        ),
+        (
+            "slurm",
+            "--submit",
+            "Slurm's sbatch (sbatch) is not installed here",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_glint"))
+            .args(["farm", engine, "render", &bunny, "--tiles", "4", start])
+            .env("PATH", "")
+            .current_dir(d)
+            .output()
+            .unwrap();
+        assert_input_error(&out, expected);
+    }
     assert_eq!(std::fs::read_dir(d).unwrap().count(), 0, "wrote something");
 }
 

@@ -418,3 +418,101 @@ fn a_stopped_tile_resumes_to_the_bytes_of_one_rendered_in_one_go() {
     }
     panic!("every render finished before the signal");
 }
+
+/// An sshd of the test's own on 127.0.0.1, ended when dropped.
+struct Sshd(std::process::Child);
+
+impl Drop for Sshd {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Starts an sshd on a free port of 127.0.0.1 that takes a key made in
+/// `dir`; returns it and the GNU parallel login line that reaches it, or why
+/// it cannot run here.
+fn start_sshd(dir: &Path) -> Result<(Sshd, String), String> {
+    let sshd = ["/usr/sbin/sshd", "/usr/local/sbin/sshd"]
+        .into_iter()
+        .find(|p| Path::new(p).exists())
+        .ok_or("no sshd (apt-get install openssh-server)")?;
+    for key in ["host_key", "client_key"] {
+        let made = Command::new("ssh-keygen")
+            .args(["-q", "-t", "ed25519", "-N", "", "-f"])
+            .arg(dir.join(key))
+            .status()
+            .map_err(|e| format!("no ssh-keygen ({e})"))?;
+        assert!(made.success());
+    }
+    std::fs::copy(dir.join("client_key.pub"), dir.join("authorized_keys")).unwrap();
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .map_err(|e| e.to_string())?
+        .port();
+    let config = format!(
+        "Port {port}\nListenAddress 127.0.0.1\nHostKey {host}\nAuthorizedKeysFile {keys}\n\
+         StrictModes no\nUsePAM no\nPasswordAuthentication no\nKbdInteractiveAuthentication no\n\
+         PermitRootLogin prohibit-password\nPidFile {pid}\n",
+        host = dir.join("host_key").display(),
+        keys = dir.join("authorized_keys").display(),
+        pid = dir.join("sshd.pid").display(),
+    );
+    std::fs::write(dir.join("sshd_config"), config).unwrap();
+    // Run as root, sshd wants its privilege separation folder.
+    let _ = std::fs::create_dir_all("/run/sshd");
+    let child = Command::new(sshd)
+        .arg("-D")
+        .arg("-f")
+        .arg(dir.join("sshd_config"))
+        .arg("-E")
+        .arg(dir.join("sshd.log"))
+        .spawn()
+        .map_err(|e| format!("sshd does not start ({e})"))?;
+    let server = Sshd(child);
+    let login = format!(
+        "ssh -p {port} -i {} -o StrictHostKeyChecking=no -o UserKnownHostsFile=/dev/null -o LogLevel=ERROR -o BatchMode=yes 127.0.0.1",
+        dir.join("client_key").display()
+    );
+    let start = std::time::Instant::now();
+    loop {
+        let probe = Command::new("sh")
+            .arg("-c")
+            .arg(format!("{login} true"))
+            .output();
+        if probe.is_ok_and(|o| o.status.success()) {
+            return Ok((server, login));
+        }
+        if start.elapsed() > std::time::Duration::from_secs(10) {
+            let log = std::fs::read_to_string(dir.join("sshd.log")).unwrap_or_default();
+            return Err(format!("cannot log in to the test's sshd: {}", log.trim()));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+}
+
+#[test]
+fn farm_runs_on_gnu_parallel_over_ssh_to_this_machine() {
+    if Command::new("parallel").arg("--version").output().is_err() {
+        eprintln!("skipped: GNU parallel is not installed (apt-get install parallel); see docs/testing.md");
+        return;
+    }
+    let keys = tempfile::tempdir().unwrap();
+    let (_server, login) = match start_sshd(keys.path()) {
+        Ok(started) => started,
+        Err(why) => {
+            eprintln!("skipped: {why}; see docs/testing.md");
+            return;
+        }
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    run(&render_args(&["-o", "whole.exr"]), d);
+    // Two jobs at a time on the one machine, reached over ssh.
+    std::fs::write(d.join("machines.txt"), format!("2/{login}\n")).unwrap();
+    write_farm("parallel", d, &["--sshloginfile", "machines.txt", "--run"]);
+    assert!(bytes(d, "out/farmed.exr") == bytes(d, "whole.exr"));
+    let log = std::fs::read_to_string(d.join("farm/parallel.joblog")).unwrap();
+    let over_ssh = log.lines().skip(1).filter(|l| l.contains("ssh -p")).count();
+    assert_eq!(over_ssh, 5, "every tile over ssh: {log}");
+}

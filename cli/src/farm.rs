@@ -74,7 +74,7 @@ struct FarmRender {
 #[derive(Args)]
 struct SlurmOptions {
     /// Tasks of the array running at once (sbatch --array=0-N%M)
-    #[arg(long, value_name = "M", global = true)]
+    #[arg(long, value_name = "M", global = true, value_parser = clap::value_parser!(u32).range(1..))]
     max_running: Option<u32>,
 
     /// Time limit of each task, as sbatch takes it (MM, HH:MM:SS or D-HH:MM:SS)
@@ -86,7 +86,7 @@ struct SlurmOptions {
     mem: Option<String>,
 
     /// CPUs of each task; glint renders with as many threads
-    #[arg(long, value_name = "N", global = true, default_value_t = 1)]
+    #[arg(long, value_name = "N", global = true, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1024))]
     cpus: u32,
 
     /// The partition (queue) to submit to

@@ -298,7 +298,7 @@ fn farm_options_are_checked_before_anything_is_written() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let bunny = scene("bunny-cornell");
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 8] = [
         (
             &["slurm", "render", &bunny, "--tiles", "0"],
             "expected at least 1 tile",
@@ -310,6 +310,22 @@ fn farm_options_are_checked_before_anything_is_written() {
         (
             &["slurm", "render", &bunny, "--tiles", "4", "--mem", "lots"],
             "expected a memory size",
+        ),
+        (
+            &["slurm", "render", &bunny, "--tiles", "4", "--cpus", "0"],
+            "invalid value '0' for '--cpus",
+        ),
+        (
+            &[
+                "slurm",
+                "render",
+                &bunny,
+                "--tiles",
+                "4",
+                "--max-running",
+                "0",
+            ],
+            "invalid value '0' for '--max-running",
         ),
         (
             &[

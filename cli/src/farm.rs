@@ -132,68 +132,65 @@ pub(crate) fn farm(args: &FarmArgs) -> Result<(), Failure> {
         Engine::Slurm {
             options,
             job: Job::Render(render),
-        } => {
-            let plan = Plan::new(render)?;
-            if plan.dir.to_string_lossy().chars().any(char::is_whitespace) {
-                return Err(Failure::Input(format!(
-                    "--dir {}: Slurm's #SBATCH lines cannot hold a path with spaces; choose another folder",
-                    plan.dir.display()
-                )));
-            }
-            if options.submit {
-                needs("sbatch", "--version", "Slurm's sbatch")?;
-            }
-            plan.write_common()?;
-            let (array, merge) = (
-                plan.dir.join("render.sbatch"),
-                plan.dir.join("assemble.sbatch"),
-            );
-            write_script(&array, &plan.slurm_array(options))?;
-            write_script(&merge, &plan.slurm_merge(options))?;
-            let commands = format!(
-                "job=$(sbatch --parsable {})\nsbatch --dependency=afterok:${{job%%;*}} {}\n",
-                quote(&array),
-                quote(&merge)
-            );
-            match options.submit {
-                true => submit(&array, &merge),
-                false => {
-                    crate::output::say(&format!(
-                        "wrote {}: {} tiles of {}; submit with\n{commands}",
-                        plan.dir.display(),
-                        plan.tiles,
-                        plan.scene.display()
-                    ));
-                    Ok(())
-                }
-            }
-        }
+        } => slurm(options, &Plan::new(render)?),
         Engine::Parallel {
             options,
             job: Job::Render(render),
-        } => {
-            let plan = Plan::new(render)?;
-            if options.run {
-                needs("parallel", "--version", "GNU parallel")?;
-            }
-            plan.write_common()?;
-            let script = plan.dir.join("run-parallel.sh");
-            write_script(&script, &plan.parallel(options))?;
-            match options.run {
-                true => run_parallel(&script),
-                false => {
-                    crate::output::say(&format!(
-                        "wrote {}: {} tiles of {}; run with\n{}\n",
-                        plan.dir.display(),
-                        plan.tiles,
-                        plan.scene.display(),
-                        quote(&script)
-                    ));
-                    Ok(())
-                }
-            }
-        }
+        } => parallel(options, &Plan::new(render)?),
     }
+}
+
+/// Writes the job array and the merge job, and submits them or says how.
+fn slurm(options: &SlurmOptions, plan: &Plan) -> Result<(), Failure> {
+    if plan.dir.to_string_lossy().chars().any(char::is_whitespace) {
+        return Err(Failure::Input(format!(
+            "--dir {}: Slurm's #SBATCH lines cannot hold a path with spaces; choose another folder",
+            plan.dir.display()
+        )));
+    }
+    if options.submit {
+        needs("sbatch", "--version", "Slurm's sbatch")?;
+    }
+    plan.write_common()?;
+    let (array, merge) = (
+        plan.dir.join("render.sbatch"),
+        plan.dir.join("assemble.sbatch"),
+    );
+    write_script(&array, &plan.slurm_array(options))?;
+    write_script(&merge, &plan.slurm_merge(options))?;
+    if options.submit {
+        return submit(&array, &merge);
+    }
+    crate::output::say(&format!(
+        "wrote {}: {} tiles of {}; submit with\njob=$(sbatch --parsable {})\nsbatch --dependency=afterok:${{job%%;*}} {}\n",
+        plan.dir.display(),
+        plan.tiles,
+        plan.scene.display(),
+        quote(&array),
+        quote(&merge)
+    ));
+    Ok(())
+}
+
+/// Writes the GNU parallel script, and runs it or says how.
+fn parallel(options: &ParallelOptions, plan: &Plan) -> Result<(), Failure> {
+    if options.run {
+        needs("parallel", "--version", "GNU parallel")?;
+    }
+    plan.write_common()?;
+    let script = plan.dir.join("run-parallel.sh");
+    write_script(&script, &plan.parallel(options))?;
+    if options.run {
+        return run_parallel(&script);
+    }
+    crate::output::say(&format!(
+        "wrote {}: {} tiles of {}; run with\n{}\n",
+        plan.dir.display(),
+        plan.tiles,
+        plan.scene.display(),
+        quote(&script)
+    ));
+    Ok(())
 }
 
 /// A render in tiles, checked, with every path absolute.

@@ -128,6 +128,15 @@ pub(crate) struct BenchArgs {
     /// Most mirror reflections followed per camera ray (overrides render.max_depth)
     #[arg(long, value_name = "N")]
     max_depth: Option<u32>,
+
+    /// Render nothing: put together the results of benches of this scene run
+    /// apart (each TASK-DIR holding the results.json of a `glint bench` with
+    /// some of the strategies and budgets, against one reference, as the
+    /// tasks of `glint farm ... bench` write them): one table, CSV, JSON and
+    /// plot over all their rows, with the fits and speed-ups (no heat maps:
+    /// each task's are on its own scale)
+    #[arg(long, value_name = "TASK-DIR", num_args = 1.., conflicts_with_all = ["time", "reference", "reference_spp", "texture_filters", "light_strategies", "environment_samplings", "region", "resolution", "heatmap_step"])]
+    merge: Vec<PathBuf>,
 }
 
 /// Where the rendered reference samples each pixel.
@@ -140,6 +149,9 @@ enum ReferencePixel {
 }
 
 pub(crate) fn bench(args: &BenchArgs) -> Result<(), Failure> {
+    if !args.merge.is_empty() {
+        return merge(args);
+    }
     let config = config(args)?;
     check_output_dir(&config.output_dir)?;
     // A bar over the current render's tiles, with the render's name.
@@ -180,6 +192,56 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<(), Failure> {
         config.output_dir.display()
     ));
     Ok(())
+}
+
+/// `--merge`: the tasks' results, read and put together, written as a
+/// bench's.
+fn merge(args: &BenchArgs) -> Result<(), Failure> {
+    let dir = output_dir(args);
+    check_output_dir(&dir)?;
+    let scene = glint_bench::scene_name(&args.scene);
+    let mut reports = Vec::new();
+    let mut names = Vec::new();
+    for task in &args.merge {
+        let path = task.join("results.json");
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| Failure::Input(format!("--merge: {}: {e}", path.display())))?;
+        let report: glint_bench::Report = serde_json::from_str(&text).map_err(|e| {
+            Failure::Input(format!(
+                "--merge: {}: not a glint bench results.json ({e})",
+                path.display()
+            ))
+        })?;
+        if report.scene_name != scene {
+            return Err(Failure::Input(format!(
+                "--merge: {}: results of scene \"{}\", not {}",
+                path.display(),
+                report.scene_name,
+                args.scene.display()
+            )));
+        }
+        reports.push(report);
+        names.push(task.display().to_string());
+    }
+    let bench =
+        glint_bench::merge(reports, &names).map_err(|e| Failure::Input(format!("--merge: {e}")))?;
+    std::fs::create_dir_all(&dir).map_err(|e| Failure::Other(format!("{}: {e}", dir.display())))?;
+    let written = bench.write(&dir).map_err(Failure::Other)?;
+    crate::output::say(&bench.report.table());
+    crate::output::say(&format!(
+        "wrote {} files to {} from {} tasks\n",
+        written.len(),
+        dir.display(),
+        args.merge.len()
+    ));
+    Ok(())
+}
+
+/// Where the results go: `-o`, or SCENE-NAME-bench.
+fn output_dir(args: &BenchArgs) -> PathBuf {
+    args.output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}-bench", glint_bench::scene_name(&args.scene))))
 }
 
 /// The output directory, before any work: an existing directory we may write
@@ -272,9 +334,7 @@ fn config(args: &BenchArgs) -> Result<BenchConfig, Failure> {
         seed: args.seed,
         threads: args.threads,
         max_depth: args.max_depth,
-        output_dir: args.output.clone().unwrap_or_else(|| {
-            PathBuf::from(format!("{}-bench", glint_bench::scene_name(&args.scene)))
-        }),
+        output_dir: output_dir(args),
         version: version(),
     })
 }

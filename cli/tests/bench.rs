@@ -151,7 +151,127 @@ fn help_documents_every_flag() {
         "--seed",
         "--threads",
         "--max-depth",
+        "--merge",
     ] {
         assert!(help.contains(flag), "{flag} undocumented");
     }
+}
+
+/// The deterministic columns of a results.json's rows (not the times), keyed
+/// by strategy and budget.
+fn rows(dir: &Path) -> Vec<(String, u64, Vec<f64>)> {
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
+    let mut rows: Vec<(String, u64, Vec<f64>)> = json["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            let values = ["rmse", "rel_mse", "flip", "camera_rays", "shadow_rays"]
+                .map(|k| r[k].as_f64().unwrap())
+                .to_vec();
+            (
+                r["strategy"].as_str().unwrap().to_owned(),
+                r["total_samples"].as_u64().unwrap(),
+                values,
+            )
+        })
+        .collect();
+    rows.sort_by(|a, b| (&a.0, a.1).cmp(&(&b.0, b.1)));
+    rows
+}
+
+/// Benches run apart (a strategy's budgets split between two tasks) and put
+/// together with `--merge` give the single bench's rows and fits; tasks of
+/// another reference, or one measured twice, are refused.
+#[test]
+fn merged_tasks_give_the_single_bench_s_rows_and_fits() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let set1 = scene("cornell-set1");
+    let run = |args: &[&str]| {
+        let o = glint(args, d);
+        assert!(o.status.success(), "{args:?}: {}", text(&o.stderr));
+        text(&o.stdout)
+    };
+    for (seed, name) in [("777", "ref.exr"), ("778", "other-ref.exr")] {
+        run(&[
+            "render",
+            &set1,
+            "--resolution",
+            "16x16",
+            "--spp",
+            "256",
+            "--seed",
+            seed,
+            "-o",
+            name,
+        ]);
+    }
+    let bench = |samplers: &str, spp: &str, reference: &str, out: &str| {
+        let args = [
+            "bench",
+            &set1,
+            "--resolution",
+            "16x16",
+            "--samplers",
+            samplers,
+            "--spp",
+            spp,
+        ];
+        run(&[&args[..], &["--reference", reference, "-o", out]].concat());
+    };
+    bench("random,sobol", "1,4,16", "ref.exr", "whole");
+    bench("random", "1,4", "ref.exr", "t0");
+    bench("random", "16", "ref.exr", "t1");
+    bench("sobol", "1,4,16", "ref.exr", "t2");
+    let table = run(&["bench", &set1, "--merge", "t2", "t0", "t1", "-o", "merged"]);
+    assert!(
+        table.contains("sobol: relMSE slope") && table.contains("from 3 tasks"),
+        "{table}"
+    );
+    let (whole, merged) = (rows(&d.join("whole")), rows(&d.join("merged")));
+    assert_eq!(whole.len(), 6);
+    for (a, b) in whole.iter().zip(&merged) {
+        assert_eq!((&a.0, a.1), (&b.0, b.1));
+        for (x, y) in a.2.iter().zip(&b.2) {
+            // The metrics' parallel sums may round their last bit apart.
+            assert!((x - y).abs() <= 1e-12 * x.abs(), "{a:?} against {b:?}");
+        }
+    }
+    let slopes = |dir: &str| -> Vec<(String, f64)> {
+        let json: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(d.join(dir).join("results.json")).unwrap(),
+        )
+        .unwrap();
+        let mut s: Vec<(String, f64)> = json["strategies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| {
+                (
+                    s["name"].as_str().unwrap().to_owned(),
+                    s["rel_mse_slope"].as_f64().unwrap(),
+                )
+            })
+            .collect();
+        s.sort_by(|a, b| a.0.cmp(&b.0));
+        s
+    };
+    for ((a, x), (b, y)) in slopes("whole").iter().zip(&slopes("merged")) {
+        assert_eq!(a, b);
+        assert!((x - y).abs() < 1e-9, "{a}: {x} against {y}");
+    }
+    assert!(d.join("merged/relmse-vs-time.png").exists());
+    bench("sobol", "1,4,16", "other-ref.exr", "t3");
+    let o = glint(&["bench", &set1, "--merge", "t0", "t3", "-o", "bad"], d);
+    assert_input_error(&o, "t3: another reference than t0's");
+    let o = glint(&["bench", &set1, "--merge", "t0", "t0", "-o", "bad"], d);
+    assert_input_error(
+        &o,
+        "random at 1 spp × 1 light samples is measured by two tasks",
+    );
+    let o = glint(&["bench", &set1, "--merge", "nowhere", "-o", "bad"], d);
+    assert_input_error(&o, "--merge: nowhere/results.json");
+    assert!(!d.join("bad").exists());
 }

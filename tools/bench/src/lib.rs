@@ -23,6 +23,7 @@
 pub mod budget;
 pub mod fit;
 pub mod machine;
+mod merge;
 mod output;
 pub mod plot;
 pub mod reference;
@@ -32,6 +33,7 @@ mod sweep;
 
 pub use budget::{Ladder, SampleBudget};
 pub use machine::Machine;
+pub use merge::merge;
 pub use reference::Reference;
 pub use report::Report;
 pub use strategy::{Strategy, TextureChoice};
@@ -234,8 +236,8 @@ pub fn run(
         "measuring errors (RMSE, relative MSE, FLIP)",
     ));
     let rows = rows(config, &measurements, &reference, region);
-    let strategies = summaries(config, &rows);
-    let baseline = baseline(config, &rows);
+    let strategies = summaries(&names(config), &rows);
+    let baseline = baseline(&names(config), &rows);
     let heatmap_step = config
         .heatmap_step
         .unwrap_or(usize::MAX)
@@ -679,26 +681,28 @@ fn rows(
         .collect()
 }
 
+/// The strategies' names, in the order they were given.
+fn names(config: &BenchConfig) -> Vec<String> {
+    config.strategies.iter().map(Strategy::name).collect()
+}
+
 /// The strategy speed-ups are measured against: the first strategy whose
 /// patterns are all `random` (whatever its texture filter), else the first.
-fn baseline_name(config: &BenchConfig) -> String {
-    config
-        .strategies
+/// By name: its patterns' part (before any `+`) is `random` alone, as
+/// [`Strategy::name`] writes three equal patterns.
+fn baseline_name(names: &[String]) -> String {
+    names
         .iter()
-        .find(|s| {
-            s.pixel == SamplePattern::Random
-                && s.light == SamplePattern::Random
-                && s.environment == SamplePattern::Random
-        })
-        .unwrap_or(&config.strategies[0])
-        .name()
+        .find(|name| name.split('+').next() == Some(SamplePattern::Random.name()))
+        .unwrap_or(&names[0])
+        .clone()
 }
 
 /// The baseline's target: its largest budget, by samples and then by time.
 /// Samples come first because the times of a small scene's cheapest budgets
 /// can swap places on a busy machine, and the target must not move with them.
-fn baseline(config: &BenchConfig, rows: &[Row]) -> Option<Baseline> {
-    let name = baseline_name(config);
+fn baseline(names: &[String], rows: &[Row]) -> Option<Baseline> {
+    let name = baseline_name(names);
     let last = rows.iter().filter(|r| r.strategy == name).max_by(|a, b| {
         a.total_samples
             .cmp(&b.total_samples)
@@ -712,13 +716,12 @@ fn baseline(config: &BenchConfig, rows: &[Row]) -> Option<Baseline> {
     })
 }
 
-fn summaries(config: &BenchConfig, rows: &[Row]) -> Vec<StrategySummary> {
-    let base = baseline(config, rows);
-    config
-        .strategies
+fn summaries(names: &[String], rows: &[Row]) -> Vec<StrategySummary> {
+    let base = baseline(names, rows);
+    names
         .iter()
-        .map(|s| {
-            let name = s.name();
+        .map(|name| {
+            let name = name.clone();
             let mine: Vec<&Row> = rows.iter().filter(|r| r.strategy == name).collect();
             let against_samples = |error: fn(&Row) -> f64| {
                 let points: Vec<(f64, f64)> = mine

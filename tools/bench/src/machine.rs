@@ -1,10 +1,10 @@
 //! The machine a bench ran on, for the report and the plot's label: timings mean
 //! nothing without it.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What the report says about the machine.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Machine {
     /// The processor's model name (from `/proc/cpuinfo` on Linux), or `unknown`.
     pub cpu: String,

@@ -35,7 +35,7 @@ pub const MAX_ROUNDS: u32 = 64;
 pub const NOISE_MARGIN: f64 = 10.0;
 
 /// Where the reference came from.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Origin {
     /// Read from a file the user gave.

@@ -3,11 +3,11 @@
 
 use crate::machine::Machine;
 use crate::reference::Origin;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt::Write;
 
 /// The whole result of a bench.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Report {
     /// The scene file, as given.
     pub scene: String,
@@ -29,14 +29,14 @@ pub struct Report {
     pub heatmaps: Option<HeatmapSummary>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RegionSummary {
     pub name: Option<String>,
     pub pixels: [u32; 4],
     pub whole_image: bool,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ReferenceSummary {
     pub origin: Origin,
     pub rounds: u32,
@@ -55,7 +55,7 @@ pub struct ReferenceSummary {
 }
 
 /// One strategy at one budget.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Row {
     pub strategy: String,
     pub spp: u32,
@@ -80,7 +80,7 @@ pub struct Row {
 }
 
 /// A strategy's convergence and speed-up.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StrategySummary {
     pub name: String,
     /// Fitted log–log slopes of relative MSE and of RMSE against total samples.
@@ -94,7 +94,7 @@ pub struct StrategySummary {
     pub speedup_extrapolated: bool,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Baseline {
     pub strategy: String,
     pub target_rel_mse: f64,
@@ -102,7 +102,7 @@ pub struct Baseline {
     pub time_s: f64,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct HeatmapSummary {
     /// The budget the heat maps show (its index on the ladder, and its spp).
     pub step: usize,

@@ -194,6 +194,56 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// A bench split into tasks for `glint farm ... bench`: the `--samplers`
+/// entries, and per ladder step the budget flags a task takes for it.
+pub(crate) struct SweepSplit {
+    pub(crate) samplers: Vec<String>,
+    pub(crate) steps: Vec<Vec<String>>,
+}
+
+/// Checks `args` as a bench would (everything but the scene's assets and
+/// the reference's size, which each task checks) and splits it into one
+/// task per strategy and budget. Every task must measure against one
+/// reference: `--reference FILE` is required.
+pub(crate) fn sweep_split(args: &BenchArgs) -> Result<SweepSplit, Failure> {
+    let config = config(args)?;
+    if args.reference.is_none() {
+        return Err(Failure::Input(
+            "glint farm bench: give --reference FILE (after --), one reference for every task; \
+             render one with glint farm ... render at many samples and another --seed"
+                .into(),
+        ));
+    }
+    let samplers: Vec<String> = args
+        .samplers
+        .split(',')
+        .map(|s| s.trim().to_owned())
+        .collect();
+    let light: Vec<&str> = args.light_samples.split(',').map(str::trim).collect();
+    let environment: Option<Vec<&str>> = args
+        .environment_samples
+        .as_ref()
+        .map(|list| list.split(',').map(str::trim).collect());
+    let (flag, budgets): (&str, Vec<&str>) = match &args.time {
+        Some(list) => ("--time", list.split(',').map(str::trim).collect()),
+        None => ("--spp", args.spp.split(',').map(str::trim).collect()),
+    };
+    let per_step =
+        |values: &[&str], i: usize| values[if values.len() == 1 { 0 } else { i }].to_owned();
+    let steps = (0..budgets.len())
+        .map(|i| {
+            let mut step = vec![flag.to_owned(), budgets[i].to_owned()];
+            step.extend(["--light-samples".to_owned(), per_step(&light, i)]);
+            if let Some(environment) = &environment {
+                step.extend(["--environment-samples".to_owned(), per_step(environment, i)]);
+            }
+            step
+        })
+        .collect();
+    debug_assert!(!config.strategies.is_empty());
+    Ok(SweepSplit { samplers, steps })
+}
+
 /// `--merge`: the tasks' results, read and put together, written as a
 /// bench's.
 fn merge(args: &BenchArgs) -> Result<(), Failure> {

@@ -46,6 +46,9 @@ enum Engine {
 enum Job {
     /// One frame in tiles: glint render --tile I/N for each I, then glint assemble
     Render(FarmRender),
+    /// A glint bench sweep: one task per strategy and budget against one
+    /// reference file, then glint bench --merge (the fits and the plot)
+    Bench(crate::farm_sweep::FarmBench),
 }
 
 #[derive(Args)]
@@ -129,43 +132,63 @@ const MANAGED: [&str; 7] = [
 
 pub(crate) fn farm(args: &FarmArgs) -> Result<(), Failure> {
     match &args.engine {
-        Engine::Slurm {
-            options,
-            job: Job::Render(render),
-        } => slurm(options, &Plan::new(render)?),
-        Engine::Parallel {
-            options,
-            job: Job::Render(render),
-        } => parallel(options, &Plan::new(render)?),
+        Engine::Slurm { options, job } => slurm(options, &job_of(job)?),
+        Engine::Parallel { options, job } => parallel(options, &job_of(job)?),
     }
 }
 
+/// The job, checked and planned; nothing written yet.
+fn job_of(job: &Job) -> Result<Farm, Failure> {
+    match job {
+        Job::Render(render) => Ok(Plan::new(render)?.farm()),
+        Job::Bench(bench) => Ok(crate::farm_sweep::Sweep::new(bench)?.farm()),
+    }
+}
+
+/// What the engines run: tasks `0..tasks`, each `TASK_SCRIPT I`, then the
+/// merge script once all have succeeded.
+pub(crate) struct Farm {
+    /// Names the jobs, the logs and the Slurm scripts (`render.sbatch`,
+    /// `assemble.sbatch`).
+    pub(crate) kind: &'static str,
+    pub(crate) merge_kind: &'static str,
+    pub(crate) task_script: &'static str,
+    pub(crate) merge_script: &'static str,
+    pub(crate) scene: PathBuf,
+    pub(crate) dir: PathBuf,
+    pub(crate) tasks: u32,
+    /// Said when the job is written: "5 tiles of SCENE".
+    pub(crate) what: String,
+    /// The folders to make and the scripts to write, with their text.
+    pub(crate) folders: Vec<PathBuf>,
+    pub(crate) scripts: Vec<(PathBuf, String)>,
+}
+
 /// Writes the job array and the merge job, and submits them or says how.
-fn slurm(options: &SlurmOptions, plan: &Plan) -> Result<(), Failure> {
-    if plan.dir.to_string_lossy().chars().any(char::is_whitespace) {
+fn slurm(options: &SlurmOptions, farm: &Farm) -> Result<(), Failure> {
+    if farm.dir.to_string_lossy().chars().any(char::is_whitespace) {
         return Err(Failure::Input(format!(
             "--dir {}: Slurm's #SBATCH lines cannot hold a path with spaces; choose another folder",
-            plan.dir.display()
+            farm.dir.display()
         )));
     }
     if options.submit {
         needs("sbatch", "--version", "Slurm's sbatch")?;
     }
-    plan.write_common()?;
+    farm.write()?;
     let (array, merge) = (
-        plan.dir.join("render.sbatch"),
-        plan.dir.join("assemble.sbatch"),
+        farm.dir.join(format!("{}.sbatch", farm.kind)),
+        farm.dir.join(format!("{}.sbatch", farm.merge_kind)),
     );
-    write_script(&array, &plan.slurm_array(options))?;
-    write_script(&merge, &plan.slurm_merge(options))?;
+    write_script(&array, &farm.slurm_array(options))?;
+    write_script(&merge, &farm.slurm_merge(options))?;
     if options.submit {
         return submit(&array, &merge);
     }
     crate::output::say(&format!(
-        "wrote {}: {} tiles of {}; submit with\njob=$(sbatch --parsable {})\nsbatch --dependency=afterok:${{job%%;*}} {}\n",
-        plan.dir.display(),
-        plan.tiles,
-        plan.scene.display(),
+        "wrote {}: {}; submit with\njob=$(sbatch --parsable {})\nsbatch --dependency=afterok:${{job%%;*}} {}\n",
+        farm.dir.display(),
+        farm.what,
         quote(&array),
         quote(&merge)
     ));
@@ -173,21 +196,20 @@ fn slurm(options: &SlurmOptions, plan: &Plan) -> Result<(), Failure> {
 }
 
 /// Writes the GNU parallel script, and runs it or says how.
-fn parallel(options: &ParallelOptions, plan: &Plan) -> Result<(), Failure> {
+fn parallel(options: &ParallelOptions, farm: &Farm) -> Result<(), Failure> {
     if options.run {
         needs("parallel", "--version", "GNU parallel")?;
     }
-    plan.write_common()?;
-    let script = plan.dir.join("run-parallel.sh");
-    write_script(&script, &plan.parallel(options))?;
+    farm.write()?;
+    let script = farm.dir.join("run-parallel.sh");
+    write_script(&script, &farm.parallel(options))?;
     if options.run {
         return run_parallel(&script);
     }
     crate::output::say(&format!(
-        "wrote {}: {} tiles of {}; run with\n{}\n",
-        plan.dir.display(),
-        plan.tiles,
-        plan.scene.display(),
+        "wrote {}: {}; run with\n{}\n",
+        farm.dir.display(),
+        farm.what,
         quote(&script)
     ));
     Ok(())
@@ -261,17 +283,25 @@ impl Plan {
         })
     }
 
-    /// Makes the directory, `tiles/` and `logs/`, and writes the scripts
-    /// both engines run: `render-tile.sh` and `assemble.sh`.
-    fn write_common(&self) -> Result<(), Failure> {
-        let output_folder = self.output.parent().map(Path::to_owned);
+    /// The job: a task per tile (`render-tile.sh`), then `assemble.sh`.
+    fn farm(&self) -> Farm {
         let folders = [self.dir.clone(), self.tiles_dir(), self.dir.join("logs")];
-        for dir in folders.into_iter().chain(output_folder) {
-            std::fs::create_dir_all(&dir)
-                .map_err(|e| Failure::Other(format!("{}: cannot make it: {e}", dir.display())))?;
+        let output_folder = self.output.parent().map(Path::to_owned);
+        Farm {
+            kind: "render",
+            merge_kind: "assemble",
+            task_script: "render-tile.sh",
+            merge_script: "assemble.sh",
+            scene: self.scene.clone(),
+            dir: self.dir.clone(),
+            tasks: self.tiles,
+            what: format!("{} tiles of {}", self.tiles, self.scene.display()),
+            folders: folders.into_iter().chain(output_folder).collect(),
+            scripts: vec![
+                (self.dir.join("render-tile.sh"), self.render_tile()),
+                (self.dir.join("assemble.sh"), self.assemble()),
+            ],
         }
-        write_script(&self.dir.join("render-tile.sh"), &self.render_tile())?;
-        write_script(&self.dir.join("assemble.sh"), &self.assemble())
     }
 
     fn tiles_dir(&self) -> PathBuf {
@@ -328,53 +358,72 @@ exec {glint} assemble "${{files[@]}}" -o {output}
             output = quote(&self.output),
         )
     }
+}
 
-    /// `render.sbatch`: the job array, task I rendering tile I.
+impl Farm {
+    /// Makes the folders and writes the job's scripts.
+    fn write(&self) -> Result<(), Failure> {
+        for dir in &self.folders {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| Failure::Other(format!("{}: cannot make it: {e}", dir.display())))?;
+        }
+        for (path, text) in &self.scripts {
+            write_script(path, text)?;
+        }
+        Ok(())
+    }
+
+    /// `KIND.sbatch`: the job array, task I running `TASK_SCRIPT I`.
     fn slurm_array(&self, options: &SlurmOptions) -> String {
         let throttle = options
             .max_running
             .map_or(String::new(), |m| format!("%{m}"));
         let mut lines = vec![
             "#!/bin/bash".to_owned(),
-            format!("#SBATCH --job-name=glint-render-{}", self.name()),
-            format!("#SBATCH --array=0-{}{throttle}", self.tiles - 1),
+            format!("#SBATCH --job-name=glint-{}-{}", self.kind, self.name()),
+            format!("#SBATCH --array=0-{}{throttle}", self.tasks - 1),
             format!(
-                "#SBATCH --output={}/logs/render_%A_%a.log",
-                self.dir.display()
+                "#SBATCH --output={}/logs/{}_%A_%a.log",
+                self.dir.display(),
+                self.kind
             ),
             // A requeued task adds to its log instead of replacing it.
             "#SBATCH --open-mode=append".to_owned(),
             format!("#SBATCH --cpus-per-task={}", options.cpus),
-            // Requeued after a node failure or preemption; the tile then
+            // Requeued after a node failure or preemption; a tile then
             // continues from its partial render.
             "#SBATCH --requeue".to_owned(),
         ];
         lines.extend(self.slurm_limits(options));
         lines.push(format!(
-            "# Tile $SLURM_ARRAY_TASK_ID of {} of {} (written by glint farm).",
-            self.tiles,
-            self.scene.display()
+            "# Task $SLURM_ARRAY_TASK_ID of {} (written by glint farm).",
+            self.what
         ));
         lines.push(format!(
             "exec {} \"$SLURM_ARRAY_TASK_ID\"",
-            quote(&self.dir.join("render-tile.sh"))
+            quote(&self.dir.join(self.task_script))
         ));
         lines.join("\n") + "\n"
     }
 
-    /// `assemble.sbatch`: the merge, submitted to wait for the array.
+    /// `MERGE_KIND.sbatch`: the merge, submitted to wait for the array.
     fn slurm_merge(&self, options: &SlurmOptions) -> String {
         let mut lines = vec![
             "#!/bin/bash".to_owned(),
-            format!("#SBATCH --job-name=glint-assemble-{}", self.name()),
             format!(
-                "#SBATCH --output={}/logs/assemble_%j.log",
-                self.dir.display()
+                "#SBATCH --job-name=glint-{}-{}",
+                self.merge_kind,
+                self.name()
+            ),
+            format!(
+                "#SBATCH --output={}/logs/{}_%j.log",
+                self.dir.display(),
+                self.merge_kind
             ),
             "#SBATCH --cpus-per-task=1".to_owned(),
         ];
         lines.extend(self.slurm_limits(options));
-        lines.push(format!("exec {}", quote(&self.dir.join("assemble.sh"))));
+        lines.push(format!("exec {}", quote(&self.dir.join(self.merge_script))));
         lines.join("\n") + "\n"
     }
 
@@ -392,9 +441,9 @@ exec {glint} assemble "${{files[@]}}" -o {output}
         lines
     }
 
-    /// `run-parallel.sh`: every tile through GNU parallel, then the merge.
-    /// Run again, it renders only the tiles whose job failed (the job log
-    /// and `--resume-failed`), each continuing its partial render.
+    /// `run-parallel.sh`: every task through GNU parallel, then the merge.
+    /// Run again, it runs only the tasks whose job failed (the job log and
+    /// `--resume-failed`), a tile continuing its partial render.
     fn parallel(&self, options: &ParallelOptions) -> String {
         let mut engine = vec![
             "parallel".to_owned(),
@@ -411,25 +460,23 @@ exec {glint} assemble "${{files[@]}}" -o {output}
         }
         format!(
             r#"#!/bin/bash
-# Renders the {tiles} tiles of {scene} with GNU parallel, then puts them
-# together (written by glint farm). Run again after a failure: only the
-# failed tiles are rendered again.
+# Runs the {what} with GNU parallel, then the merge (written by glint farm).
+# Run again after a failure: only the failed tasks run again.
 set -uo pipefail
-{engine} {render_tile} {{}} ::: $(seq 0 {last})
+{engine} {task} {{}} ::: $(seq 0 {last})
 status=$?
 if [ $status -ne 0 ]; then
-  echo "glint farm: $status tile job(s) failed (see {joblog}); run this script again to render them" >&2
+  echo "glint farm: $status job(s) failed (see {joblog}); run this script again to run them" >&2
   exit $status
 fi
-exec {assemble}
+exec {merge}
 "#,
-            tiles = self.tiles,
-            scene = quote(&self.scene),
+            what = self.what,
             engine = engine.join(" "),
-            render_tile = quote(&self.dir.join("render-tile.sh")),
-            last = self.tiles - 1,
+            task = quote(&self.dir.join(self.task_script)),
+            last = self.tasks - 1,
             joblog = self.dir.join("parallel.joblog").display(),
-            assemble = quote(&self.dir.join("assemble.sh")),
+            merge = quote(&self.dir.join(self.merge_script)),
         )
     }
 
@@ -548,12 +595,12 @@ fn run_parallel(script: &Path) -> Result<(), Failure> {
 }
 
 /// `path` quoted for bash.
-fn quote(path: &Path) -> String {
+pub(crate) fn quote(path: &Path) -> String {
     quote_str(&path.to_string_lossy())
 }
 
 /// `text` as one bash word: as is where it is plainly safe, else in single quotes.
-fn quote_str(text: &str) -> String {
+pub(crate) fn quote_str(text: &str) -> String {
     let plain = !text.is_empty()
         && text
             .chars()

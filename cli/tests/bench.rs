@@ -275,3 +275,106 @@ fn merged_tasks_give_the_single_bench_s_rows_and_fits() {
     assert_input_error(&o, "--merge: nowhere/results.json");
     assert!(!d.join("bad").exists());
 }
+
+/// `glint farm parallel bench` splits a sweep into one task per strategy
+/// and budget; its scripts, run by hand in any order, then merged, give the
+/// single bench's rows and slopes. Its options are checked first.
+#[test]
+fn a_farmed_sweep_gives_the_single_bench_s_rows_and_fits() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let set1 = scene("cornell-set1");
+    let run = |args: &[&str]| {
+        let o = glint(args, d);
+        assert!(o.status.success(), "{args:?}: {}", text(&o.stderr));
+        text(&o.stdout)
+    };
+    run(&[
+        "render",
+        &set1,
+        "--resolution",
+        "16x16",
+        "--spp",
+        "256",
+        "--seed",
+        "777",
+        "-o",
+        "ref.exr",
+    ]);
+    let measure = [
+        "--resolution",
+        "16x16",
+        "--samplers",
+        "random,sobol",
+        "--spp",
+        "1,4,16",
+    ];
+    let reference = ["--reference", "ref.exr"];
+    run(&[
+        &["bench", &set1, "-o", "whole"],
+        &measure[..],
+        &reference[..],
+    ]
+    .concat());
+    let said = run(&[
+        &[
+            "farm", "parallel", "bench", &set1, "--dir", "farm", "-o", "merged", "--",
+        ],
+        &measure[..],
+        &reference[..],
+    ]
+    .concat());
+    assert!(
+        said.contains("6 tasks (2 strategies × 3 budgets)"),
+        "{said}"
+    );
+    let farm = d.join("farm");
+    for task in [5, 0, 3, 1, 4, 2] {
+        let o = std::process::Command::new(farm.join("bench-task.sh"))
+            .arg(task.to_string())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "task {task}: {}", text(&o.stderr));
+    }
+    let o = std::process::Command::new(farm.join("merge-bench.sh"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (whole, merged) = (rows(&d.join("whole")), rows(&d.join("merged")));
+    assert_eq!(whole.len(), 6);
+    assert_eq!(merged.len(), 6);
+    for (a, b) in whole.iter().zip(&merged) {
+        assert_eq!((&a.0, a.1), (&b.0, b.1));
+        for (x, y) in a.2.iter().zip(&b.2) {
+            assert!((x - y).abs() <= 1e-12 * x.abs(), "{a:?} against {b:?}");
+        }
+    }
+    for (args, expected) in [
+        (vec!["--spp", "1,4"], "give --reference FILE"),
+        (
+            vec!["--reference", "gone.exr"],
+            "--reference gone.exr: no such file",
+        ),
+        (
+            vec!["--reference", "ref.exr", "--threads", "2"],
+            "--threads is set by glint farm",
+        ),
+        (
+            vec!["--reference", "ref.exr", "--spp", "x"],
+            "--spp: expected whole numbers",
+        ),
+    ] {
+        let mut all = vec![
+            "farm",
+            "parallel",
+            "bench",
+            set1.as_str(),
+            "--dir",
+            "bad",
+            "--",
+        ];
+        all.extend(args);
+        assert_input_error(&glint(&all, d), expected);
+        assert!(!d.join("bad").exists());
+    }
+}

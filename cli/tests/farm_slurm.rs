@@ -2,7 +2,8 @@
 //! `sbatch` (a job array and a merge job that waits for it) gives the single
 //! render's bytes, also when one task is stopped mid-render and requeued
 //! (`scontrol requeue`: SIGTERM, then the task runs again and resumes its
-//! tile). Runs where `sinfo` answers; elsewhere it is skipped with a message.
+//! tile); a bench sweep (a task per strategy and budget, then the merge)
+//! gives the single bench's errors. Runs where `sinfo` answers; elsewhere it is skipped with a message.
 //! One command starts a one-node cluster here: `sudo
 //! tools/cluster/slurm-one-node.sh` (docs/testing.md).
 
@@ -108,7 +109,7 @@ fn logs_text(dir: &Path) -> String {
 }
 
 #[test]
-fn a_tiled_render_through_sbatch_is_the_single_render_also_after_a_requeue() {
+fn a_tiled_render_and_a_sweep_through_sbatch_are_the_single_runs_also_after_a_requeue() {
     if let Err(why) = slurm_answers() {
         eprintln!(
             "skipped: {why}; start a one-node cluster with `sudo tools/cluster/slurm-one-node.sh`, then `cargo test -p glint-cli --test farm_slurm` (docs/testing.md)"
@@ -135,6 +136,95 @@ fn a_tiled_render_through_sbatch_is_the_single_render_also_after_a_requeue() {
         logs_text(&d.join("quick/logs"))
     );
     assert!(std::fs::read(&farmed).unwrap() == std::fs::read(&whole).unwrap());
+
+    // A sweep: one task per strategy and budget, then the merge.
+    let cornell = scene("cornell-set1");
+    let measure = [
+        "--resolution",
+        "16x16",
+        "--samplers",
+        "random,sobol",
+        "--spp",
+        "1,4",
+    ];
+    let reference = glint(
+        &[
+            "render",
+            &cornell,
+            "--resolution",
+            "16x16",
+            "--spp",
+            "256",
+            "--seed",
+            "9",
+            "-o",
+            "ref16.exr",
+        ],
+        d,
+    );
+    assert!(reference.status.success(), "{}", stderr(&reference));
+    let single = glint(
+        &[
+            &["bench", &cornell, "-o", "single"],
+            &measure[..],
+            &["--reference", "ref16.exr"],
+        ]
+        .concat(),
+        d,
+    );
+    assert!(single.status.success(), "{}", stderr(&single));
+    let out = glint(
+        &[
+            &[
+                "farm", "slurm", "bench", &cornell, "--dir", "sweep", "-o", "swept", "--submit",
+                "--",
+            ],
+            &measure[..],
+            &["--reference", "ref16.exr"],
+        ]
+        .concat(),
+        d,
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let words: Vec<String> = stdout(&out).split_whitespace().map(str::to_owned).collect();
+    let at = |word: &str, skip: usize| {
+        let k = words.iter().position(|w| w == word).expect(word);
+        words[k + skip].clone()
+    };
+    let (sweep, sweep_merge) = (at("array", 1), at("and", 2));
+    wait_for(&[&sweep, &sweep_merge], &d.join("sweep/logs"));
+    let rows = |dir: &str| -> Vec<(String, u64, f64)> {
+        let path = d.join(dir).join("results.json");
+        let text = std::fs::read_to_string(&path).unwrap_or_else(|e| {
+            panic!(
+                "{}: {e}; logs:\n{}",
+                path.display(),
+                logs_text(&d.join("sweep/logs"))
+            )
+        });
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let mut rows: Vec<(String, u64, f64)> = json["rows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| {
+                let name = r["strategy"].as_str().unwrap().to_owned();
+                (
+                    name,
+                    r["total_samples"].as_u64().unwrap(),
+                    r["rel_mse"].as_f64().unwrap(),
+                )
+            })
+            .collect();
+        rows.sort_by(|a, b| (&a.0, a.1).cmp(&(&b.0, b.1)));
+        rows
+    };
+    let (single, swept) = (rows("single"), rows("swept"));
+    assert_eq!(single.len(), 4);
+    for (a, b) in single.iter().zip(&swept) {
+        assert_eq!((&a.0, a.1), (&b.0, b.1));
+        assert!((a.2 - b.2).abs() <= 1e-12 * a.2, "{a:?} against {b:?}");
+    }
 
     // One task stopped mid-render: requeued, it resumes its tile.
     let (array, merge) = submit(d, "long", 2, LONG_SPP);

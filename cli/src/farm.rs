@@ -235,15 +235,7 @@ impl Plan {
                 "--tiles: expected at least 1 tile, got 0".into(),
             ));
         }
-        if let Some(option) = args.render_options.iter().find(|o| {
-            let name = o.split('=').next().unwrap_or(o);
-            MANAGED.contains(&name)
-        }) {
-            return Err(Failure::Input(format!(
-                "render options after --: {option} is set by glint farm for each tile (managed: {})",
-                MANAGED.join(", ")
-            )));
-        }
+        check_managed("render", &args.render_options, &MANAGED)?;
         let stem = args
             .scene
             .file_stem()
@@ -499,30 +491,55 @@ exec {merge}
 /// options' errors are caught here, before any job exists.
 fn parse_render(scene: &Path, dir: &Path, options: &[String]) -> Result<RenderArgs, Failure> {
     let tile = dir.join("tiles").join("tile-0.exr");
-    let mut words: Vec<std::ffi::OsString> = vec!["glint".into(), "render".into()];
-    words.push(scene.as_os_str().to_owned());
-    words.extend([
+    let fixed = [
         "-o".into(),
         tile.into_os_string(),
         "--tile".into(),
         "0/1".into(),
-    ]);
+    ];
+    match parse_command("render", scene, &fixed, options)? {
+        Command::Render(args) => Ok(args),
+        _ => unreachable!("parsed as glint render"),
+    }
+}
+
+/// `glint COMMAND SCENE FIXED... OPTIONS...` as glint parses it; a usage
+/// error is bad input in the options after `--`.
+pub(crate) fn parse_command(
+    command: &str,
+    scene: &Path,
+    fixed: &[std::ffi::OsString],
+    options: &[String],
+) -> Result<Command, Failure> {
+    let mut words: Vec<std::ffi::OsString> = vec!["glint".into(), command.into()];
+    words.push(scene.as_os_str().to_owned());
+    words.extend(fixed.iter().cloned());
     words.extend(options.iter().map(Into::into));
     let parsed = Cli::try_parse_from(words).map_err(|e| {
         let rendered = e.render().to_string();
-        let first = rendered
-            .lines()
-            .next()
-            .unwrap_or("invalid options")
-            .to_owned();
+        let first = rendered.lines().next().unwrap_or("invalid options");
         Failure::Input(format!(
-            "render options after --: {}",
-            first.strip_prefix("error: ").unwrap_or(&first)
+            "{command} options after --: {}",
+            first.strip_prefix("error: ").unwrap_or(first)
         ))
     })?;
-    match parsed.command {
-        Command::Render(args) => Ok(args),
-        _ => unreachable!("parsed as glint render"),
+    Ok(parsed.command)
+}
+
+/// Refuses an option among `options` that the farm sets for each task
+/// (`managed`).
+pub(crate) fn check_managed(
+    command: &str,
+    options: &[String],
+    managed: &[&str],
+) -> Result<(), Failure> {
+    let name = |o: &String| o.split('=').next().unwrap_or(o).to_owned();
+    match options.iter().find(|o| managed.contains(&name(o).as_str())) {
+        Some(option) => Err(Failure::Input(format!(
+            "{command} options after --: {option} is set by glint farm for each task (managed: {})",
+            managed.join(", ")
+        ))),
+        None => Ok(()),
     }
 }
 

@@ -3,9 +3,9 @@
 //! same reference file, then `merge-bench.sh`, which fits and plots from the
 //! tasks' JSON (`glint bench --merge`).
 
-use crate::farm::{quote, quote_str, Farm};
-use crate::{Cli, Command, Failure};
-use clap::{Args, Parser};
+use crate::farm::{check_managed, parse_command, quote, quote_str, Farm};
+use crate::{Command, Failure};
+use clap::Args;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -58,15 +58,7 @@ impl Sweep {
     /// Checks everything before any file is written: the options (as `glint
     /// bench` parses and checks them) and the paths.
     pub(crate) fn new(args: &FarmBench) -> Result<Sweep, Failure> {
-        if let Some(option) = args.bench_options.iter().find(|o| {
-            let name = o.split('=').next().unwrap_or(o);
-            MANAGED.contains(&name)
-        }) {
-            return Err(Failure::Input(format!(
-                "bench options after --: {option} is set by glint farm for each task (managed: {})",
-                MANAGED.join(", ")
-            )));
-        }
+        check_managed("bench", &args.bench_options, &MANAGED)?;
         let stem = glint_bench::scene_name(&args.scene);
         let dir = args
             .dir
@@ -196,26 +188,13 @@ fn parse_bench(
     dir: &Path,
     options: &[String],
 ) -> Result<crate::bench::BenchArgs, Failure> {
-    let mut words: Vec<std::ffi::OsString> = vec!["glint".into(), "bench".into()];
-    words.push(scene.as_os_str().to_owned());
-    words.extend([
-        "-o".into(),
-        dir.join("tasks").join("task-0").into_os_string(),
-    ]);
-    words.extend(options.iter().map(Into::into));
-    let parsed = Cli::try_parse_from(words).map_err(|e| {
-        let rendered = e.render().to_string();
-        let first = rendered
-            .lines()
-            .next()
-            .unwrap_or("invalid options")
-            .to_owned();
-        Failure::Input(format!(
-            "bench options after --: {}",
-            first.strip_prefix("error: ").unwrap_or(&first)
-        ))
-    })?;
-    match parsed.command {
+    let task = dir.join("tasks").join("task-0");
+    match parse_command(
+        "bench",
+        scene,
+        &["-o".into(), task.into_os_string()],
+        options,
+    )? {
         Command::Bench(args) => Ok(args),
         _ => unreachable!("parsed as glint bench"),
     }

@@ -181,6 +181,26 @@ fn rows(dir: &Path) -> Vec<(String, u64, Vec<f64>)> {
     rows
 }
 
+/// Runs glint in `d`, which must succeed; returns its stdout.
+fn succeeds(args: &[&str], d: &Path) -> String {
+    let o = glint(args, d);
+    assert!(o.status.success(), "{args:?}: {}", text(&o.stderr));
+    text(&o.stdout)
+}
+
+/// The same rows (strategies, budgets, errors and rays), the metrics to the
+/// last bits their parallel sums may round apart.
+fn assert_same_rows(whole: &Path, merged: &Path, count: usize) {
+    let (whole, merged) = (rows(whole), rows(merged));
+    assert_eq!((whole.len(), merged.len()), (count, count));
+    for (a, b) in whole.iter().zip(&merged) {
+        assert_eq!((&a.0, a.1), (&b.0, b.1));
+        for (x, y) in a.2.iter().zip(&b.2) {
+            assert!((x - y).abs() <= 1e-12 * x.abs(), "{a:?} against {b:?}");
+        }
+    }
+}
+
 /// Benches run apart (a strategy's budgets split between two tasks) and put
 /// together with `--merge` give the single bench's rows and fits; tasks of
 /// another reference, or one measured twice, are refused.
@@ -189,11 +209,7 @@ fn merged_tasks_give_the_single_bench_s_rows_and_fits() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let set1 = scene("cornell-set1");
-    let run = |args: &[&str]| {
-        let o = glint(args, d);
-        assert!(o.status.success(), "{args:?}: {}", text(&o.stderr));
-        text(&o.stdout)
-    };
+    let run = |args: &[&str]| succeeds(args, d);
     for (seed, name) in [("777", "ref.exr"), ("778", "other-ref.exr")] {
         run(&[
             "render",
@@ -230,15 +246,7 @@ fn merged_tasks_give_the_single_bench_s_rows_and_fits() {
         table.contains("sobol: relMSE slope") && table.contains("from 3 tasks"),
         "{table}"
     );
-    let (whole, merged) = (rows(&d.join("whole")), rows(&d.join("merged")));
-    assert_eq!(whole.len(), 6);
-    for (a, b) in whole.iter().zip(&merged) {
-        assert_eq!((&a.0, a.1), (&b.0, b.1));
-        for (x, y) in a.2.iter().zip(&b.2) {
-            // The metrics' parallel sums may round their last bit apart.
-            assert!((x - y).abs() <= 1e-12 * x.abs(), "{a:?} against {b:?}");
-        }
-    }
+    assert_same_rows(&d.join("whole"), &d.join("merged"), 6);
     let slopes = |dir: &str| -> Vec<(String, f64)> {
         let json: serde_json::Value = serde_json::from_str(
             &std::fs::read_to_string(d.join(dir).join("results.json")).unwrap(),
@@ -284,11 +292,7 @@ fn a_farmed_sweep_gives_the_single_bench_s_rows_and_fits() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let set1 = scene("cornell-set1");
-    let run = |args: &[&str]| {
-        let o = glint(args, d);
-        assert!(o.status.success(), "{args:?}: {}", text(&o.stderr));
-        text(&o.stdout)
-    };
+    let run = |args: &[&str]| succeeds(args, d);
     run(&[
         "render",
         &set1,
@@ -340,15 +344,7 @@ fn a_farmed_sweep_gives_the_single_bench_s_rows_and_fits() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let (whole, merged) = (rows(&d.join("whole")), rows(&d.join("merged")));
-    assert_eq!(whole.len(), 6);
-    assert_eq!(merged.len(), 6);
-    for (a, b) in whole.iter().zip(&merged) {
-        assert_eq!((&a.0, a.1), (&b.0, b.1));
-        for (x, y) in a.2.iter().zip(&b.2) {
-            assert!((x - y).abs() <= 1e-12 * x.abs(), "{a:?} against {b:?}");
-        }
-    }
+    assert_same_rows(&d.join("whole"), &d.join("merged"), 6);
     for (args, expected) in [
         (vec!["--spp", "1,4"], "give --reference FILE"),
         (

@@ -337,7 +337,7 @@ fn farm_options_are_checked_before_anything_is_written() {
             &[
                 "parallel", "render", &bunny, "--tiles", "4", "--", "--crop", "0,0,4,4",
             ],
-            "--crop is set by glint farm for each tile",
+            "--crop is set by glint farm for each task",
         ),
         (
             &[

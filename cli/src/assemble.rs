@@ -36,7 +36,8 @@ pub(crate) fn assemble(args: &AssembleArgs) -> Result<(), Failure> {
     crate::output::check_outputs_apart(&[("-o", args.output.as_path())], &inputs)?;
     // One piece in memory at a time, beside the image: a tile's data window
     // spans nearly the whole image.
-    let mut first: Option<PartialFilm> = None;
+    // The first piece's render and image size, which the others must share.
+    let mut first: Option<(Option<String>, UVec2)> = None;
     let mut film = Film::new(UVec2::ONE);
     // Per pixel, which piece holds it (its index plus one; 0 for none).
     let mut holder = Vec::new();
@@ -47,19 +48,13 @@ pub(crate) fn assemble(args: &AssembleArgs) -> Result<(), Failure> {
             None => {
                 film = Film::new(piece.placement.image);
                 holder = vec![0u32; film.pixels().len()];
+                first = Some((piece.fingerprint.clone(), piece.placement.image));
             }
             Some(first) => check_one_render((&args.tiles[0], first), (path, &piece))?,
         }
         place(&mut film, &mut holder, k, &piece)
             .map_err(|(other, count, at)| overlap(&args.tiles, other, k, count, at))?;
         tiles.push(piece.tile);
-        if first.is_none() {
-            first = Some(PartialFilm {
-                film: Film::new(UVec2::ONE),
-                finished: Vec::new(),
-                ..piece
-            });
-        }
     }
     let image = film.resolution();
     let missing = holder.iter().filter(|&&h| h == 0).count();
@@ -105,17 +100,17 @@ fn load_piece(path: &Path) -> Result<PartialFilm, Failure> {
 /// Refuses a piece of another render than the first piece: another scene,
 /// assets or settings (its fingerprint), or another image size.
 fn check_one_render(
-    (first_path, first): (&Path, &PartialFilm),
+    (first_path, (fingerprint, image)): (&Path, &(Option<String>, UVec2)),
     (path, piece): (&Path, &PartialFilm),
 ) -> Result<(), Failure> {
-    if piece.fingerprint != first.fingerprint {
+    if piece.fingerprint != *fingerprint {
         return Err(Failure::Input(format!(
             "{}: a piece of another render than {} (the scene, its assets, the settings or Glint's version differ): assemble the pieces of one render",
             path.display(),
             first_path.display()
         )));
     }
-    let (a, b) = (piece.placement.image, first.placement.image);
+    let (a, b) = (piece.placement.image, *image);
     if a != b {
         return Err(Failure::Input(format!(
             "{}: a piece of a {}x{} image, {} of a {}x{} one",

@@ -159,9 +159,11 @@ pub(crate) struct Farm {
     pub(crate) tasks: u32,
     /// Said when the job is written: "5 tiles of SCENE".
     pub(crate) what: String,
-    /// The folders to make and the scripts to write, with their text.
+    /// The folders to make.
     pub(crate) folders: Vec<PathBuf>,
-    pub(crate) scripts: Vec<(PathBuf, String)>,
+    /// The text of `task_script` and of `merge_script`.
+    pub(crate) task_text: String,
+    pub(crate) merge_text: String,
 }
 
 /// Writes the job array and the merge job, and submits them or says how.
@@ -289,10 +291,8 @@ impl Plan {
             tasks: self.tiles,
             what: format!("{} tiles of {}", self.tiles, self.scene.display()),
             folders: folders.into_iter().chain(output_folder).collect(),
-            scripts: vec![
-                (self.dir.join("render-tile.sh"), self.render_tile()),
-                (self.dir.join("assemble.sh"), self.assemble()),
-            ],
+            task_text: self.render_tile(),
+            merge_text: self.assemble(),
         }
     }
 
@@ -359,10 +359,8 @@ impl Farm {
             std::fs::create_dir_all(dir)
                 .map_err(|e| Failure::Other(format!("{}: cannot make it: {e}", dir.display())))?;
         }
-        for (path, text) in &self.scripts {
-            write_script(path, text)?;
-        }
-        Ok(())
+        write_script(&self.dir.join(self.task_script), &self.task_text)?;
+        write_script(&self.dir.join(self.merge_script), &self.merge_text)
     }
 
     /// `KIND.sbatch`: the job array, task I running `TASK_SCRIPT I`.

@@ -121,10 +121,8 @@ impl Sweep {
                 self.scene.display()
             ),
             folders: folders.into_iter().chain(output_folder).collect(),
-            scripts: vec![
-                (self.dir.join("bench-task.sh"), self.task_script()),
-                (self.dir.join("merge-bench.sh"), self.merge_script()),
-            ],
+            task_text: self.task_script(),
+            merge_text: self.merge_script(),
         }
     }
 

@@ -289,8 +289,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         };
         // A tile's other rows were never its to render.
         let others = args.tile.map_or(0, |tile| {
-            let rows = (0..image.y).filter(|&y| !tile.has_row(y)).count();
-            rows * image.x as usize
+            (image.y - tile.row_count(image.y)) as usize * image.x as usize
         });
         return Err(write_partial(
             &output,
@@ -337,7 +336,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
             "tile {tile} of {}x{} ({} rows)",
             image.x,
             image.y,
-            (0..image.y).filter(|&y| tile.has_row(y)).count()
+            tile.row_count(image.y)
         ),
         None => format!("{}x{}", resolution.x, resolution.y),
     };

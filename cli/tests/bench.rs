@@ -188,6 +188,12 @@ fn succeeds(args: &[&str], d: &Path) -> String {
     text(&o.stdout)
 }
 
+/// A 16 × 16 reference for `scene` in `d`: 256 samples with `seed`.
+fn reference(scene: &str, seed: &str, name: &str, d: &Path) {
+    let args = ["render", scene, "--resolution", "16x16", "--spp", "256"];
+    succeeds(&[&args[..], &["--seed", seed, "-o", name]].concat(), d);
+}
+
 /// The same rows (strategies, budgets, errors and rays), the metrics to the
 /// last bits their parallel sums may round apart.
 fn assert_same_rows(whole: &Path, merged: &Path, count: usize) {
@@ -211,18 +217,7 @@ fn merged_tasks_give_the_single_bench_s_rows_and_fits() {
     let set1 = scene("cornell-set1");
     let run = |args: &[&str]| succeeds(args, d);
     for (seed, name) in [("777", "ref.exr"), ("778", "other-ref.exr")] {
-        run(&[
-            "render",
-            &set1,
-            "--resolution",
-            "16x16",
-            "--spp",
-            "256",
-            "--seed",
-            seed,
-            "-o",
-            name,
-        ]);
+        reference(&set1, seed, name, d);
     }
     let bench = |samplers: &str, spp: &str, reference: &str, out: &str| {
         let args = [
@@ -293,18 +288,7 @@ fn a_farmed_sweep_gives_the_single_bench_s_rows_and_fits() {
     let d = dir.path();
     let set1 = scene("cornell-set1");
     let run = |args: &[&str]| succeeds(args, d);
-    run(&[
-        "render",
-        &set1,
-        "--resolution",
-        "16x16",
-        "--spp",
-        "256",
-        "--seed",
-        "777",
-        "-o",
-        "ref.exr",
-    ]);
+    reference(&set1, "777", "ref.exr", d);
     let measure = [
         "--resolution",
         "16x16",

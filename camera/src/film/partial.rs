@@ -93,6 +93,11 @@ impl Tile {
         y % self.count == self.index
     }
 
+    /// How many of an image's `height` rows are the tile's.
+    pub fn row_count(&self, height: u32) -> u32 {
+        height.saturating_sub(self.index).div_ceil(self.count)
+    }
+
     /// The tile's first and last rows plus one in an image `height` rows
     /// high, if it has any.
     pub fn row_span(&self, height: u32) -> Option<(u32, u32)> {
@@ -435,6 +440,10 @@ mod tests {
         assert_eq!(tile.row_span(13), Some((2, 13)));
         assert_eq!(tile.row_span(12), Some((2, 8)));
         assert_eq!(tile.row_span(2), None);
+        for height in 0..13 {
+            let rows = (0..height).filter(|&y| tile.has_row(y)).count() as u32;
+            assert_eq!(tile.row_count(height), rows, "{height} rows");
+        }
         for bad in ["5/5", "1/0", "1", "a/2", "-1/2"] {
             assert!(Tile::parse(bad).is_err(), "{bad}");
         }

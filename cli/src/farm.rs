@@ -49,6 +49,10 @@ enum Job {
     /// A glint bench sweep: one task per strategy and budget against one
     /// reference file, then glint bench --merge (the fits and the plot)
     Bench(crate::farm_sweep::FarmBench),
+    /// A class's grading: its references rendered into a shared cache, then
+    /// one task per part of the submissions (glint grade --part I/N), then
+    /// glint grade --merge (the report)
+    Grade(crate::farm_class::FarmGrade),
 }
 
 #[derive(Args)]
@@ -142,12 +146,16 @@ fn job_of(job: &Job) -> Result<Farm, Failure> {
     match job {
         Job::Render(render) => Ok(Plan::new(render)?.farm()),
         Job::Bench(bench) => Ok(crate::farm_sweep::Sweep::new(bench)?.farm()),
+        Job::Grade(grade) => Ok(crate::farm_class::ClassPlan::new(grade)?.farm()),
     }
 }
 
-/// What the engines run: tasks `0..tasks`, each `TASK_SCRIPT I`, then the
-/// merge script once all have succeeded.
+/// What the engines run: the first step if there is one, then tasks
+/// `0..tasks`, each `TASK_SCRIPT I`, then the merge script once all have
+/// succeeded.
 pub(crate) struct Farm {
+    /// A step the tasks wait for.
+    pub(crate) first: Option<FirstStep>,
     /// Names the jobs, the logs and the Slurm scripts (`render.sbatch`,
     /// `assemble.sbatch`).
     pub(crate) kind: &'static str,
@@ -166,6 +174,14 @@ pub(crate) struct Farm {
     pub(crate) merge_text: String,
 }
 
+/// A step run once before the tasks, on one machine with all the CPUs it
+/// is given: `KIND.sbatch` running `SCRIPT`.
+pub(crate) struct FirstStep {
+    pub(crate) kind: &'static str,
+    pub(crate) script: &'static str,
+    pub(crate) text: String,
+}
+
 /// Writes the job array and the merge job, and submits them or says how.
 fn slurm(options: &SlurmOptions, farm: &Farm) -> Result<(), Failure> {
     if farm.dir.to_string_lossy().chars().any(char::is_whitespace) {
@@ -182,16 +198,31 @@ fn slurm(options: &SlurmOptions, farm: &Farm) -> Result<(), Failure> {
         farm.dir.join(format!("{}.sbatch", farm.kind)),
         farm.dir.join(format!("{}.sbatch", farm.merge_kind)),
     );
+    let first = match &farm.first {
+        Some(step) => {
+            let path = farm.dir.join(format!("{}.sbatch", step.kind));
+            write_script(&path, &farm.slurm_first(step, options))?;
+            Some(path)
+        }
+        None => None,
+    };
     write_script(&array, &farm.slurm_array(options))?;
     write_script(&merge, &farm.slurm_merge(options))?;
     if options.submit {
-        return submit(&array, &merge);
+        return submit(farm, first.as_deref(), &array, &merge);
     }
+    let array_command = match &first {
+        Some(first) => format!(
+            "first=$(sbatch --parsable {})\njob=$(sbatch --parsable --dependency=afterok:${{first%%;*}} {})",
+            quote(first),
+            quote(&array)
+        ),
+        None => format!("job=$(sbatch --parsable {})", quote(&array)),
+    };
     crate::output::say(&format!(
-        "wrote {}: {}; submit with\njob=$(sbatch --parsable {})\nsbatch --dependency=afterok:${{job%%;*}} {}\n",
+        "wrote {}: {}; submit with\n{array_command}\nsbatch --dependency=afterok:${{job%%;*}} {}\n",
         farm.dir.display(),
         farm.what,
-        quote(&array),
         quote(&merge)
     ));
     Ok(())
@@ -282,6 +313,7 @@ impl Plan {
         let folders = [self.dir.clone(), self.tiles_dir(), self.dir.join("logs")];
         let output_folder = self.output.parent().map(Path::to_owned);
         Farm {
+            first: None,
             kind: "render",
             merge_kind: "assemble",
             task_script: "render-tile.sh",
@@ -359,8 +391,30 @@ impl Farm {
             std::fs::create_dir_all(dir)
                 .map_err(|e| Failure::Other(format!("{}: cannot make it: {e}", dir.display())))?;
         }
+        if let Some(step) = &self.first {
+            write_script(&self.dir.join(step.script), &step.text)?;
+        }
         write_script(&self.dir.join(self.task_script), &self.task_text)?;
         write_script(&self.dir.join(self.merge_script), &self.merge_text)
+    }
+
+    /// `KIND.sbatch` of the first step: one job.
+    fn slurm_first(&self, step: &FirstStep, options: &SlurmOptions) -> String {
+        let mut lines = vec![
+            "#!/bin/bash".to_owned(),
+            format!("#SBATCH --job-name=glint-{}-{}", step.kind, self.name()),
+            format!(
+                "#SBATCH --output={}/logs/{}_%j.log",
+                self.dir.display(),
+                step.kind
+            ),
+            "#SBATCH --open-mode=append".to_owned(),
+            format!("#SBATCH --cpus-per-task={}", options.cpus),
+            "#SBATCH --requeue".to_owned(),
+        ];
+        lines.extend(self.slurm_limits(options));
+        lines.push(format!("exec {}", quote(&self.dir.join(step.script))));
+        lines.join("\n") + "\n"
     }
 
     /// `KIND.sbatch`: the job array, task I running `TASK_SCRIPT I`.
@@ -448,12 +502,20 @@ impl Farm {
             let logins = std::path::absolute(logins).unwrap_or_else(|_| logins.clone());
             engine.push(format!("--sshloginfile {}", quote(&logins)));
         }
+        let first = match &self.first {
+            Some(step) => format!(
+                "# First, on this machine: {kind}.\n{script} || exit $?\n",
+                kind = step.kind,
+                script = quote(&self.dir.join(step.script))
+            ),
+            None => String::new(),
+        };
         format!(
             r#"#!/bin/bash
 # Runs the {what} with GNU parallel, then the merge (written by glint farm).
 # Run again after a failure: only the failed tasks run again.
 set -uo pipefail
-{engine} {task} {{}} ::: $(seq 0 {last})
+{first}{engine} {task} {{}} ::: $(seq 0 {last})
 status=$?
 if [ $status -ne 0 ]; then
   echo "glint farm: $status job(s) failed (see {joblog}); run this script again to run them" >&2
@@ -490,27 +552,26 @@ exec {merge}
 fn parse_render(scene: &Path, dir: &Path, options: &[String]) -> Result<RenderArgs, Failure> {
     let tile = dir.join("tiles").join("tile-0.exr");
     let fixed = [
+        scene.as_os_str().to_owned(),
         "-o".into(),
         tile.into_os_string(),
         "--tile".into(),
         "0/1".into(),
     ];
-    match parse_command("render", scene, &fixed, options)? {
+    match parse_command("render", &fixed, options)? {
         Command::Render(args) => Ok(args),
         _ => unreachable!("parsed as glint render"),
     }
 }
 
-/// `glint COMMAND SCENE FIXED... OPTIONS...` as glint parses it; a usage
-/// error is bad input in the options after `--`.
+/// `glint COMMAND FIXED... OPTIONS...` as glint parses it; a usage error
+/// is bad input in the options after `--`.
 pub(crate) fn parse_command(
     command: &str,
-    scene: &Path,
     fixed: &[std::ffi::OsString],
     options: &[String],
 ) -> Result<Command, Failure> {
     let mut words: Vec<std::ffi::OsString> = vec!["glint".into(), command.into()];
-    words.push(scene.as_os_str().to_owned());
     words.extend(fixed.iter().cloned());
     words.extend(options.iter().map(Into::into));
     let parsed = Cli::try_parse_from(words).map_err(|e| {
@@ -570,7 +631,7 @@ fn needs(program: &str, argument: &str, name: &str) -> Result<(), Failure> {
 }
 
 /// Submits the array, then the merge with a dependency on it.
-fn submit(array: &Path, merge: &Path) -> Result<(), Failure> {
+fn submit(farm: &Farm, first: Option<&Path>, array: &Path, merge: &Path) -> Result<(), Failure> {
     let sbatch = |args: &[&std::ffi::OsStr]| -> Result<String, Failure> {
         let out = std::process::Command::new("sbatch")
             .arg("--parsable")
@@ -586,11 +647,20 @@ fn submit(array: &Path, merge: &Path) -> Result<(), Failure> {
         let id = String::from_utf8_lossy(&out.stdout);
         Ok(id.trim().split(';').next().unwrap_or_default().to_owned())
     };
-    let job = sbatch(&[array.as_os_str()])?;
-    let dependency = format!("--dependency=afterok:{job}");
-    let merge_job = sbatch(&[dependency.as_ref(), merge.as_os_str()])?;
+    let after = |job: &str| format!("--dependency=afterok:{job}");
+    let mut said = String::from("submitted ");
+    let job = match (first, &farm.first) {
+        (Some(first), Some(step)) => {
+            let first_job = sbatch(&[first.as_os_str()])?;
+            said += &format!("job {first_job} ({}), then ", step.kind);
+            sbatch(&[after(&first_job).as_ref(), array.as_os_str()])?
+        }
+        _ => sbatch(&[array.as_os_str()])?,
+    };
+    let merge_job = sbatch(&[after(&job).as_ref(), merge.as_os_str()])?;
     crate::output::say(&format!(
-        "submitted job array {job} (render) and job {merge_job} (assemble, after the array succeeds)\n"
+        "{said}job array {job} ({}) and job {merge_job} ({}, after the array succeeds)\n",
+        farm.kind, farm.merge_kind
     ));
     Ok(())
 }
@@ -602,7 +672,7 @@ fn run_parallel(script: &Path) -> Result<(), Failure> {
     match status.code() {
         Some(0) => Ok(()),
         code => Err(Failure::Other(format!(
-            "{} failed (exit status {}); run it again to render the failed tiles",
+            "{} failed (exit status {}); run it again to run the failed tasks",
             script.display(),
             code.map_or("none".into(), |c| c.to_string())
         ))),

@@ -106,6 +106,7 @@ impl Sweep {
             self.dir.join("logs"),
         ];
         Farm {
+            first: None,
             kind: "bench",
             merge_kind: "merge",
             task_script: "bench-task.sh",
@@ -187,12 +188,12 @@ fn parse_bench(
     options: &[String],
 ) -> Result<crate::bench::BenchArgs, Failure> {
     let task = dir.join("tasks").join("task-0");
-    match parse_command(
-        "bench",
-        scene,
-        &["-o".into(), task.into_os_string()],
-        options,
-    )? {
+    let fixed = [
+        scene.as_os_str().to_owned(),
+        "-o".into(),
+        task.into_os_string(),
+    ];
+    match parse_command("bench", &fixed, options)? {
         Command::Bench(args) => Ok(args),
         _ => unreachable!("parsed as glint bench"),
     }

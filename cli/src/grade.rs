@@ -8,6 +8,8 @@ use crate::{named, progress_bar, Failure};
 use clap::{Args, ValueEnum};
 use glint_grade::class::{self, ClassGrades, Entry, Progress};
 use glint_grade::course::{Course, Scenes};
+use glint_grade::parts::{self, Part};
+use glint_grade::report::ReportRow;
 use glint_grade::{text, Cache, GradeError, StatedSettings, TestOptions};
 use glint_integrator::SamplePattern;
 use indicatif::ProgressBar;
@@ -99,9 +101,34 @@ pub(crate) struct GradeArgs {
     heatmap: Option<PathBuf>,
 
     /// Write a report folder: index.html (thumbnails, heat maps, a verdict per
-    /// scene, sortable columns; works offline), grades.csv, grades.json
+    /// scene, sortable columns; works offline), grades.csv, grades.json; with
+    /// --part, the part's folder (part.json and its images)
     #[arg(long, value_name = "DIR")]
     report: Option<PathBuf>,
+
+    /// Grade part I of N of the class (submissions I, I+N, I+2N, ... in
+    /// class order) into the part folder --report DIR, to be merged with
+    /// --merge; exits 0 once graded, whatever the verdicts (docs/cluster.md)
+    #[arg(long, value_name = "I/N", requires_all = ["class", "report"], value_parser = glint_grade::parts::Part::parse)]
+    part: Option<Part>,
+
+    /// Render the references the class needs into the cache (--cache), and
+    /// grade nothing: the first step of a class graded in parts
+    #[arg(long, requires = "class", conflicts_with_all = ["report", "heatmap", "part", "no_cache"])]
+    references_only: bool,
+
+    /// Merge the part folders of a class graded in parts (--part I/N) into
+    /// what a single run prints and writes (--format, --report)
+    #[arg(long, value_name = "PART-DIR", num_args = 1.., conflicts_with_all = [
+        "inputs", "class", "stages", "heatmap", "part", "references_only", "cache", "no_cache",
+        "spp", "sampler", "light_samples", "light_sampler", "alpha", "block",
+    ])]
+    merge: Vec<PathBuf>,
+
+    /// Worker threads [default: one per core]; the grades are the same for
+    /// any count
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
 
     /// Stage by stage: with --write, write test vectors of SCENE's stages
     /// (camera, intersection, texture, lighting, film: inputs and Glint's
@@ -179,6 +206,20 @@ pub(crate) fn grade(args: &GradeArgs) -> Result<(), Failure> {
     if args.stages {
         return crate::grade_stages::run(&args.stage_args()?);
     }
+    let Some(threads) = args.threads else {
+        return grade_or_merge(args);
+    };
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads as usize)
+        .build()
+        .map_err(|e| Failure::Other(format!("cannot start {threads} threads: {e}")))?
+        .install(|| grade_or_merge(args))
+}
+
+fn grade_or_merge(args: &GradeArgs) -> Result<(), Failure> {
+    if !args.merge.is_empty() {
+        return merge(args);
+    }
     let stated = stated(args)?;
     let (entries, scenes, base) = entries(args, &stated)?;
     check_outputs(args, &entries)?;
@@ -190,32 +231,130 @@ pub(crate) fn grade(args: &GradeArgs) -> Result<(), Failure> {
         cache: cache(args)?,
     };
     let bar = GradeProgress::new();
+    if args.references_only {
+        return references_only(&entries, (&scenes, &base), &options, &bar);
+    }
+    let class_entries = entries.len();
+    let fingerprint = parts::class_fingerprint(&entries, &class_options(args));
+    let (entries, part) = match args.part {
+        Some(part) => (part_entries(part, entries)?, Some(part)),
+        None => (entries, None),
+    };
     // The report is made in a folder of its own beside the one asked for,
     // and takes its place only when whole: a failed run leaves the old one.
     let staging = args.report.as_deref().map(Staging::new).transpose()?;
     let report = staging.as_ref().map(|s| s.dir.path());
     let on_graded = |i: usize, row: &class::Row, s: &glint_grade::Submission, g: &class::Group| {
         if let Some(dir) = report {
-            glint_grade::html::write_images(dir, i, row, s, g)?;
+            let index = part.map_or(i, |p| p.submission(i));
+            glint_grade::html::write_images(dir, index, row, s, g)?;
         }
         Ok(())
     };
     let grades = class::grade_class(&entries, &scenes, &base, &options, &bar, &on_graded)
         .map_err(failure)?;
     bar.finish();
+    if let Some(part) = part {
+        let staging = staging.expect("--part requires --report");
+        let file = parts::part_file(fingerprint, part, class_entries, &grades);
+        parts::write_part(staging.dir.path(), &file).map_err(failure)?;
+        staging.finish()?;
+        // A part's verdicts are the merge's to report.
+        crate::output::say(&glint_grade::report::table(&grades.report_rows()));
+        return Ok(());
+    }
     if let Some(path) = &args.heatmap {
         write_heatmap(path, &grades)?;
     }
+    let rows = grades.report_rows();
     if let Some(staging) = staging {
-        glint_grade::html::write_report(staging.dir.path(), &grades).map_err(failure)?;
+        glint_grade::html::write_report(staging.dir.path(), &rows).map_err(failure)?;
         staging.finish()?;
     }
-    print(args, &grades)?;
-    if grades.all_passed() {
-        Ok(())
-    } else {
-        Err(Failure::Verdict(None))
+    match (&grades.rows[..], &args.class) {
+        ([row], None) if args.format == Format::Table => print_details(row),
+        _ => print_rows(args.format, &rows),
     }
+    verdict(&rows)
+}
+
+/// How many submissions the class of `args` (`--class`) has: its
+/// folder or manifest read and checked, as a run would before any work.
+pub(crate) fn class_size(args: &GradeArgs) -> Result<usize, Failure> {
+    let stated = stated(args)?;
+    Ok(entries(args, &stated)?.0.len())
+}
+
+/// Exit status 0 when every submission passed, else 1.
+fn verdict(rows: &[ReportRow]) -> Result<(), Failure> {
+    match rows.iter().all(ReportRow::passed) {
+        true => Ok(()),
+        false => Err(Failure::Verdict(None)),
+    }
+}
+
+/// `--references-only`: the references rendered into the cache.
+fn references_only(
+    entries: &[Entry],
+    (scenes, base): (&Scenes, &Path),
+    options: &class::ClassOptions,
+    bar: &GradeProgress,
+) -> Result<(), Failure> {
+    let Some(dir) = &options.cache.dir else {
+        return Err(Failure::Input(
+            "--references-only renders into the reference cache, and there is none here; give --cache DIR".into(),
+        ));
+    };
+    let sets = class::render_references(entries, scenes, base, options, bar).map_err(failure)?;
+    bar.finish();
+    crate::output::say(&format!(
+        "{sets} reference sets for {} submissions are in {}\n",
+        entries.len(),
+        dir.display()
+    ));
+    Ok(())
+}
+
+/// The class's submissions that are `part`'s, in class order.
+fn part_entries(part: Part, entries: Vec<Entry>) -> Result<Vec<Entry>, Failure> {
+    if part.count > entries.len() {
+        return Err(Failure::Input(format!(
+            "--part {part}: the class has {} submissions, one per part at most; use at most {} parts",
+            entries.len(),
+            entries.len()
+        )));
+    }
+    Ok(entries
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| part.has(*i))
+        .map(|(_, e)| e)
+        .collect())
+}
+
+/// The options that decide a class's grades beyond its submissions: the
+/// parts of a class must agree on them.
+fn class_options(args: &GradeArgs) -> String {
+    format!(
+        "class {:?}, scenes {:?}, course {}, alpha {}, block {:?}",
+        args.class, args.scenes, args.course, args.alpha, args.block
+    )
+}
+
+/// `--merge`: the parts' rows and images, reported as a single run would.
+fn merge(args: &GradeArgs) -> Result<(), Failure> {
+    if let Some(dir) = &args.report {
+        check_report_dir(dir)?;
+    }
+    let merged = parts::merge(&args.merge).map_err(failure)?;
+    if let Some(report) = &args.report {
+        let staging = Staging::new(report)?;
+        parts::copy_images(&merged, staging.dir.path()).map_err(failure)?;
+        glint_grade::html::write_report(staging.dir.path(), &merged.rows).map_err(failure)?;
+        staging.finish()?;
+    }
+    print_rows(args.format, &merged.rows);
+    verdict(&merged.rows)
 }
 
 /// A report folder being made: a temporary folder beside `target`, moved into
@@ -439,15 +578,23 @@ fn check_outputs(args: &GradeArgs, entries: &[Entry]) -> Result<(), Failure> {
         check_heatmap_path(path, &[entries[0].file.as_path()])?;
     }
     if let Some(dir) = &args.report {
-        glint_grade::output::check_dir(dir, "--report").map_err(failure)?;
-        // The report replaces the folder whole: only an earlier report's.
-        let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
-        if dir.is_dir() && !is_empty(dir) && !dir.join("grades.json").is_file() {
-            return Err(Failure::Input(format!(
-                "{}: --report: the folder holds files that are not a report of glint grade's, and a report replaces its folder whole; choose a new folder",
-                dir.display()
-            )));
-        }
+        check_report_dir(dir)?;
+    }
+    Ok(())
+}
+
+/// A report folder: new, empty, or an earlier report's (or part's), which
+/// the new one replaces whole.
+pub(crate) fn check_report_dir(dir: &Path) -> Result<(), Failure> {
+    glint_grade::output::check_dir(dir, "--report").map_err(failure)?;
+    let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
+    let is_report =
+        |d: &Path| d.join("grades.json").is_file() || d.join(parts::PART_FILE).is_file();
+    if dir.is_dir() && !is_empty(dir) && !is_report(dir) {
+        return Err(Failure::Input(format!(
+            "{}: --report: the folder holds files that are not a report of glint grade's, and a report replaces its folder whole; choose a new folder",
+            dir.display()
+        )));
     }
     Ok(())
 }
@@ -463,25 +610,26 @@ fn write_heatmap(path: &Path, grades: &ClassGrades) -> Result<(), Failure> {
     glint_grade::html::save_png(path, submission.resolution(), &pixels).map_err(failure)
 }
 
-fn print(args: &GradeArgs, grades: &ClassGrades) -> Result<(), Failure> {
-    let text = match args.format {
-        Format::Csv => glint_grade::report::csv(grades),
-        Format::Json => {
-            serde_json::to_string_pretty(&glint_grade::report::json(grades)).expect("JSON") + "\n"
-        }
-        Format::Table => match (&grades.rows[..], args.class.is_some()) {
-            ([row], false) => match &row.outcome {
-                class::Outcome::Graded(g) => glint_grade::report::details(g, 10),
-                class::Outcome::Unreadable { message } => {
-                    format!("{}: error: {message}\n", row.file)
-                }
-            },
-            _ => glint_grade::report::table(grades),
-        },
+/// One submission's every rejected region, or why it was not graded.
+fn print_details(row: &class::Row) {
+    let text = match &row.outcome {
+        class::Outcome::Graded(g) => glint_grade::report::details(g, 10),
+        class::Outcome::Unreadable { message } => format!("{}: error: {message}\n", row.file),
     };
-    // A reader that stops early (`| head`) is not an error.
     crate::output::say(&text);
-    Ok(())
+}
+
+/// The class in `format`. A reader that stops early (`| head`) is not an
+/// error.
+fn print_rows(format: Format, rows: &[ReportRow]) {
+    let text = match format {
+        Format::Csv => glint_grade::report::csv(rows),
+        Format::Json => {
+            serde_json::to_string_pretty(&glint_grade::report::json(rows)).expect("JSON") + "\n"
+        }
+        Format::Table => glint_grade::report::table(rows),
+    };
+    crate::output::say(&text);
 }
 
 fn failure(e: GradeError) -> Failure {

@@ -3,13 +3,15 @@
 //! render's bytes, also when one task is stopped mid-render and requeued
 //! (`scontrol requeue`: SIGTERM, then the task runs again and resumes its
 //! tile); a bench sweep (a task per strategy and budget, then the merge)
-//! gives the single bench's errors. Runs where `sinfo` answers; elsewhere it is skipped with a message.
+//! gives the single bench's errors; a class's grading (the references, a
+//! task per part, then the merge) gives the single run's report, byte for
+//! byte. Runs where `sinfo` answers; elsewhere it is skipped with a message.
 //! One command starts a one-node cluster here: `sudo
 //! tools/cluster/slurm-one-node.sh` (docs/testing.md).
 
 mod common;
 
-use common::{glint, scene, stderr, stdout};
+use common::{assert_same_folders, glint, scene, small_class, stderr, stdout};
 use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -63,13 +65,16 @@ fn submit(d: &Path, name: &str, tiles: u32, spp: &str) -> (String, String) {
     let out = glint(&args, d);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let said = stdout(&out);
+    (job_id(&said, "array", 1), job_id(&said, "and", 2))
+}
+
+/// The job id `skip` words after `word` in what `glint farm slurm --submit`
+/// said: "submitted [job F (references), then ]job array A (render) and job
+/// M (assemble, ...)".
+fn job_id(said: &str, word: &str, skip: usize) -> String {
     let words: Vec<&str> = said.split_whitespace().collect();
-    // "submitted job array A (render) and job M (assemble, ...)"
-    let after = |word: &str, skip: usize| {
-        let k = words.iter().position(|w| *w == word).expect(word);
-        words[k + skip].to_owned()
-    };
-    (after("array", 1), after("and", 2))
+    let k = words.iter().position(|w| *w == word).expect(word);
+    words[k + skip].to_owned()
 }
 
 /// Waits until none of `jobs` is queued or running.
@@ -109,7 +114,7 @@ fn logs_text(dir: &Path) -> String {
 }
 
 #[test]
-fn a_tiled_render_and_a_sweep_through_sbatch_are_the_single_runs_also_after_a_requeue() {
+fn a_tiled_render_a_sweep_and_a_class_through_sbatch_are_the_single_runs_also_after_a_requeue() {
     if let Err(why) = slurm_answers() {
         eprintln!(
             "skipped: {why}; start a one-node cluster with `sudo tools/cluster/slurm-one-node.sh`, then `cargo test -p glint-cli --test farm_slurm` (docs/testing.md)"
@@ -186,12 +191,8 @@ fn a_tiled_render_and_a_sweep_through_sbatch_are_the_single_runs_also_after_a_re
         d,
     );
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    let words: Vec<String> = stdout(&out).split_whitespace().map(str::to_owned).collect();
-    let at = |word: &str, skip: usize| {
-        let k = words.iter().position(|w| w == word).expect(word);
-        words[k + skip].clone()
-    };
-    let (sweep, sweep_merge) = (at("array", 1), at("and", 2));
+    let said = stdout(&out);
+    let (sweep, sweep_merge) = (job_id(&said, "array", 1), job_id(&said, "and", 2));
     wait_for(&[&sweep, &sweep_merge], &d.join("sweep/logs"));
     let rows = |dir: &str| -> Vec<(String, u64, f64)> {
         let path = d.join(dir).join("results.json");
@@ -225,6 +226,58 @@ fn a_tiled_render_and_a_sweep_through_sbatch_are_the_single_runs_also_after_a_re
         assert_eq!((&a.0, a.1), (&b.0, b.1));
         assert!((a.2 - b.2).abs() <= 1e-12 * a.2, "{a:?} against {b:?}");
     }
+
+    // A class: its references, then a task per part, then the merge.
+    let class = small_class(d);
+    let class = class.to_str().unwrap();
+    let scenes = ["--scenes", "scenes"];
+    let single = glint(
+        &[
+            &[
+                "grade",
+                "--class",
+                class,
+                "--report",
+                "class-single",
+                "--cache",
+                "cache",
+            ],
+            &scenes[..],
+        ]
+        .concat(),
+        d,
+    );
+    assert_eq!(single.status.code(), Some(1), "{}", stderr(&single));
+    let out = glint(
+        &[
+            &[
+                "farm",
+                "slurm",
+                "grade",
+                "--class",
+                class,
+                "--parts",
+                "3",
+                "--dir",
+                "class-farm",
+            ][..],
+            &["-o", "class-report", "--submit", "--"],
+            &scenes[..],
+        ]
+        .concat(),
+        d,
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let said = stdout(&out);
+    let [references, grading, merge] =
+        [("job", 1), ("array", 1), ("and", 2)].map(|(word, skip)| job_id(&said, word, skip));
+    wait_for(&[&references, &grading, &merge], &d.join("class-farm/logs"));
+    assert!(
+        d.join("class-report/grades.json").is_file(),
+        "no report; logs:\n{}",
+        logs_text(&d.join("class-farm/logs"))
+    );
+    assert_same_folders(&d.join("class-single"), &d.join("class-report"));
 
     // One task stopped mid-render: requeued, it resumes its tile.
     let (array, merge) = submit(d, "long", 2, LONG_SPP);

@@ -88,3 +88,89 @@ pub fn python_with_mitsuba() -> Option<PathBuf> {
         .is_ok_and(|o| o.status.success());
     imports.then_some(python)
 }
+
+/// A small class in `dir`: `scenes/` with Set 1 and Set 2, and
+/// `class.csv` listing three students' 32 × 32 renders of both (4 random
+/// camera and light samples), one of them of the wrong scene, and a fourth
+/// student's file that is not there. Returns the manifest.
+pub fn small_class(dir: &Path) -> PathBuf {
+    let scenes = dir.join("scenes");
+    std::fs::create_dir_all(&scenes).unwrap();
+    for set in ["set1", "set2"] {
+        std::fs::copy(
+            scene(&format!("cornell-{set}")),
+            scenes.join(format!("{set}.toml")),
+        )
+        .unwrap();
+    }
+    let mut manifest = String::from("student,scene,file\n");
+    for (k, student) in ["ada", "bo", "cy"].into_iter().enumerate() {
+        std::fs::create_dir_all(dir.join("class").join(student)).unwrap();
+        for set in ["set1", "set2"] {
+            // Bo renders Set 1 for both.
+            let rendered = if student == "bo" { "set1" } else { set };
+            let file = format!("class/{student}/{set}.png");
+            let seed = (7 + k).to_string();
+            let scene_file = scenes.join(format!("{rendered}.toml"));
+            let o = glint(
+                &[
+                    "render",
+                    scene_file.to_str().unwrap(),
+                    "--resolution",
+                    "32x32",
+                    "--spp",
+                    "4",
+                    "--sampler",
+                    "random",
+                    "--light-samples",
+                    "4",
+                    "--light-sampler",
+                    "random",
+                    "--seed",
+                    &seed,
+                    "-o",
+                    &file,
+                ],
+                dir,
+            );
+            assert!(o.status.success(), "{}", stderr(&o));
+            manifest += &format!("{student},{set},{file}\n");
+        }
+    }
+    manifest += "dee,set1,class/dee/set1.png\n";
+    let path = dir.join("class.csv");
+    std::fs::write(&path, manifest).unwrap();
+    path
+}
+
+/// Asserts that folders `a` and `b` hold the same files, byte for byte.
+pub fn assert_same_folders(a: &Path, b: &Path) {
+    fn files(root: &Path, dir: &Path, out: &mut Vec<PathBuf>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            match path.is_dir() {
+                true => files(root, &path, out),
+                false => out.push(path.strip_prefix(root).unwrap().to_owned()),
+            }
+        }
+    }
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    files(a, a, &mut left);
+    files(b, b, &mut right);
+    left.sort();
+    right.sort();
+    assert_eq!(
+        left,
+        right,
+        "{} and {} hold other files",
+        a.display(),
+        b.display()
+    );
+    for file in &left {
+        assert!(
+            std::fs::read(a.join(file)).unwrap() == std::fs::read(b.join(file)).unwrap(),
+            "{} differs",
+            file.display()
+        );
+    }
+}

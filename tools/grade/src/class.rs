@@ -280,6 +280,14 @@ impl ClassGrades {
     pub fn all_passed(&self) -> bool {
         self.rows.iter().all(Row::passed)
     }
+
+    /// The rows as the report shows them.
+    pub fn report_rows(&self) -> Vec<crate::report::ReportRow> {
+        self.rows
+            .iter()
+            .map(crate::report::ReportRow::new)
+            .collect()
+    }
 }
 
 /// Submissions judged against the same references: one scene, resolution
@@ -288,6 +296,21 @@ pub struct Group {
     pub scene: Arc<GradeScene>,
     pub stated: StatedSettings,
     pub references: References,
+}
+
+impl Group {
+    /// What the reference set is, in words: its scene, resolution and
+    /// settings.
+    pub fn key(&self) -> String {
+        let size = self.references.resolution;
+        format!(
+            "{} at {}x{}, {:?}",
+            self.scene.path.display(),
+            size.x,
+            size.y,
+            self.stated
+        )
+    }
 }
 
 /// What a class run reports as it goes.
@@ -313,20 +336,12 @@ pub fn grade_class(
     progress: &dyn Progress,
     on_graded: &OnGraded,
 ) -> Result<ClassGrades, GradeError> {
-    let entries = &with_presets(entries, scenes, base)?[..];
-    let loaded = load_scenes(entries);
-    // What each submission needs: its scene and resolution, read from the
-    // file (and dropped: grading reads it again).
-    let probes: Vec<Probe> = entries
-        .par_iter()
-        .map(|(entry, found)| {
-            let path = found.clone()?;
-            loaded[&path].as_ref().map_err(Clone::clone)?;
-            let submission = Submission::load(&entry.file)?;
-            Ok((path, submission.resolution()))
-        })
-        .collect();
-    let (groups, row_groups) = reference_groups(entries, &probes, &loaded, options, progress)?;
+    let Prepared {
+        entries,
+        probes,
+        groups,
+        row_groups,
+    } = prepare(entries, scenes, base, options, progress)?;
     let done = AtomicUsize::new(0);
     let rows: Vec<Row> = entries
         .par_iter()
@@ -340,6 +355,60 @@ pub fn grade_class(
         })
         .collect::<Result<_, GradeError>>()?;
     Ok(ClassGrades { rows, groups })
+}
+
+/// Renders the references `entries` need into the cache (or finds them
+/// there), and grades nothing: the first step of a class graded in parts,
+/// whose parts then read them from the cache. Returns how many reference
+/// sets there are.
+pub fn render_references(
+    entries: &[Entry],
+    scenes: &Scenes,
+    base: &Path,
+    options: &ClassOptions,
+    progress: &dyn Progress,
+) -> Result<usize, GradeError> {
+    Ok(prepare(entries, scenes, base, options, progress)?
+        .groups
+        .len())
+}
+
+/// The entries with their settings completed, what each submission needs,
+/// and the references, before any is graded.
+struct Prepared {
+    entries: Vec<Located>,
+    probes: Vec<Probe>,
+    groups: Vec<Group>,
+    row_groups: Vec<Option<usize>>,
+}
+
+fn prepare(
+    entries: &[Entry],
+    scenes: &Scenes,
+    base: &Path,
+    options: &ClassOptions,
+    progress: &dyn Progress,
+) -> Result<Prepared, GradeError> {
+    let entries = with_presets(entries, scenes, base)?;
+    let loaded = load_scenes(&entries);
+    // What each submission needs: its scene and resolution, read from the
+    // file (and dropped: grading reads it again).
+    let probes: Vec<Probe> = entries
+        .par_iter()
+        .map(|(entry, found)| {
+            let path = found.clone()?;
+            loaded[&path].as_ref().map_err(Clone::clone)?;
+            let submission = Submission::load(&entry.file)?;
+            Ok((path, submission.resolution()))
+        })
+        .collect();
+    let (groups, row_groups) = reference_groups(&entries, &probes, &loaded, options, progress)?;
+    Ok(Prepared {
+        entries,
+        probes,
+        groups,
+        row_groups,
+    })
 }
 
 /// A submission's scene file and resolution, or why it cannot be graded.

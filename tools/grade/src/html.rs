@@ -3,8 +3,8 @@
 //! thumbnails; columns sortable by a click; no external scripts, styles or
 //! fonts, so it works offline), `grades.csv`, `grades.json`, and `images/`.
 
-use crate::class::{ClassGrades, Group, Outcome, Row};
-use crate::report::{self, verdict};
+use crate::class::{Group, Outcome, Row};
+use crate::report::{self, ReportRow};
 use crate::submission::Submission;
 use crate::GradeError;
 use glam::{UVec2, Vec3};
@@ -89,28 +89,46 @@ pub fn write_images(
     let images = images_dir(dir);
     std::fs::create_dir_all(&images).map_err(|e| internal(&images)(e.to_string()))?;
     let size = submission.resolution();
+    let [submission_png, _, heatmap_png, _] = submission_images(index);
     save_with_thumbnail(
-        &images.join(format!("{index}-submission.png")),
+        &images.join(submission_png),
         size,
         srgb8(submission.film.pixels()),
     )?;
     let heat = crate::heatmap::heatmap(grade, &submission.film, &group.references.objects);
-    save_with_thumbnail(&images.join(format!("{index}-heatmap.png")), size, heat)?;
-    let reference = images.join(format!("reference-{}.png", row.group.unwrap_or(0)));
+    save_with_thumbnail(&images.join(heatmap_png), size, heat)?;
+    let [reference_png, _] = reference_images(row.group.unwrap_or(0));
+    let reference = images.join(reference_png);
     if !reference.exists() {
         save_with_thumbnail(&reference, size, srgb8(&group.references.mean.mean))?;
     }
     Ok(())
 }
 
+/// The images of submission `index` in a report's `images/`: the
+/// submission and its heat map, each with its thumbnail.
+pub fn submission_images(index: usize) -> [String; 4] {
+    ["submission", "submission-small", "heatmap", "heatmap-small"]
+        .map(|k| format!("{index}-{k}.png"))
+}
+
+/// The images of reference set `group` in a report's `images/`: the
+/// reference and its thumbnail.
+pub fn reference_images(group: usize) -> [String; 2] {
+    [
+        format!("reference-{group}.png"),
+        format!("reference-{group}-small.png"),
+    ]
+}
+
 /// Writes `index.html`, `grades.csv` and `grades.json` into `dir`.
-pub fn write_report(dir: &Path, grades: &ClassGrades) -> Result<(), GradeError> {
+pub fn write_report(dir: &Path, rows: &[ReportRow]) -> Result<(), GradeError> {
     std::fs::create_dir_all(dir).map_err(|e| internal(dir)(e.to_string()))?;
-    let json = serde_json::to_string_pretty(&report::json(grades)).expect("JSON") + "\n";
+    let json = serde_json::to_string_pretty(&report::json(rows)).expect("JSON") + "\n";
     for (name, text) in [
-        ("grades.csv", report::csv(grades)),
+        ("grades.csv", report::csv(rows)),
         ("grades.json", json),
-        ("index.html", page(grades)),
+        ("index.html", page(rows)),
     ] {
         crate::output::write_text(&dir.join(name), &text)?;
     }
@@ -126,18 +144,18 @@ fn escape(text: &str) -> String {
 }
 
 /// The page: students as rows, scenes as columns.
-fn page(grades: &ClassGrades) -> String {
+fn page(rows: &[ReportRow]) -> String {
     let scenes: Vec<&str> = {
         let mut seen = Vec::new();
-        for row in &grades.rows {
+        for row in rows {
             if !seen.contains(&row.scene.as_str()) {
                 seen.push(row.scene.as_str());
             }
         }
         seen
     };
-    let mut students: BTreeMap<&str, Vec<(usize, &Row)>> = BTreeMap::new();
-    for (i, row) in grades.rows.iter().enumerate() {
+    let mut students: BTreeMap<&str, Vec<(usize, &ReportRow)>> = BTreeMap::new();
+    for (i, row) in rows.iter().enumerate() {
         students.entry(&row.student).or_default().push((i, row));
     }
     let mut body = String::new();
@@ -162,12 +180,12 @@ fn page(grades: &ClassGrades) -> String {
         .enumerate()
         .map(|(k, s)| format!("<th data-column=\"{}\">{}</th>", k + 2, escape(s)))
         .collect();
-    let count = |v: &str| grades.rows.iter().filter(|r| verdict(r) == v).count();
+    let count = |v: &str| rows.iter().filter(|r| r.verdict == v).count();
     format!(
         include_str!("report.html"),
         summary = format!(
             "{} submissions from {} students: {} pass, {} fail, {} not graded",
-            grades.rows.len(),
+            rows.len(),
             students.len(),
             count("pass"),
             count("fail"),
@@ -178,30 +196,23 @@ fn page(grades: &ClassGrades) -> String {
     )
 }
 
-/// One submission's cell: verdict, thumbnails, and what failed. Its sort key
-/// orders failures by their evidence, then errors, then passes.
-fn cell(index: usize, row: &Row) -> String {
-    let v = verdict(row);
-    let key = match &row.outcome {
-        Outcome::Graded(g) if g.passed => 1e9 - g.largest_accepted_z,
-        Outcome::Graded(g) => g
-            .rejected
-            .first()
-            .map_or(0.0, |f| -f.strongest().z.abs().min(1e8)),
-        Outcome::Unreadable { .. } => 5e8,
-    };
-    let images = match (&row.outcome, row.group) {
-        (Outcome::Graded(_), Some(g)) => format!(
+/// One submission's cell: verdict, thumbnails, and what failed, sorted by
+/// [`ReportRow::sort_key`].
+fn cell(index: usize, row: &ReportRow) -> String {
+    let v = &row.verdict;
+    let images = match row.reference {
+        Some(g) => format!(
             "<div class=\"thumbs\">{}{}{}</div>",
             thumb(&format!("images/{index}-submission"), "submission"),
             thumb(&format!("images/reference-{g}"), "reference"),
             thumb(&format!("images/{index}-heatmap"), "heat map"),
         ),
-        _ => String::new(),
+        None => String::new(),
     };
     format!(
-        "<td data-sort=\"{key}\" class=\"{v}\"><span class=\"verdict\">{v}</span>{images}<div class=\"note\">{}</div><div class=\"file\">{}</div></td>",
-        escape(&report::summary(row)),
+        "<td data-sort=\"{}\" class=\"{v}\"><span class=\"verdict\">{v}</span>{images}<div class=\"note\">{}</div><div class=\"file\">{}</div></td>",
+        row.sort_key,
+        escape(&row.summary),
         escape(&row.file),
     )
 }

@@ -31,6 +31,7 @@ pub mod heatmap;
 pub mod html;
 pub mod hypothesis;
 pub mod output;
+pub mod parts;
 pub mod reference;
 pub mod report;
 pub mod stages;

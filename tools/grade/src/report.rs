@@ -1,8 +1,12 @@
 //! A class's results as a table for the terminal, CSV and JSON; the HTML
-//! report is [`html`](crate::html).
+//! report is [`html`](crate::html). Each submission's row is first put in
+//! the words and numbers every format shows ([`ReportRow`]); the formats are
+//! made from those alone, so a class graded in parts ([`crate::parts`]) gives
+//! the report a single run gives.
 
-use crate::class::{ClassGrades, Outcome, Row};
+use crate::class::{Outcome, Row};
 use crate::{ChannelFinding, ImageGrade, RegionFinding};
+use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 /// The schema name of the JSON document.
@@ -97,19 +101,82 @@ fn significant(v: f64) -> String {
     format!("{v:.decimals$}")
 }
 
+/// One submission as a class's report shows it, in every format.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReportRow {
+    pub student: String,
+    pub scene: String,
+    pub file: String,
+    /// "pass", "fail" or "error" ([`verdict`]).
+    pub verdict: String,
+    /// What the table and CSV say beyond the verdict ([`summary`]).
+    pub summary: String,
+    /// The CSV's cells from `rejected` to `worst_channel`.
+    pub numbers: [String; 5],
+    /// The submission in `grades.json`.
+    pub json: Value,
+    /// The HTML cell's sort key: failures by their evidence, then errors,
+    /// then passes.
+    pub sort_key: String,
+    /// The reference set it was judged against, where it was graded: the
+    /// report's `images/reference-G.png`.
+    pub reference: Option<usize>,
+}
+
+impl ReportRow {
+    pub fn new(row: &Row) -> ReportRow {
+        let mut json = serde_json::to_value(row).expect("plain data");
+        json["verdict"] = json!(verdict(row));
+        ReportRow {
+            student: row.student.clone(),
+            scene: row.scene.clone(),
+            file: row.file.clone(),
+            verdict: verdict(row).to_owned(),
+            summary: summary(row),
+            numbers: csv_numbers(row),
+            json,
+            sort_key: sort_key(row).to_string(),
+            reference: match row.outcome {
+                Outcome::Graded(_) => row.group,
+                Outcome::Unreadable { .. } => None,
+            },
+        }
+    }
+
+    pub fn passed(&self) -> bool {
+        self.verdict == "pass"
+    }
+}
+
+/// Orders failures by their evidence, then errors, then passes.
+fn sort_key(row: &Row) -> f64 {
+    match &row.outcome {
+        Outcome::Graded(g) if g.passed => 1e9 - g.largest_accepted_z,
+        Outcome::Graded(g) => g
+            .rejected
+            .first()
+            .map_or(0.0, |f| -f.strongest().z.abs().min(1e8)),
+        Outcome::Unreadable { .. } => 5e8,
+    }
+}
+
+/// How many rows have the verdict `v`.
+fn count(rows: &[ReportRow], v: &str) -> usize {
+    rows.iter().filter(|r| r.verdict == v).count()
+}
+
 /// The class as aligned columns: student, scene, verdict, summary; then the
 /// counts.
-pub fn table(grades: &ClassGrades) -> String {
+pub fn table(report: &[ReportRow]) -> String {
     let header = ["student", "scene", "verdict", "where, how much"];
-    let rows: Vec<[String; 4]> = grades
-        .rows
+    let rows: Vec<[String; 4]> = report
         .iter()
         .map(|r| {
             [
                 r.student.clone(),
                 r.scene.clone(),
-                verdict(r).to_owned(),
-                summary(r),
+                r.verdict.clone(),
+                r.summary.clone(),
             ]
         })
         .collect();
@@ -135,13 +202,12 @@ pub fn table(grades: &ClassGrades) -> String {
     for r in &rows {
         out += &line([&r[0], &r[1], &r[2], &r[3]]);
     }
-    let count = |v: &str| grades.rows.iter().filter(|r| verdict(r) == v).count();
     out += &format!(
         "\n{} submissions: {} pass, {} fail, {} not graded\n",
-        grades.rows.len(),
-        count("pass"),
-        count("fail"),
-        count("error")
+        report.len(),
+        count(report, "pass"),
+        count(report, "fail"),
+        count(report, "error")
     );
     out
 }
@@ -204,37 +270,43 @@ pub const CSV_COLUMNS: [&str; 10] = [
     "summary",
 ];
 
+/// The CSV's cells from `rejected` to `worst_channel`: empty where the
+/// submission was not graded.
+fn csv_numbers(row: &Row) -> [String; 5] {
+    match &row.outcome {
+        Outcome::Graded(g) => {
+            let worst = g.rejected.first();
+            let largest = worst.map_or(g.largest_accepted_z, |f| f.strongest().z);
+            [
+                g.rejected.len().to_string(),
+                g.tests.to_string(),
+                format!("{largest:.2}"),
+                worst.map_or(String::new(), |f| f.region.clone()),
+                worst.map_or("", |f| f.strongest().channel).to_owned(),
+            ]
+        }
+        Outcome::Unreadable { .. } => Default::default(),
+    }
+}
+
 /// The class as CSV, one row per submission.
-pub fn csv(grades: &ClassGrades) -> String {
+pub fn csv(report: &[ReportRow]) -> String {
     let mut writer = csv::Writer::from_writer(Vec::new());
     writer.write_record(CSV_COLUMNS).expect("in memory");
-    for row in &grades.rows {
-        let (rejected, tests, largest, region, channel) = match &row.outcome {
-            Outcome::Graded(g) => {
-                let worst = g.rejected.first();
-                let largest = worst.map_or(g.largest_accepted_z, |f| f.strongest().z);
-                (
-                    g.rejected.len().to_string(),
-                    g.tests.to_string(),
-                    format!("{largest:.2}"),
-                    worst.map_or(String::new(), |f| f.region.clone()),
-                    worst.map_or("", |f| f.strongest().channel).to_owned(),
-                )
-            }
-            Outcome::Unreadable { .. } => Default::default(),
-        };
+    for row in report {
+        let [rejected, tests, largest, region, channel] = &row.numbers;
         writer
             .write_record([
                 row.student.as_str(),
                 &row.scene,
                 &row.file,
-                verdict(row),
-                &rejected,
-                &tests,
-                &largest,
-                &region,
-                &channel,
-                &summary(row),
+                &row.verdict,
+                rejected,
+                tests,
+                largest,
+                region,
+                channel,
+                &row.summary,
             ])
             .expect("in memory");
     }
@@ -242,22 +314,13 @@ pub fn csv(grades: &ClassGrades) -> String {
 }
 
 /// The class as a JSON document (schema [`SCHEMA`]).
-pub fn json(grades: &ClassGrades) -> Value {
-    let rows: Vec<Value> = grades
-        .rows
-        .iter()
-        .map(|r| {
-            let mut value = serde_json::to_value(r).expect("plain data");
-            value["verdict"] = json!(verdict(r));
-            value
-        })
-        .collect();
-    let count = |v: &str| grades.rows.iter().filter(|r| verdict(r) == v).count();
+pub fn json(report: &[ReportRow]) -> Value {
+    let rows: Vec<&Value> = report.iter().map(|r| &r.json).collect();
     json!({
         "schema": SCHEMA,
         "submissions": rows,
-        "pass": count("pass"),
-        "fail": count("fail"),
-        "error": count("error"),
+        "pass": count(report, "pass"),
+        "fail": count(report, "fail"),
+        "error": count(report, "error"),
     })
 }

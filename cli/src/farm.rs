@@ -174,11 +174,12 @@ pub(crate) struct Farm {
     pub(crate) merge_text: String,
 }
 
-/// A step run once before the tasks, on one machine with all the CPUs it
-/// is given: `KIND.sbatch` running `SCRIPT`.
+/// Tasks that the tasks wait for: `KIND.sbatch`, an array of `tasks`
+/// tasks, each `SCRIPT I`.
 pub(crate) struct FirstStep {
     pub(crate) kind: &'static str,
     pub(crate) script: &'static str,
+    pub(crate) tasks: u32,
     pub(crate) text: String,
 }
 
@@ -398,38 +399,39 @@ impl Farm {
         write_script(&self.dir.join(self.merge_script), &self.merge_text)
     }
 
-    /// `KIND.sbatch` of the first step: one job.
-    fn slurm_first(&self, step: &FirstStep, options: &SlurmOptions) -> String {
-        let mut lines = vec![
-            "#!/bin/bash".to_owned(),
-            format!("#SBATCH --job-name=glint-{}-{}", step.kind, self.name()),
-            format!(
-                "#SBATCH --output={}/logs/{}_%j.log",
-                self.dir.display(),
-                step.kind
-            ),
-            "#SBATCH --open-mode=append".to_owned(),
-            format!("#SBATCH --cpus-per-task={}", options.cpus),
-            "#SBATCH --requeue".to_owned(),
-        ];
-        lines.extend(self.slurm_limits(options));
-        lines.push(format!("exec {}", quote(&self.dir.join(step.script))));
-        lines.join("\n") + "\n"
-    }
-
     /// `KIND.sbatch`: the job array, task I running `TASK_SCRIPT I`.
     fn slurm_array(&self, options: &SlurmOptions) -> String {
+        self.slurm_tasks(
+            (self.kind, self.task_script, self.tasks),
+            &self.what,
+            options,
+        )
+    }
+
+    /// The first step's `KIND.sbatch`, an array as the tasks'.
+    fn slurm_first(&self, step: &FirstStep, options: &SlurmOptions) -> String {
+        let what = format!("{} {}, before the {}", step.tasks, step.kind, self.what);
+        self.slurm_tasks((step.kind, step.script, step.tasks), &what, options)
+    }
+
+    /// A job array named `kind` of `tasks` tasks, task I running `script I`
+    /// (of `what`).
+    fn slurm_tasks(
+        &self,
+        (kind, script, tasks): (&str, &str, u32),
+        what: &str,
+        options: &SlurmOptions,
+    ) -> String {
         let throttle = options
             .max_running
             .map_or(String::new(), |m| format!("%{m}"));
         let mut lines = vec![
             "#!/bin/bash".to_owned(),
-            format!("#SBATCH --job-name=glint-{}-{}", self.kind, self.name()),
-            format!("#SBATCH --array=0-{}{throttle}", self.tasks - 1),
+            format!("#SBATCH --job-name=glint-{kind}-{}", self.name()),
+            format!("#SBATCH --array=0-{}{throttle}", tasks - 1),
             format!(
-                "#SBATCH --output={}/logs/{}_%A_%a.log",
+                "#SBATCH --output={}/logs/{kind}_%A_%a.log",
                 self.dir.display(),
-                self.kind
             ),
             // A requeued task adds to its log instead of replacing it.
             "#SBATCH --open-mode=append".to_owned(),
@@ -440,12 +442,11 @@ impl Farm {
         ];
         lines.extend(self.slurm_limits(options));
         lines.push(format!(
-            "# Task $SLURM_ARRAY_TASK_ID of {} (written by glint farm).",
-            self.what
+            "# Task $SLURM_ARRAY_TASK_ID of {what} (written by glint farm)."
         ));
         lines.push(format!(
             "exec {} \"$SLURM_ARRAY_TASK_ID\"",
-            quote(&self.dir.join(self.task_script))
+            quote(&self.dir.join(script))
         ));
         lines.join("\n") + "\n"
     }
@@ -489,24 +490,37 @@ impl Farm {
     /// Run again, it runs only the tasks whose job failed (the job log and
     /// `--resume-failed`), a tile continuing its partial render.
     fn parallel(&self, options: &ParallelOptions) -> String {
-        let mut engine = vec![
-            "parallel".to_owned(),
-            format!("--joblog {}", quote(&self.dir.join("parallel.joblog"))),
-            "--resume-failed".to_owned(),
-            "--halt never".to_owned(),
-        ];
+        let mut flags = vec!["--resume-failed".to_owned(), "--halt never".to_owned()];
         if let Some(jobs) = &options.jobs {
-            engine.push(format!("--jobs {jobs}"));
+            flags.push(format!("--jobs {jobs}"));
         }
         if let Some(logins) = &options.sshloginfile {
             let logins = std::path::absolute(logins).unwrap_or_else(|_| logins.clone());
-            engine.push(format!("--sshloginfile {}", quote(&logins)));
+            flags.push(format!("--sshloginfile {}", quote(&logins)));
         }
+        // Each step's jobs, then a stop if any failed.
+        let step = |joblog: &str, script: &str, tasks: u32| {
+            let joblog = self.dir.join(joblog);
+            format!(
+                r#"parallel --joblog {log} {flags} {script} {{}} ::: $(seq 0 {last})
+status=$?
+if [ $status -ne 0 ]; then
+  echo "glint farm: $status job(s) failed (see {log_text}); run this script again to run them" >&2
+  exit $status
+fi
+"#,
+                log = quote(&joblog),
+                flags = flags.join(" "),
+                script = quote(&self.dir.join(script)),
+                last = tasks - 1,
+                log_text = joblog.display(),
+            )
+        };
         let first = match &self.first {
-            Some(step) => format!(
-                "# First, on this machine: {kind}.\n{script} || exit $?\n",
-                kind = step.kind,
-                script = quote(&self.dir.join(step.script))
+            Some(first) => format!(
+                "# First: {kind}.\n{jobs}# Then the tasks.\n",
+                kind = first.kind,
+                jobs = step(&format!("{}.joblog", first.kind), first.script, first.tasks)
             ),
             None => String::new(),
         };
@@ -515,19 +529,10 @@ impl Farm {
 # Runs the {what} with GNU parallel, then the merge (written by glint farm).
 # Run again after a failure: only the failed tasks run again.
 set -uo pipefail
-{first}{engine} {task} {{}} ::: $(seq 0 {last})
-status=$?
-if [ $status -ne 0 ]; then
-  echo "glint farm: $status job(s) failed (see {joblog}); run this script again to run them" >&2
-  exit $status
-fi
-exec {merge}
+{first}{tasks}exec {merge}
 "#,
             what = self.what,
-            engine = engine.join(" "),
-            task = quote(&self.dir.join(self.task_script)),
-            last = self.tasks - 1,
-            joblog = self.dir.join("parallel.joblog").display(),
+            tasks = step("parallel.joblog", self.task_script, self.tasks),
             merge = quote(&self.dir.join(self.merge_script)),
         )
     }

@@ -36,6 +36,12 @@ pub(crate) struct FarmGrade {
     #[arg(long, value_name = "DIR")]
     cache: Option<PathBuf>,
 
+    /// Tasks rendering the references before the parts: task I renders
+    /// reference sets I, I+R, ... (one per scene, resolution and settings,
+    /// in order of first use) [default: the class's scene count]
+    #[arg(long, value_name = "R", value_parser = clap::value_parser!(u32).range(1..))]
+    reference_tasks: Option<u32>,
+
     /// Options for every glint grade (after --, e.g. -- --scenes scenes
     /// --spp 16): how the class is graded
     #[arg(last = true, value_name = "GRADE-OPTIONS")]
@@ -67,6 +73,7 @@ pub(crate) struct ClassPlan {
     here: PathBuf,
     class: PathBuf,
     parts: u32,
+    reference_tasks: u32,
     output: PathBuf,
     dir: PathBuf,
     cache: PathBuf,
@@ -98,7 +105,7 @@ impl ClassPlan {
         }
         crate::grade::check_report_dir(&output)?;
         let grade = parse_grade(&args.class, &dir, &args.grade_options)?;
-        let submissions = crate::grade::class_size(&grade)?;
+        let (submissions, scenes) = crate::grade::class_size(&grade)?;
         if args.parts as usize > submissions {
             return Err(Failure::Input(format!(
                 "--parts {}: the class has {submissions} submissions, one per part at most; use at most {submissions} parts",
@@ -113,6 +120,7 @@ impl ClassPlan {
             here: absolute(Path::new(".")),
             class: absolute(&args.class),
             parts: args.parts,
+            reference_tasks: args.reference_tasks.unwrap_or(scenes as u32),
             output: absolute(&output),
             dir: absolute(&dir),
             cache: absolute(&cache),
@@ -133,6 +141,7 @@ impl ClassPlan {
             first: Some(FirstStep {
                 kind: "references",
                 script: "references.sh",
+                tasks: self.reference_tasks,
                 text: self.references_script(),
             }),
             kind: "grade",
@@ -176,19 +185,21 @@ impl ClassPlan {
         )
     }
 
-    /// `references.sh`: every reference set the class needs, into the cache,
-    /// on all the CPUs the step has.
+    /// `references.sh I`: reference sets I, I+R, … of the class, into the
+    /// cache.
     fn references_script(&self) -> String {
         format!(
-            r#"{preamble}threads=()
-if [ -n "${{SLURM_CPUS_PER_TASK:-}}" ]; then threads=(--threads "$SLURM_CPUS_PER_TASK"); fi
-exec {command} "${{threads[@]}}"
+            r#"{preamble}task="$1"
+threads="${{SLURM_CPUS_PER_TASK:-1}}"
+exec {command} --part "$task/{tasks}" --threads "$threads"
 "#,
             preamble = self.preamble(&format!(
-                "Renders the references of the class {} into its cache",
-                self.class.display()
+                "Renders reference sets I, I+{tasks}, ... of the class {} into its cache. Usage: references.sh I",
+                self.class.display(),
+                tasks = self.reference_tasks
             )),
             command = self.grade_command(" --references-only"),
+            tasks = self.reference_tasks,
         )
     }
 

@@ -108,13 +108,14 @@ pub(crate) struct GradeArgs {
 
     /// Grade part I of N of the class (submissions I, I+N, I+2N, ... in
     /// class order) into the part folder --report DIR, to be merged with
-    /// --merge; exits 0 once graded, whatever the verdicts (docs/cluster.md)
-    #[arg(long, value_name = "I/N", requires_all = ["class", "report"], value_parser = glint_grade::parts::Part::parse)]
+    /// --merge; exits 0 once graded, whatever the verdicts. With
+    /// --references-only: reference sets I, I+N, ... (docs/cluster.md)
+    #[arg(long, value_name = "I/N", requires = "class", value_parser = glint_grade::parts::Part::parse)]
     part: Option<Part>,
 
     /// Render the references the class needs into the cache (--cache), and
     /// grade nothing: the first step of a class graded in parts
-    #[arg(long, requires = "class", conflicts_with_all = ["report", "heatmap", "part", "no_cache"])]
+    #[arg(long, requires = "class", conflicts_with_all = ["report", "heatmap", "no_cache"])]
     references_only: bool,
 
     /// Merge the part folders of a class graded in parts (--part I/N) into
@@ -220,6 +221,11 @@ fn grade_or_merge(args: &GradeArgs) -> Result<(), Failure> {
     if !args.merge.is_empty() {
         return merge(args);
     }
+    if args.part.is_some() && args.report.is_none() && !args.references_only {
+        return Err(Failure::Input(
+            "--part grades into a part folder: give it with --report DIR".into(),
+        ));
+    }
     let stated = stated(args)?;
     let (entries, scenes, base) = entries(args, &stated)?;
     check_outputs(args, &entries)?;
@@ -232,7 +238,7 @@ fn grade_or_merge(args: &GradeArgs) -> Result<(), Failure> {
     };
     let bar = GradeProgress::new();
     if args.references_only {
-        return references_only(&entries, (&scenes, &base), &options, &bar);
+        return references_only(&entries, (&scenes, &base), &options, (&bar, args.part));
     }
     let class_entries = entries.len();
     let fingerprint = parts::class_fingerprint(&entries, &class_options(args));
@@ -278,11 +284,15 @@ fn grade_or_merge(args: &GradeArgs) -> Result<(), Failure> {
     verdict(&rows)
 }
 
-/// How many submissions the class of `args` (`--class`) has: its
-/// folder or manifest read and checked, as a run would before any work.
-pub(crate) fn class_size(args: &GradeArgs) -> Result<usize, Failure> {
+/// How many submissions the class of `args` (`--class`) has, and of how
+/// many scenes: its folder or manifest read and checked, as a run would
+/// before any work.
+pub(crate) fn class_size(args: &GradeArgs) -> Result<(usize, usize), Failure> {
     let stated = stated(args)?;
-    Ok(entries(args, &stated)?.0.len())
+    let entries = entries(args, &stated)?.0;
+    let scenes: std::collections::BTreeSet<&str> =
+        entries.iter().map(|e| e.scene.as_str()).collect();
+    Ok((entries.len(), scenes.len()))
 }
 
 /// Exit status 0 when every submission passed, else 1.
@@ -293,22 +303,28 @@ fn verdict(rows: &[ReportRow]) -> Result<(), Failure> {
     }
 }
 
-/// `--references-only`: the references rendered into the cache.
+/// `--references-only`: the references (of the reference sets of `part`)
+/// rendered into the cache.
 fn references_only(
     entries: &[Entry],
     (scenes, base): (&Scenes, &Path),
     options: &class::ClassOptions,
-    bar: &GradeProgress,
+    (bar, part): (&GradeProgress, Option<Part>),
 ) -> Result<(), Failure> {
     let Some(dir) = &options.cache.dir else {
         return Err(Failure::Input(
             "--references-only renders into the reference cache, and there is none here; give --cache DIR".into(),
         ));
     };
-    let sets = class::render_references(entries, scenes, base, options, bar).map_err(failure)?;
+    let (mine, sets) =
+        class::render_references(entries, scenes, base, options, bar, part).map_err(failure)?;
     bar.finish();
+    let which = match part {
+        Some(part) => format!("{mine} of the {sets} reference sets (part {part})"),
+        None => format!("{sets} reference sets"),
+    };
     crate::output::say(&format!(
-        "{sets} reference sets for {} submissions are in {}\n",
+        "{which} for {} submissions are in {}\n",
         entries.len(),
         dir.display()
     ));

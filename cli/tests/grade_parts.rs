@@ -37,14 +37,20 @@ fn a_class_graded_in_parts_and_merged_is_the_single_run_byte_for_byte() {
         "{json}"
     );
 
-    let o = grade(&["--cache", "shared", "--references-only"], d);
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    assert!(
-        stdout(&o).contains("2 reference sets for 7 submissions"),
-        "{}",
-        stdout(&o)
-    );
-    assert!(!d.join("part-0").exists() && !d.join("single2").exists());
+    // The references in two tasks, one set each, then the parts read them.
+    let cached = || std::fs::read_dir(d.join("shared")).map_or(0, |files| files.count());
+    let mut counts = vec![cached()];
+    for task in ["0/2", "1/2"] {
+        let o = grade(
+            &["--cache", "shared", "--references-only", "--part", task],
+            d,
+        );
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let said = format!("1 of the 2 reference sets (part {task}) for 7 submissions");
+        assert!(stdout(&o).contains(&said), "{}", stdout(&o));
+        counts.push(cached());
+    }
+    assert!(counts[0] < counts[1] && counts[1] < counts[2], "{counts:?}");
     for part in 0..3 {
         let (tile, folder) = (format!("{part}/3"), format!("part-{part}"));
         let o = grade(
@@ -190,8 +196,15 @@ fn glint_farm_grade_scripts_give_the_single_report_by_hand_and_through_gnu_paral
         sbatch.contains("#SBATCH --array=0-2") && sbatch.contains("grade-part.sh"),
         "{sbatch}"
     );
-    assert!(by_hand.join("references.sbatch").is_file() && by_hand.join("merge.sbatch").is_file());
-    run(&by_hand.join("references.sh"), &[]);
+    let references = std::fs::read_to_string(by_hand.join("references.sbatch")).unwrap();
+    assert!(
+        references.contains("#SBATCH --array=0-1"),
+        "a task per scene: {references}"
+    );
+    assert!(by_hand.join("merge.sbatch").is_file());
+    for task in ["0", "1"] {
+        run(&by_hand.join("references.sh"), &[task]);
+    }
     for part in ["0", "1", "2"] {
         run(&by_hand.join("grade-part.sh"), &[part]);
     }

@@ -359,18 +359,29 @@ pub fn grade_class(
 
 /// Renders the references `entries` need into the cache (or finds them
 /// there), and grades nothing: the first step of a class graded in parts,
-/// whose parts then read them from the cache. Returns how many reference
-/// sets there are.
+/// whose parts then read them from the cache. With `part`, only the part's
+/// reference sets (I, I + N, … in order of first use). Returns how many sets
+/// were rendered or found, and how many the class has.
 pub fn render_references(
     entries: &[Entry],
     scenes: &Scenes,
     base: &Path,
     options: &ClassOptions,
     progress: &dyn Progress,
-) -> Result<usize, GradeError> {
-    Ok(prepare(entries, scenes, base, options, progress)?
-        .groups
-        .len())
+    part: Option<crate::parts::Part>,
+) -> Result<(usize, usize), GradeError> {
+    let (entries, loaded, probes) = probe(entries, scenes, base)?;
+    let (keys, _) = reference_keys(&entries, &probes);
+    let mine: Vec<&ReferenceKey> = keys
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| part.is_none_or(|p| p.has(*i)))
+        .map(|(_, key)| key)
+        .collect();
+    for key in &mine {
+        reference_group(key, &loaded, options, progress)?;
+    }
+    Ok((mine.len(), keys.len()))
 }
 
 /// The entries with their settings completed, what each submission needs,
@@ -389,10 +400,30 @@ fn prepare(
     options: &ClassOptions,
     progress: &dyn Progress,
 ) -> Result<Prepared, GradeError> {
+    let (entries, loaded, probes) = probe(entries, scenes, base)?;
+    let (keys, row_groups) = reference_keys(&entries, &probes);
+    let groups = keys
+        .iter()
+        .map(|key| reference_group(key, &loaded, options, progress))
+        .collect::<Result<_, _>>()?;
+    Ok(Prepared {
+        entries,
+        probes,
+        groups,
+        row_groups,
+    })
+}
+
+/// The entries with their settings completed, their scenes loaded, and
+/// each submission's scene file and resolution, read from the file (and
+/// dropped: grading reads it again).
+fn probe(
+    entries: &[Entry],
+    scenes: &Scenes,
+    base: &Path,
+) -> Result<(Vec<Located>, Loaded, Vec<Probe>), GradeError> {
     let entries = with_presets(entries, scenes, base)?;
     let loaded = load_scenes(&entries);
-    // What each submission needs: its scene and resolution, read from the
-    // file (and dropped: grading reads it again).
     let probes: Vec<Probe> = entries
         .par_iter()
         .map(|(entry, found)| {
@@ -402,13 +433,7 @@ fn prepare(
             Ok((path, submission.resolution()))
         })
         .collect();
-    let (groups, row_groups) = reference_groups(&entries, &probes, &loaded, options, progress)?;
-    Ok(Prepared {
-        entries,
-        probes,
-        groups,
-        row_groups,
-    })
+    Ok((entries, loaded, probes))
 }
 
 /// A submission's scene file and resolution, or why it cannot be graded.
@@ -435,42 +460,48 @@ fn load_scenes(entries: &[Located]) -> Loaded {
     loaded
 }
 
-/// The references each readable submission is judged against, rendered (or
-/// read from the cache) once per scene, resolution and stated settings; and
-/// each row's group.
-fn reference_groups(
+/// A reference set: the scene file, the resolution and the stated settings.
+type ReferenceKey = (PathBuf, UVec2, StatedSettings);
+
+/// The reference sets readable submissions are judged against, in order of
+/// first use (once per scene, resolution and stated settings), and each
+/// row's.
+fn reference_keys(
     entries: &[Located],
     probes: &[Probe],
+) -> (Vec<ReferenceKey>, Vec<Option<usize>>) {
+    let mut keys: Vec<ReferenceKey> = Vec::new();
+    let row_groups = entries
+        .iter()
+        .zip(probes)
+        .map(|((entry, _), probe)| {
+            let (path, resolution) = probe.as_ref().ok()?;
+            let key = (path.clone(), *resolution, entry.stated);
+            Some(keys.iter().position(|k| *k == key).unwrap_or_else(|| {
+                keys.push(key);
+                keys.len() - 1
+            }))
+        })
+        .collect();
+    (keys, row_groups)
+}
+
+/// The references of `key`, rendered or read from the cache.
+fn reference_group(
+    (path, resolution, stated): &ReferenceKey,
     loaded: &Loaded,
     options: &ClassOptions,
     progress: &dyn Progress,
-) -> Result<(Vec<Group>, Vec<Option<usize>>), GradeError> {
-    let mut groups: Vec<Group> = Vec::new();
-    let mut keys: Vec<(PathBuf, UVec2, StatedSettings)> = Vec::new();
-    let mut row_groups = Vec::with_capacity(entries.len());
-    for ((entry, _), probe) in entries.iter().zip(probes) {
-        let Ok((path, resolution)) = probe else {
-            row_groups.push(None);
-            continue;
-        };
-        let key = (path.clone(), *resolution, entry.stated);
-        if let Some(i) = keys.iter().position(|k| *k == key) {
-            row_groups.push(Some(i));
-            continue;
-        }
-        let scene = loaded[path].as_ref().expect("probed").clone();
-        let plan = ReferencePlan::new(&entry.stated, scene.settings());
-        let rendering = |what: &str| progress.rendering(what);
-        let references = references(&scene, *resolution, &plan, &options.cache, &rendering)?;
-        keys.push(key);
-        groups.push(Group {
-            scene,
-            stated: entry.stated,
-            references,
-        });
-        row_groups.push(Some(groups.len() - 1));
-    }
-    Ok((groups, row_groups))
+) -> Result<Group, GradeError> {
+    let scene = loaded[path].as_ref().expect("probed").clone();
+    let plan = ReferencePlan::new(stated, scene.settings());
+    let rendering = |what: &str| progress.rendering(what);
+    let references = references(&scene, *resolution, &plan, &options.cache, &rendering)?;
+    Ok(Group {
+        scene,
+        stated: *stated,
+        references,
+    })
 }
 
 /// What a report calls a scene: its name, or a scene file's stem.

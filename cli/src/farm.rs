@@ -9,7 +9,9 @@
 //! a time limit's SIGTERM, GNU parallel's `--resume-failed`). A tile rendered
 //! again gives the same bytes. `assemble.sh` then puts the tiles together
 //! (`glint assemble`), which refuses an incomplete set and names the tiles
-//! to render again. docs/cluster.md walks through both engines.
+//! to render again. A bench sweep (`farm_sweep.rs`) and a class's grading
+//! (`farm_class.rs`) fill the same [`Farm`] with scripts of their own.
+//! docs/cluster.md walks through both engines.
 
 use crate::render::RenderArgs;
 use crate::{Cli, Command, Failure};
@@ -24,16 +26,18 @@ pub(crate) struct FarmArgs {
 
 #[derive(Subcommand)]
 enum Engine {
-    /// A Slurm job array, one task per tile (render.sbatch), and a merge job
-    /// that runs once every task has succeeded (assemble.sbatch)
+    /// A Slurm job array, one task per tile, bench task or part (with, for a
+    /// class, an array of reference tasks before it), and a merge job that
+    /// runs once every task has succeeded
     Slurm {
         #[command(flatten)]
         options: SlurmOptions,
         #[command(subcommand)]
         job: Job,
     },
-    /// A GNU parallel command, one job per tile, on this machine's cores or
-    /// on machines reached by ssh (run-parallel.sh), then the merge
+    /// A GNU parallel command, one job per tile, bench task or part, on this
+    /// machine's cores or on machines reached by ssh (run-parallel.sh), then
+    /// the merge
     Parallel {
         #[command(flatten)]
         options: ParallelOptions,
@@ -100,7 +104,7 @@ struct SlurmOptions {
     #[arg(long, value_name = "NAME", global = true, value_parser = parse_slurm_name)]
     partition: Option<String>,
 
-    /// Submit the two jobs (sbatch) instead of printing the commands
+    /// Submit the jobs (sbatch) instead of printing the commands
     #[arg(long, global = true)]
     submit: bool,
 }

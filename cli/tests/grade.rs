@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{assert_input_error, glint, scene, stderr, stdout};
+use common::{assert_input_error, glint, scene, stderr, stdout, CORRECT};
 use std::path::{Path, PathBuf};
 
 /// Renders the Cornell box Set 1 at 32 × 32 into `dir/name` with `flags`.
@@ -21,20 +21,6 @@ fn render(dir: &Path, scene_file: &str, name: &str, flags: &[&str]) -> PathBuf {
     assert!(o.status.success(), "{}", stderr(&o));
     out
 }
-
-/// A correct submission: 4 random camera samples and 4 random light samples.
-const CORRECT: [&str; 10] = [
-    "--spp",
-    "4",
-    "--sampler",
-    "random",
-    "--light-samples",
-    "4",
-    "--light-sampler",
-    "random",
-    "--seed",
-    "7",
-];
 
 /// Set 1 without its ambient light: the classic "no ambient" mistake.
 fn no_ambient_scene(dir: &Path) -> String {

@@ -17,6 +17,21 @@ pub const SMALL: [&str; 6] = [
     "4",
 ];
 
+/// A correct submission: 4 random camera samples and 4 random light
+/// samples, seed 7.
+pub const CORRECT: [&str; 10] = [
+    "--spp",
+    "4",
+    "--sampler",
+    "random",
+    "--light-samples",
+    "4",
+    "--light-sampler",
+    "random",
+    "--seed",
+    "7",
+];
+
 /// Runs the built `glint` with `args` in `dir`.
 pub fn glint(args: &[&str], dir: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_glint"))
@@ -90,8 +105,8 @@ pub fn python_with_mitsuba() -> Option<PathBuf> {
 }
 
 /// A small class in `dir`: `scenes/` with Set 1 and Set 2, and
-/// `class.csv` listing three students' 32 × 32 renders of both (4 random
-/// camera and light samples), one of them of the wrong scene, and a fourth
+/// `class.csv` listing three students' 32 × 32 renders of both ([`CORRECT`]'s
+/// settings, a seed each), one of them of the wrong scene, and a fourth
 /// student's file that is not there. Returns the manifest.
 pub fn small_class(dir: &Path) -> PathBuf {
     let scenes = dir.join("scenes");
@@ -112,27 +127,12 @@ pub fn small_class(dir: &Path) -> PathBuf {
             let file = format!("class/{student}/{set}.png");
             let seed = (7 + k).to_string();
             let scene_file = scenes.join(format!("{rendered}.toml"));
-            let o = glint(
-                &[
-                    "render",
-                    scene_file.to_str().unwrap(),
-                    "--resolution",
-                    "32x32",
-                    "--spp",
-                    "4",
-                    "--sampler",
-                    "random",
-                    "--light-samples",
-                    "4",
-                    "--light-sampler",
-                    "random",
-                    "--seed",
-                    &seed,
-                    "-o",
-                    &file,
-                ],
-                dir,
-            );
+            let scene_file = scene_file.to_str().unwrap();
+            let mut args = vec!["render", scene_file, "--resolution", "32x32", "-o", &file];
+            // CORRECT's settings, with each student's own seed.
+            args.extend_from_slice(&CORRECT[..8]);
+            args.extend(["--seed", &seed]);
+            let o = glint(&args, dir);
             assert!(o.status.success(), "{}", stderr(&o));
             manifest += &format!("{student},{set},{file}\n");
         }

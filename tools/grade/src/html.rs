@@ -200,7 +200,7 @@ fn page(rows: &[ReportRow]) -> String {
 /// [`ReportRow::sort_key`].
 fn cell(index: usize, row: &ReportRow) -> String {
     let v = &row.verdict;
-    let images = match row.reference {
+    let images = match row.reference.filter(|_| row.graded()) {
         Some(g) => format!(
             "<div class=\"thumbs\">{}{}{}</div>",
             thumb(&format!("images/{index}-submission"), "submission"),

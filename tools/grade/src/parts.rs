@@ -147,8 +147,9 @@ pub struct Merged {
     pub rows: Vec<ReportRow>,
     /// The part folder holding each row's images.
     pub row_parts: Vec<PathBuf>,
-    /// Each reference set's image: the part folder and its number there.
-    pub references: Vec<(PathBuf, usize)>,
+    /// Each reference set's image, where a submission judged against it
+    /// was graded: the part folder and its number there.
+    pub references: Vec<Option<(PathBuf, usize)>>,
 }
 
 /// Reads the part folders `dirs` and merges them; refuses parts of other
@@ -243,7 +244,10 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, GradeError> {
         row_parts: Vec::with_capacity(submissions),
         references: Vec::new(),
     };
+    // Reference sets numbered by first use, as a single run numbers them;
+    // each one's image from the part of its first graded submission.
     let mut keys: Vec<&str> = Vec::new();
+    let mut images: Vec<Option<(PathBuf, usize)>> = Vec::new();
     for slot in slots {
         let (mut row, p) = slot.expect("every part's rows are there, each its own");
         let (dir, file) = &parts[p];
@@ -251,14 +255,18 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, GradeError> {
             let key = file.references[local].as_str();
             let global = keys.iter().position(|k| *k == key).unwrap_or_else(|| {
                 keys.push(key);
-                merged.references.push((dir.clone(), local));
+                images.push(None);
                 keys.len() - 1
             });
+            if row.graded() && images[global].is_none() {
+                images[global] = Some((dir.clone(), local));
+            }
             row.reference = Some(global);
         }
         merged.rows.push(row);
         merged.row_parts.push(dir.clone());
     }
+    merged.references = images;
     Ok(merged)
 }
 
@@ -305,14 +313,15 @@ pub fn copy_images(merged: &Merged, dir: &Path) -> Result<(), GradeError> {
         })
     };
     for (i, (row, part)) in merged.rows.iter().zip(&merged.row_parts).enumerate() {
-        if row.reference.is_none() {
+        if row.reference.is_none() || !row.graded() {
             continue;
         }
         for name in crate::html::submission_images(i) {
             copy(part.join("images").join(&name), images.join(&name))?;
         }
     }
-    for (g, (part, local)) in merged.references.iter().enumerate() {
+    let references = merged.references.iter().enumerate();
+    for (g, (part, local)) in references.filter_map(|(g, r)| Some((g, r.as_ref()?))) {
         for (from, to) in crate::html::reference_images(*local)
             .into_iter()
             .zip(crate::html::reference_images(g))

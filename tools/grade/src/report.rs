@@ -118,8 +118,8 @@ pub struct ReportRow {
     /// The HTML cell's sort key: failures by their evidence, then errors,
     /// then passes.
     pub sort_key: String,
-    /// The reference set it was judged against, where it was graded: the
-    /// report's `images/reference-G.png`.
+    /// The reference set it is judged against, where its scene and
+    /// resolution could be read: the report's `images/reference-G.png`.
     pub reference: Option<usize>,
 }
 
@@ -136,15 +136,17 @@ impl ReportRow {
             numbers: csv_numbers(row),
             json,
             sort_key: sort_key(row).to_string(),
-            reference: match row.outcome {
-                Outcome::Graded(_) => row.group,
-                Outcome::Unreadable { .. } => None,
-            },
+            reference: row.group,
         }
     }
 
     pub fn passed(&self) -> bool {
         self.verdict == "pass"
+    }
+
+    /// Whether it was graded, and has images in the report.
+    pub fn graded(&self) -> bool {
+        self.verdict != "error"
     }
 }
 

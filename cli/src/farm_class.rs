@@ -103,7 +103,7 @@ impl ClassPlan {
             glint_camera::check_output_folder(folder)
                 .map_err(|e| Failure::Input(format!("{flag} {}: {e}", folder.display())))?;
         }
-        crate::grade::check_report_dir(&output)?;
+        crate::grade::check_report_dir(&output, "-o")?;
         let grade = parse_grade(&args.class, &dir, &args.grade_options)?;
         let (submissions, scenes) = crate::grade::class_size(&grade)?;
         if args.parts as usize > submissions {

@@ -360,7 +360,7 @@ fn class_options(args: &GradeArgs) -> String {
 /// `--merge`: the parts' rows and images, reported as a single run would.
 fn merge(args: &GradeArgs) -> Result<(), Failure> {
     if let Some(dir) = &args.report {
-        check_report_dir(dir)?;
+        check_report_dir(dir, "--report")?;
     }
     let merged = parts::merge(&args.merge).map_err(failure)?;
     if let Some(report) = &args.report {
@@ -594,21 +594,21 @@ fn check_outputs(args: &GradeArgs, entries: &[Entry]) -> Result<(), Failure> {
         check_heatmap_path(path, &[entries[0].file.as_path()])?;
     }
     if let Some(dir) = &args.report {
-        check_report_dir(dir)?;
+        check_report_dir(dir, "--report")?;
     }
     Ok(())
 }
 
 /// A report folder: new, empty, or an earlier report's (or part's), which
 /// the new one replaces whole.
-pub(crate) fn check_report_dir(dir: &Path) -> Result<(), Failure> {
-    glint_grade::output::check_dir(dir, "--report").map_err(failure)?;
+pub(crate) fn check_report_dir(dir: &Path, flag: &str) -> Result<(), Failure> {
+    glint_grade::output::check_dir(dir, flag).map_err(failure)?;
     let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
     let is_report =
         |d: &Path| d.join("grades.json").is_file() || d.join(parts::PART_FILE).is_file();
     if dir.is_dir() && !is_empty(dir) && !is_report(dir) {
         return Err(Failure::Input(format!(
-            "{}: --report: the folder holds files that are not a report of glint grade's, and a report replaces its folder whole; choose a new folder",
+            "{}: {flag}: the folder holds files that are not a report of glint grade's, and a report replaces its folder whole; choose a new folder",
             dir.display()
         )));
     }

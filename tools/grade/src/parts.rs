@@ -193,15 +193,16 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, GradeError> {
                     first.display()
                 )));
             }
-            if f.part.count != file.part.count {
+            if f.part.count != file.part.count || f.submissions != file.submissions {
                 return Err(input(
                     dir,
                     format!(
-                        "part {} of {}, and {} is part {}: the parts of one class are of one count",
-                        file.part.index,
-                        file.part.count,
+                        "part {} of {} submissions, and {} is part {} of {}: the parts of one class agree on both",
+                        file.part,
+                        file.submissions,
                         first.display(),
-                        f.part
+                        f.part,
+                        f.submissions
                     ),
                 ));
             }
@@ -273,11 +274,13 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, GradeError> {
 /// A part's rows are the part's submissions of the class, each once, and
 /// name reference sets it has.
 fn check_rows(file: &PartFile) -> Result<(), String> {
-    let expected: Vec<usize> = (file.part.index..file.submissions)
-        .step_by(file.part.count)
-        .collect();
-    let indices: Vec<usize> = file.rows.iter().map(|r| r.index).collect();
-    if indices != expected {
+    let Part { index, count } = file.part;
+    if count == 0 || index >= count {
+        return Err(format!("{PART_FILE}: part {index}/{count} is no part"));
+    }
+    let expected = file.submissions.saturating_sub(index).div_ceil(count);
+    let mine = |k: usize, r: &PartRow| r.index == index + k * count;
+    if file.rows.len() != expected || !file.rows.iter().enumerate().all(|(k, r)| mine(k, r)) {
         return Err(format!(
             "{PART_FILE}: its rows are not part {}'s submissions of {}",
             file.part, file.submissions
@@ -344,6 +347,42 @@ mod tests {
         assert_eq!((0..3).map(|k| part.submission(k)).collect::<Vec<_>>(), mine);
         for bad in ["3/3", "1/0", "1", "a/b", "-1/3"] {
             assert!(Part::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    /// A part file edited by hand is refused, not followed: no division by
+    /// a zero count, no room made for the submissions it claims.
+    #[test]
+    fn malformed_part_files_are_refused() {
+        let file = |index, count, submissions, rows: &[usize]| PartFile {
+            schema: PART_SCHEMA.into(),
+            class: String::new(),
+            part: Part { index, count },
+            submissions,
+            rows: rows
+                .iter()
+                .map(|&index| PartRow { index, row: row() })
+                .collect(),
+            references: Vec::new(),
+        };
+        assert!(check_rows(&file(0, 0, 4, &[])).is_err());
+        assert!(check_rows(&file(2, 2, 4, &[])).is_err());
+        assert!(check_rows(&file(0, 1, usize::MAX, &[0])).is_err());
+        assert!(check_rows(&file(1, 2, 5, &[1, 4])).is_err());
+        assert!(check_rows(&file(1, 2, 5, &[1, 3])).is_ok());
+    }
+
+    fn row() -> ReportRow {
+        ReportRow {
+            student: "ada".into(),
+            scene: "set1".into(),
+            file: "ada/set1.png".into(),
+            verdict: "error".into(),
+            summary: String::new(),
+            numbers: Default::default(),
+            json: serde_json::Value::Null,
+            sort_key: String::new(),
+            reference: None,
         }
     }
 }

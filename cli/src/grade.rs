@@ -375,9 +375,14 @@ fn merge(args: &GradeArgs) -> Result<(), Failure> {
 
 /// A report folder being made: a temporary folder beside `target`, moved into
 /// its place when finished (an old report moved aside first, then removed).
+/// Interrupted (SIGINT, SIGTERM: Ctrl-C, a Slurm requeue or time limit),
+/// the run removes it and ends with the signal's status (128 + its number),
+/// never in the middle of putting the report in place.
 struct Staging {
     dir: tempfile::TempDir,
     target: PathBuf,
+    /// Held while the report is put in place; a signal waits for it.
+    placing: std::sync::Arc<std::sync::Mutex<()>>,
 }
 
 impl Staging {
@@ -395,13 +400,17 @@ impl Staging {
                     target.display()
                 ))
             })?;
+        let placing = std::sync::Arc::new(std::sync::Mutex::new(()));
+        remove_on_signal(dir.path(), std::sync::Arc::clone(&placing))?;
         Ok(Staging {
             dir,
             target: target.to_owned(),
+            placing,
         })
     }
 
     fn finish(self) -> Result<(), Failure> {
+        let _placing = self.placing.lock();
         let fail = |e: std::io::Error| {
             Failure::Internal(format!(
                 "{}: cannot put the report in place: {e}",
@@ -434,6 +443,30 @@ impl Staging {
         }
         Ok(())
     }
+}
+
+/// Ends the process on SIGINT or SIGTERM with the signal's status, after
+/// removing `dir` (unless it was put in place meanwhile, which `placing`
+/// guards).
+fn remove_on_signal(
+    dir: &Path,
+    placing: std::sync::Arc<std::sync::Mutex<()>>,
+) -> Result<(), Failure> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let dir = dir.to_owned();
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
+        .map_err(|e| Failure::Other(format!("cannot watch for signals: {e}")))?;
+    std::thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                let _placed_or_not = placing.lock();
+                let _ = std::fs::remove_dir_all(&dir);
+                std::process::exit(128 + signal);
+            }
+        })
+        .map_err(|e| Failure::Other(format!("cannot watch for signals: {e}")))?;
+    Ok(())
 }
 
 /// The settings the command line states for every submission (a manifest's

@@ -240,3 +240,47 @@ fn glint_farm_grade_scripts_give_the_single_report_by_hand_and_through_gnu_paral
     run(&parallel.join("run-parallel.sh"), &[]);
     assert_same_folders(&d.join("single"), &d.join("parallel-report"));
 }
+
+/// A part stopped by SIGTERM (a Slurm requeue, a time limit) ends with the
+/// signal's status, leaves the part folder of an earlier run as it was, and
+/// leaves nothing beside it.
+#[test]
+fn a_stopped_part_leaves_the_earlier_part_as_it_was_and_nothing_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    small_class(d);
+    let part = ["--no-cache", "--part", "0/2", "--report", "part-0"];
+    let o = grade(&part, d);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let before = std::fs::read(d.join("part-0/part.json")).unwrap();
+    let staging = || {
+        std::fs::read_dir(d)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .any(|e| e.file_name().to_string_lossy().starts_with(".glint"))
+    };
+    // Without the cache the part renders its references first: time to stop
+    // it once its folder is being made. A run that finishes first is tried again.
+    let stopped = (0..20).find_map(|_| {
+        let mut args = vec!["grade", "--class", "class.csv", "--scenes", "scenes"];
+        args.extend_from_slice(&part);
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+            .args(&args)
+            .current_dir(d)
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        while !staging() && child.try_wait().unwrap().is_none() {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        let _ = std::process::Command::new("kill")
+            .args(["-TERM", &child.id().to_string()])
+            .status();
+        let status = child.wait().unwrap();
+        (status.code() != Some(0)).then_some(status)
+    });
+    let stopped = stopped.expect("no run was stopped mid-way in 20 tries");
+    assert_eq!(stopped.code(), Some(128 + 15), "{stopped:?}");
+    assert!(!staging(), "a stopped part leaves its folder being made");
+    assert!(std::fs::read(d.join("part-0/part.json")).unwrap() == before);
+}

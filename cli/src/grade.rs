@@ -19,8 +19,9 @@ use std::path::{Path, PathBuf};
 #[command(
     after_help = "Exit status: 0 when every submission passes, 1 when one fails or \
                   cannot be read, 2 for bad input (flags, scene, manifest, output paths), \
-                  3 for a failure of Glint's own. The test and its assumptions: \
-                  docs/grading.md."
+                  3 for a failure of Glint's own, 128 + the signal's number when \
+                  stopped (Ctrl-C, SIGTERM; a report being made is removed). The test \
+                  and its assumptions: docs/grading.md."
 )]
 pub(crate) struct GradeArgs {
     /// The scene the submissions render (TOML), then the submitted images

@@ -274,18 +274,9 @@ impl Plan {
             ));
         }
         check_managed("render", &args.render_options, &MANAGED)?;
-        let stem = args
-            .scene
-            .file_stem()
-            .map_or("render".into(), |s| s.to_string_lossy().into_owned());
-        let dir = args
-            .dir
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(format!("{stem}.farm")));
-        let output = args
-            .output
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
+        let stem = file_stem(&args.scene, "render");
+        let dir = or_default(&args.dir, format!("{stem}.farm"));
+        let output = or_default(&args.output, format!("{stem}.png"));
         glint_camera::ImageFormat::from_path(&output).map_err(|e| Failure::Input(e.to_string()))?;
         let output_folder = output.parent().filter(|p| !p.as_os_str().is_empty());
         glint_camera::check_output_folder(output_folder.unwrap_or(Path::new(".")))
@@ -554,6 +545,17 @@ set -uo pipefail
             })
             .collect()
     }
+}
+
+/// `path`'s file name without its extension, or `fallback`.
+pub(crate) fn file_stem(path: &Path, fallback: &str) -> String {
+    path.file_stem()
+        .map_or(fallback.into(), |s| s.to_string_lossy().into_owned())
+}
+
+/// A path flag's value, or its default (a name in the current directory).
+pub(crate) fn or_default(given: &Option<PathBuf>, default: String) -> PathBuf {
+    given.clone().unwrap_or_else(|| PathBuf::from(default))
 }
 
 /// The tiles' `glint render` command line as `glint render` parses it: the

@@ -5,7 +5,9 @@
 //! reads them from there; then `merge-grades.sh` merges the parts into the
 //! report a single run writes (`glint grade --merge`).
 
-use crate::farm::{check_managed, parse_command, quote, quote_str, Farm, FirstStep};
+use crate::farm::{
+    check_managed, file_stem, or_default, parse_command, quote, quote_str, Farm, FirstStep,
+};
 use crate::{Command, Failure};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -86,18 +88,9 @@ impl ClassPlan {
     /// part count against its submissions, and the paths.
     pub(crate) fn new(args: &FarmGrade) -> Result<ClassPlan, Failure> {
         check_managed("grade", &args.grade_options, &MANAGED)?;
-        let stem = args
-            .class
-            .file_stem()
-            .map_or("class".into(), |s| s.to_string_lossy().into_owned());
-        let dir = args
-            .dir
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(format!("{stem}.grade-farm")));
-        let output = args
-            .output
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(format!("{stem}-report")));
+        let stem = file_stem(&args.class, "class");
+        let dir = or_default(&args.dir, format!("{stem}.grade-farm"));
+        let output = or_default(&args.output, format!("{stem}-report"));
         let cache = args.cache.clone().unwrap_or_else(|| dir.join("cache"));
         for (flag, folder) in [("--dir", &dir), ("--cache", &cache)] {
             glint_camera::check_output_folder(folder)

@@ -3,7 +3,7 @@
 //! same reference file, then `merge-bench.sh`, which fits and plots from the
 //! tasks' JSON (`glint bench --merge`).
 
-use crate::farm::{check_managed, parse_command, quote, quote_str, Farm};
+use crate::farm::{check_managed, or_default, parse_command, quote, quote_str, Farm};
 use crate::{Command, Failure};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -60,14 +60,8 @@ impl Sweep {
     pub(crate) fn new(args: &FarmBench) -> Result<Sweep, Failure> {
         check_managed("bench", &args.bench_options, &MANAGED)?;
         let stem = glint_bench::scene_name(&args.scene);
-        let dir = args
-            .dir
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(format!("{stem}.bench-farm")));
-        let output = args
-            .output
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(format!("{stem}-bench")));
+        let dir = or_default(&args.dir, format!("{stem}.bench-farm"));
+        let output = or_default(&args.output, format!("{stem}-bench"));
         for (flag, folder) in [("--dir", &dir), ("-o", &output)] {
             glint_camera::check_output_folder(folder)
                 .map_err(|e| Failure::Input(format!("{flag} {}: {e}", folder.display())))?;

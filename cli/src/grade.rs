@@ -230,6 +230,9 @@ fn grade_or_merge(args: &GradeArgs) -> Result<(), Failure> {
     let stated = stated(args)?;
     let (entries, scenes, base) = entries(args, &stated)?;
     check_outputs(args, &entries)?;
+    if let Some(part) = args.part.filter(|_| !args.references_only) {
+        check_part_count(part, entries.len())?;
+    }
     let options = class::ClassOptions {
         test: TestOptions {
             alpha: args.alpha,
@@ -244,7 +247,7 @@ fn grade_or_merge(args: &GradeArgs) -> Result<(), Failure> {
     let class_entries = entries.len();
     let fingerprint = parts::class_fingerprint(&entries, &class_options(args));
     let (entries, part) = match args.part {
-        Some(part) => (part_entries(part, entries)?, Some(part)),
+        Some(part) => (part_entries(part, entries), Some(part)),
         None => (entries, None),
     };
     // The report is made in a folder of its own beside the one asked for,
@@ -332,21 +335,24 @@ fn references_only(
     Ok(())
 }
 
-/// The class's submissions that are `part`'s, in class order.
-fn part_entries(part: Part, entries: Vec<Entry>) -> Result<Vec<Entry>, Failure> {
-    if part.count > entries.len() {
-        return Err(Failure::Input(format!(
-            "--part {part}: the class has {} submissions, one per part at most; use at most {} parts",
-            entries.len(),
-            entries.len()
-        )));
+/// Refuses more parts than the class has submissions.
+fn check_part_count(part: Part, submissions: usize) -> Result<(), Failure> {
+    match part.count > submissions {
+        true => Err(Failure::Input(format!(
+            "--part {part}: the class has {submissions} submissions, one per part at most; use at most {submissions} parts"
+        ))),
+        false => Ok(()),
     }
-    Ok(entries
+}
+
+/// The class's submissions that are `part`'s, in class order.
+fn part_entries(part: Part, entries: Vec<Entry>) -> Vec<Entry> {
+    entries
         .into_iter()
         .enumerate()
         .filter(|(i, _)| part.has(*i))
         .map(|(_, e)| e)
-        .collect())
+        .collect()
 }
 
 /// The options that decide a class's grades beyond its submissions: the

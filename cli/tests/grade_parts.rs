@@ -136,8 +136,12 @@ fn the_merge_refuses_missing_repeated_and_foreign_parts_and_bad_parts_are_refuse
     assert_input_error(&merge(&["part-0", "class"]), "not a part folder");
     assert!(!d.join("out").exists(), "a refused merge writes nothing");
 
-    let o = grade(&["--cache", "cache", "--part", "0/9", "--report", "p"], d);
+    let o = grade(&["--cache", "fresh", "--part", "0/9", "--report", "p"], d);
     assert_input_error(&o, "--part 0/9: the class has 7 submissions");
+    assert!(
+        !d.join("fresh").exists(),
+        "refused before the cache is made"
+    );
     assert_input_error(
         &grade(&["--part", "3/3", "--report", "p"], d),
         "expected I/N with 0 ≤ I < N",

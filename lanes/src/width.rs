@@ -189,6 +189,34 @@ pub fn first_lanes(n: usize) -> F32Lanes {
     index.simd_lt(F32Lanes::splat(n as f32))
 }
 
+/// Lane j of the result is lane `index[j]` of `values` (each index below
+/// [`LANES`]): one `vpermd` on AVX-512, a lane-by-lane copy elsewhere.
+#[inline(always)]
+pub fn permute(values: F32Lanes, index: U32Lanes) -> F32Lanes {
+    #[cfg(all(
+        target_arch = "x86_64",
+        target_feature = "avx512f",
+        not(feature = "lanes8")
+    ))]
+    {
+        use safe_arch::{m512i, permute_i32_m512i};
+        let permuted = permute_i32_m512i(
+            bytemuck::cast::<U32Lanes, m512i>(index),
+            bytemuck::cast(values),
+        );
+        bytemuck::cast(permuted)
+    }
+    #[cfg(not(all(
+        target_arch = "x86_64",
+        target_feature = "avx512f",
+        not(feature = "lanes8")
+    )))]
+    {
+        let (values, index) = (values.as_array(), index.as_array());
+        from_fn(|j| values[index[j] as usize % LANES])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -266,7 +294,9 @@ mod tests {
         let (unit, ok) = a.try_normalize();
         let zero = (a - a).is_zero();
         for k in 0..LANES {
-            let (sa, sb) = (sample(k, 0.25), sample(k, 0.75));
+            // The lanes' own values: `sample` again could round otherwise where
+            // the optimiser folds its `sin` and `cos` at compile time.
+            let (sa, sb) = (a.lane(k), b.lane(k));
             let same = |x: f32, y: f32| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan());
             assert!(same(a.dot(&b).as_array()[k], sa.dot(sb)), "dot, lane {k}");
             assert!(same(a.dot_splat(sb).as_array()[k], sa.dot(sb)));
@@ -309,5 +339,16 @@ mod tests {
         assert_eq!(bits(first_lanes(3)), 0b111);
         assert_eq!(bits(first_lanes(LANES)), all_bits());
         assert_eq!(all_bits().count_ones() as usize, LANES);
+    }
+
+    /// Each lane of a permute is the indexed lane, repeats included.
+    #[test]
+    fn permute_takes_each_lane_from_its_index() {
+        let values = F32Lanes::new(std::array::from_fn(|k| 10.0 + k as f32));
+        let index: [u32; LANES] = std::array::from_fn(|j| (7 * j as u32 + 3) % LANES as u32 / 2);
+        let permuted = permute(values, U32Lanes::new(index));
+        for (j, (lane, from)) in permuted.as_array().iter().zip(index).enumerate() {
+            assert_eq!(*lane, 10.0 + from as f32, "lane {j}");
+        }
     }
 }

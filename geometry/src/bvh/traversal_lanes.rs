@@ -75,7 +75,9 @@ impl Bvh {
                 for child in 0..WIDTH {
                     let hits = reach & lanes.enter_child(&node.planes, child);
                     if hits != 0 {
-                        self.prefetch_child(node.link(child), &leaf_address);
+                        self.prefetch_child(node.link(child), |first| {
+                            prefetch_lines(leaf_address(first), LEAF_PREFETCH_LINES)
+                        });
                         stack.push((node.link(child), hits));
                     }
                 }
@@ -91,9 +93,10 @@ pub trait LeavesLanes {
     /// The lanes `reach` reach the leaf with positions `first..first + count`
     /// in leaf order; the visit may lower their `limit`.
     fn leaf(&mut self, first: u32, count: u32, reach: u32, limit: &mut F32Lanes);
-    /// Where the leaf at `first` keeps its primitives, to be prefetched
-    /// ([`RayStream::leaf_address`](super::RayStream::leaf_address)).
-    fn leaf_address(&self, first: u32) -> *const u8;
+    /// Asks for what a visit of the leaf at `first` reads (its primitives,
+    /// as [`RayStream::leaf_address`](super::RayStream::leaf_address) gives
+    /// them, and anything else), ahead of the visit.
+    fn prefetch_leaf(&self, first: u32);
 }
 
 impl Bvh {
@@ -158,7 +161,7 @@ impl Bvh {
                     n += 1;
                 }
                 for &(_, child) in &order[..n] {
-                    self.prefetch_child(node.link(child), |first| visit.leaf_address(first));
+                    self.prefetch_child(node.link(child), |first| visit.prefetch_leaf(first));
                 }
                 let entry =
                     |&(_, child): &(f32, usize)| (node.link(child), tests[child].0, tests[child].1);
@@ -172,13 +175,13 @@ impl Bvh {
 }
 
 impl Bvh {
-    /// Prefetches what a walk reads next at `link`: the node, or the
-    /// primitives of the leaf (at `leaf_address(first)`), so that the lanes'
+    /// Prefetches what a walk reads next at `link`: the node, or what the
+    /// visit of the leaf reads (`prefetch_leaf(first)`), so that the lanes'
     /// tests of the nodes before overlap the wait.
     #[inline(always)]
-    fn prefetch_child(&self, link: Link, leaf_address: impl FnOnce(u32) -> *const u8) {
+    fn prefetch_child(&self, link: Link, prefetch_leaf: impl FnOnce(u32)) {
         match link.is_leaf() {
-            true => prefetch_lines(leaf_address(link.leaf_range().0), LEAF_PREFETCH_LINES),
+            true => prefetch_leaf(link.leaf_range().0),
             false => prefetch(&self.tree.nodes[link.node()]),
         }
     }

@@ -231,6 +231,13 @@ impl ShapeList {
         }
     }
 
+    /// The packet of the leaf at `first`, where the leaf holds only triangles.
+    #[inline(always)]
+    pub(super) fn triangle_packet(&self, first: u32) -> Option<&TrianglePacket> {
+        let leaf = first as usize / LEAF_WIDTH;
+        (self.shape_lanes[leaf] == 0).then(|| &self.packets[leaf])
+    }
+
     /// Statistics of the BVH, once built.
     pub fn bvh_stats(&self) -> Option<BvhStats> {
         self.bvh.as_ref().map(Bvh::stats)

@@ -16,11 +16,11 @@
 //! the distance itself.)
 
 use super::{LinearShapes, Object, ObjectRef, Primitive, ShapeList};
-use crate::bvh::{LeavesLanes, RayStream};
+use crate::bvh::{LeavesLanes, RayStream, LEAF_PREFETCH_LINES};
 use crate::counters::count;
 use crate::lanes::I32Lanes;
 use crate::lanes::{self, F32Lanes, LANES};
-use crate::prefetch::prefetch;
+use crate::prefetch::{prefetch, prefetch_lines};
 use crate::triangle::WatertightRay;
 use crate::triangle_lanes::WatertightLanes;
 use crate::{Hit, Ray};
@@ -491,6 +491,22 @@ impl LanesSearch {
         self.primitive = take.select(p, self.primitive);
     }
 
+    /// [`Self::consider`] of one lane's hit at `t` on primitive `key`.
+    #[inline(always)]
+    fn consider_lane(&mut self, lane: usize, t: f32, (object, primitive): (u32, u32)) {
+        let best = self.t.as_array()[lane];
+        let key = (object as i32, primitive as i32);
+        let best_key = (
+            self.object.as_array()[lane],
+            self.primitive.as_array()[lane],
+        );
+        if t < best || t == best && key < best_key {
+            self.t.as_mut_array()[lane] = t;
+            self.object.as_mut_array()[lane] = key.0;
+            self.primitive.as_mut_array()[lane] = key.1;
+        }
+    }
+
     /// Where each lane prunes boxes: [`PRUNE_SCALE`] past its best hit.
     #[inline(always)]
     fn limit(&self) -> F32Lanes {
@@ -522,6 +538,14 @@ impl<'a, W: Fn() -> &'a WatertightLanes<'a>> LeavesLanes for ClosestLeaves<'a, W
     #[inline(always)]
     fn leaf(&mut self, first: u32, _: u32, reach: u32, limit: &mut F32Lanes) {
         let (list, search) = (self.list, &mut self.search);
+        if let Some(packet) = list.triangle_packet(first) {
+            (self.watertight)().packet_hits(packet, f32::INFINITY, reach, |lane, slot, t| {
+                let p = list.primitives[first as usize + slot];
+                search.consider_lane(lane, t, (p.object, p.triangle));
+            });
+            *limit = search.limit();
+            return;
+        }
         let walked = (self.rays, (self.watertight)());
         list.leaf_hits_lanes(first, walked, f32::INFINITY, reach, |slot, hits, t| {
             if hits != 0 {
@@ -533,9 +557,11 @@ impl<'a, W: Fn() -> &'a WatertightLanes<'a>> LeavesLanes for ClosestLeaves<'a, W
         *limit = search.limit();
     }
 
+    /// The leaf's packet, and its primitives' keys, which a hit reads.
     #[inline(always)]
-    fn leaf_address(&self, first: u32) -> *const u8 {
-        self.list.leaf_address(first)
+    fn prefetch_leaf(&self, first: u32) {
+        prefetch_lines(self.list.leaf_address(first), LEAF_PREFETCH_LINES);
+        prefetch(&self.list.primitives[first as usize]);
     }
 }
 

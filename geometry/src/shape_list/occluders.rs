@@ -427,6 +427,10 @@ impl ShapeList {
             let watertight =
                 watertight.get_or_init(|| WatertightLanes::new(rays, active & !blocked));
             let mut blocked = 0;
+            if let Some(packet) = self.triangle_packet(first) {
+                watertight.packet_hits(packet, t_max, reach, |lane, _, _| blocked |= 1 << lane);
+                return blocked;
+            }
             self.leaf_hits_lanes(first, (rays, watertight), t_max, reach, |_, hits, _| {
                 blocked |= hits;
                 blocked == reach

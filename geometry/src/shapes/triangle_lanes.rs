@@ -11,10 +11,21 @@
 //! bit for bit those of [`WatertightRay::intersect`]. Lanes whose ray passes
 //! exactly through an edge or a corner take the scalar test, whose
 //! double-precision fallback gives the edge a consistent sign.
+//!
+//! A BVH leaf's four triangles (a [`TrianglePacket`]) are tested against the
+//! rays that reach it as (ray, triangle) pairs, four rays per test
+//! ([`WatertightLanes::packet_hits`]): the same operations, lanes filled by
+//! pairs rather than by rays, since few of the rays reach any one leaf.
 
-use crate::lanes::{self, F32Lanes, Mask};
+use crate::counters::count;
+use crate::lanes::{self, F32Lanes, Mask, U32Lanes, LANES};
 use crate::triangle::{ShearedTriangle, WatertightRay};
-use crate::RayLanes;
+use crate::{RayLanes, TrianglePacket};
+
+/// Triangles in a [`TrianglePacket`].
+const PACKET_WIDTH: usize = 4;
+/// Rays per test in [`WatertightLanes::packet_hits`]: one per four lanes.
+const PAIR_RAYS: usize = LANES / PACKET_WIDTH;
 use glam::Vec3;
 
 /// Per lane, which coordinate an axis of the ray's frame takes: x where
@@ -173,6 +184,74 @@ impl<'a> WatertightLanes<'a> {
         (hits, t)
     }
 
+    /// The four triangles of `packet` against the rays of the lanes `reach`:
+    /// `hit(lane, slot, t)` for each ray that hits the triangle in `slot` in
+    /// (0, `t_max`), `t` bit for bit [`WatertightRay::intersect`]'s (NaN
+    /// slots, a leaf's padding, are never hit).
+    ///
+    /// A leaf is mostly reached by a few of the rays (by 3.3 of a camera
+    /// packet's 16 on average), so the (ray, triangle) pairs are what fill
+    /// the lanes: [`PAIR_RAYS`] rays at a time, each in four lanes, one per
+    /// triangle. Lane `j` tests ray `rays[j / 4]` against triangle `j % 4`,
+    /// its ray's data moved there by a lane permute and the triangle's
+    /// coordinates by a 4-lane broadcast; its operations are the scalar
+    /// test's. Where the triangle-by-triangle test ([`Self::hits_of`]) takes
+    /// four tests of all the lanes, this takes ⌈reach / [`PAIR_RAYS`]⌉.
+    #[inline(always)]
+    pub(crate) fn packet_hits(
+        &self,
+        packet: &TrianglePacket,
+        t_max: f32,
+        reach: u32,
+        mut hit: impl FnMut(usize, usize, f32),
+    ) {
+        count(|c| c.triangle_tests += (PACKET_WIDTH as u32 * reach.count_ones()) as u64);
+        let mut rest = reach;
+        while rest != 0 {
+            let (rays, pairs) = next_rays(&mut rest);
+            let index = U32Lanes::new(lanes::array_from_fn(|j| rays[j / PACKET_WIDTH]));
+            let of_rays = |v: F32Lanes| lanes::permute(v, index);
+            let origin = self.origin.map(of_rays);
+            let axes = self.uniform.ok_or_else(|| {
+                self.axes.map(|axis| AxisLanes {
+                    is_x: of_rays(axis.is_x),
+                    is_y: of_rays(axis.is_y),
+                })
+            });
+            let permuted = |vertex: usize| -> [F32Lanes; 3] {
+                let corner = |axis: usize| each_triangle(packet.corners[vertex][axis]);
+                let coordinates = match axes {
+                    Ok(axes) => axes.map(corner),
+                    Err(axes) => axes.map(|axis| axis.pick([0, 1, 2].map(corner))),
+                };
+                [0, 1, 2].map(|i| coordinates[i] - origin[i])
+            };
+            let shear = self.shear.map(of_rays);
+            let triangle = ShearedTriangle::new([0, 1, 2].map(permuted), shear);
+            let uvw = triangle.edge_functions();
+            let verdict = triangle.verdict(uvw, F32Lanes::splat(t_max));
+            let hits = verdict.hits.bits() & pairs;
+            let on_edge = ShearedTriangle::on_edge(uvw).bits() & pairs;
+            if hits | on_edge == 0 {
+                continue;
+            }
+            let pair = |j: usize| (rays[j / PACKET_WIDTH] as usize, j % PACKET_WIDTH);
+            let t = verdict.t_scaled * (F32Lanes::ONE / verdict.det);
+            for j in lanes::each_set(hits & !on_edge) {
+                let (lane, slot) = pair(j);
+                hit(lane, slot, t.as_array()[j]);
+            }
+            for j in lanes::each_set(on_edge) {
+                let (lane, slot) = pair(j);
+                let [p0, p1, p2] = packet.triangle(slot);
+                let ray = WatertightRay::new(&self.rays.lane(lane));
+                if let Some((t, _)) = ray.intersect(p0, p1, p2, t_max) {
+                    hit(lane, slot, t);
+                }
+            }
+        }
+    }
+
     /// The lanes `on_edge`, whose ray passes exactly through an edge or a
     /// corner, tested alone: the scalar test recomputes their edge functions
     /// in double precision.
@@ -197,6 +276,31 @@ impl<'a> WatertightLanes<'a> {
     }
 }
 
+/// Takes up to [`PAIR_RAYS`] of the lanes of `rest`, lowest first: their
+/// indices (the first repeated into the unused places) and the lanes of a
+/// [`WatertightLanes::packet_hits`] test that hold them, four per ray.
+#[inline(always)]
+fn next_rays(rest: &mut u32) -> ([u32; PAIR_RAYS], u32) {
+    let mut rays = [rest.trailing_zeros(); PAIR_RAYS];
+    let mut used = 0;
+    while used < PAIR_RAYS && *rest != 0 {
+        rays[used] = rest.trailing_zeros();
+        *rest &= *rest - 1;
+        used += 1;
+    }
+    let pairs = (1u64 << (used * PACKET_WIDTH)) - 1;
+    (rays, pairs as u32)
+}
+
+/// A packet's row of four (one coordinate of one corner of each triangle)
+/// repeated across the lanes: lane `j` holds triangle `j % 4`'s
+/// (`vbroadcastf32x4` on AVX-512).
+#[inline(always)]
+fn each_triangle(row: glam::Vec4) -> F32Lanes {
+    let row: [f32; PACKET_WIDTH] = row.into();
+    lanes::from_fn(|j| row[j % PACKET_WIDTH])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -214,40 +318,7 @@ mod tests {
         let mut rng = XorShift(0x7a1e);
         let (mut hits, mut on_edges, mut mixed) = (0, 0, 0);
         for round in 0..4000 {
-            let mut corners = [
-                rng.vec3(-2.0, 2.0),
-                rng.vec3(-2.0, 2.0),
-                rng.vec3(-2.0, 2.0),
-            ];
-            match round % 7 {
-                // Degenerate: a repeated corner, or three in a row.
-                0 => corners[2] = corners[1],
-                1 => corners[2] = corners[0] + 2.0 * (corners[1] - corners[0]),
-                _ => {}
-            }
-            // All the lanes' directions near one axis (a shared frame), or any.
-            let shared = round % 3 == 0;
-            let axis = Vec3::AXES[round % 3] * if round % 2 == 0 { 1.0 } else { -1.0 };
-            let origin = rng.vec3(-4.0, 4.0);
-            let rays: [Ray; LANES] = std::array::from_fn(|k| {
-                let corner = corners[k % 3];
-                if k % 4 == 0 {
-                    // Along an axis exactly through a corner: two edge
-                    // functions exactly zero.
-                    let along = if shared { axis } else { Vec3::AXES[k % 3] };
-                    return Ray::new(corner - 3.0 * along, along);
-                }
-                let target = match k % 4 {
-                    1 => 0.5 * (corner + corners[(k + 1) % 3]),
-                    _ => rng.vec3(-2.0, 2.0),
-                };
-                let direction = match shared {
-                    true => axis * 4.0 + 0.3 * rng.vec3(-1.0, 1.0),
-                    false if k == 5 => corners[1] - corners[0],
-                    false => target - origin,
-                };
-                Ray::new(origin, direction)
-            });
+            let (corners, rays) = awkward_case(&mut rng, round);
             let lanes = RayLanes::new(rays);
             let t_max = F32Lanes::new(std::array::from_fn(|k| match k % 3 {
                 0 => f32::INFINITY,
@@ -280,6 +351,109 @@ mod tests {
         assert!(on_edges > 100, "{on_edges} lanes through an edge or corner");
         assert!(mixed > 1_000, "{mixed} sets with mixed frames");
         assert!(mixed < 3_000, "{mixed} sets with mixed frames of 4000");
+    }
+
+    /// Round `round`'s triangle and rays: a degenerate triangle every few
+    /// rounds (a repeated corner, or three in a row); rays along and against
+    /// every axis (every permutation and both windings, mixed in one set or
+    /// one frame shared by all), rays along an axis exactly through a corner
+    /// (two edge functions exactly zero), through the middle of an edge, and
+    /// along an edge, in the triangle's plane.
+    fn awkward_case(rng: &mut XorShift, round: usize) -> ([Vec3; 3], [Ray; LANES]) {
+        let mut corners = [
+            rng.vec3(-2.0, 2.0),
+            rng.vec3(-2.0, 2.0),
+            rng.vec3(-2.0, 2.0),
+        ];
+        match round % 7 {
+            0 => corners[2] = corners[1],
+            1 => corners[2] = corners[0] + 2.0 * (corners[1] - corners[0]),
+            _ => {}
+        }
+        let shared = round % 3 == 0;
+        let axis = Vec3::AXES[round % 3] * if round % 2 == 0 { 1.0 } else { -1.0 };
+        let origin = rng.vec3(-4.0, 4.0);
+        let rays = std::array::from_fn(|k| {
+            let corner = corners[k % 3];
+            if k % 4 == 0 {
+                let along = if shared { axis } else { Vec3::AXES[k % 3] };
+                return Ray::new(corner - 3.0 * along, along);
+            }
+            let target = match k % 4 {
+                1 => 0.5 * (corner + corners[(k + 1) % 3]),
+                _ => rng.vec3(-2.0, 2.0),
+            };
+            let direction = match shared {
+                true => axis * 4.0 + 0.3 * rng.vec3(-1.0, 1.0),
+                false if k == 5 => corners[1] - corners[0],
+                false => target - origin,
+            };
+            Ray::new(origin, direction)
+        });
+        (corners, rays)
+    }
+
+    /// A whole packet against a few rays at a time reports each (ray,
+    /// triangle) hit of the scalar test once, with its distance bit for bit,
+    /// and nothing else: the awkward cases above, with the round's triangle
+    /// beside its mirror image (sharing an edge), a random one and either
+    /// padding or another random one; any subset of the lanes reaching it,
+    /// from one ray to all; with and without a limit.
+    #[test]
+    fn packets_of_pairs_are_the_scalar_test_bit_for_bit() {
+        let mut rng = XorShift(0x9a1e_5eed);
+        let (mut hits, mut on_edges, mut padded) = (0, 0, 0);
+        for round in 0..4000 {
+            let (corners, rays) = awkward_case(&mut rng, round);
+            let [a, b, c] = corners;
+            let mut triangles = vec![
+                corners,
+                [b, a, a + b - c],
+                [0; 3].map(|_| rng.vec3(-2.0, 2.0)),
+            ];
+            if round % 2 == 0 {
+                triangles.push([0; 3].map(|_| rng.vec3(-2.0, 2.0)));
+            }
+            let mut slots: Vec<usize> = (0..triangles.len()).collect();
+            slots.rotate_left(round % triangles.len());
+            let triangles: Vec<[Vec3; 3]> = slots.iter().map(|&k| triangles[k]).collect();
+            let packet = TrianglePacket::new(&triangles);
+            padded += usize::from(triangles.len() < PACKET_WIDTH);
+            let t_max = match round % 3 {
+                0 => f32::INFINITY,
+                _ => 4.0 * rng.unit(),
+            };
+            let reach = match round % 4 {
+                0 => lanes::all_bits(),
+                1 => 1 << (round / 4 % LANES),
+                _ => rng.next_u64() as u32 & lanes::all_bits(),
+            };
+            let lanes = RayLanes::new(rays);
+            let prepared = WatertightLanes::new(&lanes, lanes::all_bits());
+            let mut reported = Vec::new();
+            prepared.packet_hits(&packet, t_max, reach, |lane, slot, t| {
+                reported.push((lane, slot, t.to_bits()))
+            });
+            let mut wanted = Vec::new();
+            for lane in lanes::each_set(reach) {
+                let scalar = WatertightRay::new(&rays[lane]);
+                for (slot, [p0, p1, p2]) in triangles.iter().enumerate() {
+                    if let Some((t, _)) = scalar.intersect(*p0, *p1, *p2, t_max) {
+                        wanted.push((lane, slot, t.to_bits()));
+                    }
+                }
+                on_edges += prepared_on_edge(&prepared, &triangles[0], 1 << lane);
+            }
+            reported.sort_unstable();
+            assert_eq!(reported, wanted, "round {round}, reach {reach:#x}");
+            hits += wanted.len();
+        }
+        assert!(hits > 8_000, "{hits} hits");
+        assert!(
+            on_edges > 4_000,
+            "{on_edges} lanes through an edge or corner"
+        );
+        assert!(padded > 1_500, "{padded} packets with padding");
     }
 
     /// How many lanes of `active` hold an exactly zero edge function.

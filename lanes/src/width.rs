@@ -190,31 +190,58 @@ pub fn first_lanes(n: usize) -> F32Lanes {
 }
 
 /// Lane j of the result is lane `index[j]` of `values` (each index below
-/// [`LANES`]): one `vpermd` on AVX-512, a lane-by-lane copy elsewhere.
+/// [`LANES`]): one `vpermd` on AVX-512; on AVX2 a `vpermps` per 8-lane half
+/// of the result and source, blended by which half each index names; a
+/// lane-by-lane copy elsewhere.
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx512f",
+    not(feature = "lanes8")
+))]
 #[inline(always)]
 pub fn permute(values: F32Lanes, index: U32Lanes) -> F32Lanes {
-    #[cfg(all(
-        target_arch = "x86_64",
-        target_feature = "avx512f",
-        not(feature = "lanes8")
-    ))]
-    {
-        use safe_arch::{m512i, permute_i32_m512i};
-        let permuted = permute_i32_m512i(
-            bytemuck::cast::<U32Lanes, m512i>(index),
-            bytemuck::cast(values),
-        );
-        bytemuck::cast(permuted)
-    }
-    #[cfg(not(all(
-        target_arch = "x86_64",
-        target_feature = "avx512f",
-        not(feature = "lanes8")
-    )))]
-    {
-        let (values, index) = (values.as_array(), index.as_array());
-        from_fn(|j| values[index[j] as usize % LANES])
-    }
+    use safe_arch::{m512i, permute_i32_m512i};
+    let index = bytemuck::cast::<U32Lanes, m512i>(index);
+    bytemuck::cast(permute_i32_m512i(index, bytemuck::cast(values)))
+}
+
+/// [`permute`] on AVX2 (the doc comment above).
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    any(feature = "lanes8", not(target_feature = "avx512f"))
+))]
+#[inline(always)]
+pub fn permute(values: F32Lanes, index: U32Lanes) -> F32Lanes {
+    use safe_arch::shuffle_av_f32_all_m256 as permute_half;
+    use safe_arch::{blend_varying_m256, cmp_gt_mask_i32_m256i, m256, m256i};
+    let halves: [m256; LANES / 8] = bytemuck::cast(values);
+    let indices: [m256i; LANES / 8] = bytemuck::cast(index);
+    // `vpermps` reads an index's low three bits: its lane within a half.
+    let permuted = indices.map(|index| {
+        let mut lanes = permute_half(halves[0], index);
+        for (half, source) in halves.iter().enumerate().skip(1) {
+            let below = m256i::from([8 * half as i32 - 1; 8]);
+            let from_this_half = bytemuck::cast(cmp_gt_mask_i32_m256i(index, below));
+            lanes = blend_varying_m256(lanes, permute_half(*source, index), from_this_half);
+        }
+        lanes
+    });
+    bytemuck::cast(permuted)
+}
+
+/// [`permute`] without AVX2 (the doc comment above).
+#[cfg(not(all(
+    target_arch = "x86_64",
+    any(
+        all(target_feature = "avx512f", not(feature = "lanes8")),
+        target_feature = "avx2"
+    )
+)))]
+#[inline(always)]
+pub fn permute(values: F32Lanes, index: U32Lanes) -> F32Lanes {
+    let (values, index) = (values.as_array(), index.as_array());
+    from_fn(|j| values[index[j] as usize % LANES])
 }
 
 #[cfg(test)]
@@ -345,7 +372,11 @@ mod tests {
     #[test]
     fn permute_takes_each_lane_from_its_index() {
         let values = F32Lanes::new(std::array::from_fn(|k| 10.0 + k as f32));
-        let index: [u32; LANES] = std::array::from_fn(|j| (7 * j as u32 + 3) % LANES as u32 / 2);
+        // Lanes from both halves, and the last one again and again.
+        let index: [u32; LANES] = std::array::from_fn(|j| match j % 3 {
+            0 => LANES as u32 - 1,
+            _ => (5 * j as u32 + 3) % LANES as u32,
+        });
         let permuted = permute(values, U32Lanes::new(index));
         for (j, (lane, from)) in permuted.as_array().iter().zip(index).enumerate() {
             assert_eq!(*lane, 10.0 + from as f32, "lane {j}");

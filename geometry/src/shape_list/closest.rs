@@ -491,7 +491,9 @@ impl LanesSearch {
         self.primitive = take.select(p, self.primitive);
     }
 
-    /// [`Self::consider`] of one lane's hit at `t` on primitive `key`.
+    /// [`Self::consider`] of one lane's hit at `t` on primitive `key`, in
+    /// scalars: through `consider` with one lane's mask, camera rays in lanes
+    /// measured 0.97× (0.91–0.98, 4 alternated runs, 1M, Intel Xeon).
     #[inline(always)]
     fn consider_lane(&mut self, lane: usize, t: f32, (object, primitive): (u32, u32)) {
         let best = self.t.as_array()[lane];

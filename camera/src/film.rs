@@ -4,13 +4,15 @@
 //! rendered film with its coverage ([`PartialFilm`]) in `partial`.
 
 mod checks;
+mod depth;
+mod formats;
 mod partial;
-mod ppm;
 mod read;
 
 pub use checks::{MAX_EXPANSION, MAX_LOAD_SIDE};
+pub use formats::FileFormat;
 pub use partial::{PartialFilm, Placement, Tile};
-pub use read::SampleEncoding;
+pub use read::{AlphaChannel, ImageFile, SampleEncoding};
 
 use glam::{UVec2, Vec3};
 use std::io::{Seek, Write};
@@ -44,9 +46,6 @@ impl ImageFormat {
 pub enum FilmError {
     #[error("{}: unknown output format; expected a .png, .exr or .pfm extension", .0.display())]
     UnknownFormat(PathBuf),
-    /// [`Film::load`] was given an extension it does not read.
-    #[error("{}: unknown image format; expected a .png, .ppm, .jpg, .jpeg, .exr or .pfm extension", .0.display())]
-    UnknownInputFormat(PathBuf),
     /// [`Film::load`] could not open, decode or accept the file.
     #[error("{}: cannot read the image: {message}", path.display())]
     Read { path: PathBuf, message: String },

@@ -25,11 +25,14 @@
 //! - [`Film::new`], [`Film::set_pixel`] or [`Film::pixels_mut`] to fill it, and
 //!   [`Film::save`], whose format ([`ImageFormat`]) follows the file extension;
 //!   [`linear_to_srgb8`] is the PNG writer's transfer curve.
-//! - [`Film::load`] reads a PNG, PPM (`P6` or `P3`), JPEG, OpenEXR or PFM file back
-//!   into a film (integers decoded from sRGB with [`srgb_to_linear`], floats kept
-//!   as stored, NaN and negative values included), refusing sides over
-//!   [`MAX_LOAD_SIDE`]; [`Film::load_with_encoding`] also says how the file
-//!   stored its samples ([`SampleEncoding`]: the quantisation a grader allows for).
+//! - [`Film::load`] reads an image file back into a film, whatever wrote it:
+//!   PNG, JPEG, BMP, TGA, PPM/PGM, Radiance HDR, OpenEXR or PFM, told apart by
+//!   content ([`FileFormat`]); integers are decoded from sRGB with
+//!   [`srgb_to_linear`], floats kept as stored, NaN and negative values
+//!   included; sides over [`MAX_LOAD_SIDE`] are refused. [`Film::read`] also
+//!   says what the file was ([`ImageFile`]): how it stored its samples
+//!   ([`SampleEncoding`]: the step its values were rounded to, from the data),
+//!   its alpha ([`AlphaChannel`]), gray or palette.
 //! - Every image reader refuses what is not a regular file, and a header that
 //!   claims more pixels than [`MAX_EXPANSION`] times its file could hold, before
 //!   taking any pixel memory; [`check_output_file`] and [`check_output_folder`]
@@ -46,8 +49,8 @@ pub use camera::{
     Camera, CameraError, CameraRay, CameraRayDifferential, CameraRayLanes, F32Lanes, LANES,
 };
 pub use film::{
-    linear_to_srgb8, srgb_to_linear, Film, FilmError, ImageFormat, PartialFilm, Placement,
-    SampleEncoding, Tile, MAX_EXPANSION, MAX_LOAD_SIDE,
+    linear_to_srgb8, srgb_to_linear, AlphaChannel, FileFormat, Film, FilmError, ImageFile,
+    ImageFormat, PartialFilm, Placement, SampleEncoding, Tile, MAX_EXPANSION, MAX_LOAD_SIDE,
 };
 pub use output_paths::{check_output_file, check_output_folder, MAX_NAME_BYTES};
 

@@ -232,6 +232,7 @@ fn unreadable_and_bad_files_and_values_are_bad_input() {
     std::fs::write(dir.path().join("corrupt.png"), b"not a png").unwrap();
     std::fs::write(dir.path().join("short.pfm"), b"PF\n4 2\n-1.0\n\0\0\0\0").unwrap();
     std::fs::write(dir.path().join("image.bmp"), b"BM").unwrap();
+    std::fs::write(dir.path().join("image.gif"), b"GIF89a\x01\x00").unwrap();
     for (args, expected) in [
         (
             &["diff", "missing.pfm", "b.pfm"][..],
@@ -251,7 +252,11 @@ fn unreadable_and_bad_files_and_values_are_bad_input() {
         ),
         (
             &["diff", "image.bmp", "b.pfm"][..],
-            "image.bmp: unknown image format",
+            "image.bmp: cannot read the image: the file is truncated",
+        ),
+        (
+            &["diff", "image.gif", "b.pfm"][..],
+            "image.gif: cannot read the image: a GIF image; Glint reads PNG, JPEG, BMP, TGA, PPM/PGM, Radiance HDR, OpenEXR and PFM",
         ),
         (
             &["diff", "a.pfm", "b.pfm", "--region", "0,0,5,2"][..],

@@ -48,7 +48,7 @@ fn a_correct_render_passes_and_a_wrong_one_fails_with_where_and_how_much() {
     assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
     let text = stdout(&o);
     assert!(
-        text.contains("good.png: pass (32x32, settings spp unknown, light unknown"),
+        text.contains("good.png: pass (32x32, PNG, 8-bit RGB, settings spp unknown, light unknown"),
         "{text}"
     );
 
@@ -161,7 +161,7 @@ fn a_class_folder_and_its_manifest_give_the_same_verdicts_in_every_format() {
     let csv = stdout(&o);
     let rows: Vec<&str> = csv.lines().collect();
     assert!(
-        rows[0].starts_with("student,scene,file,verdict,rejected,tests"),
+        rows[0].starts_with("student,scene,file,format,verdict,rejected,tests"),
         "{csv}"
     );
     assert!(
@@ -189,7 +189,7 @@ fn a_class_folder_and_its_manifest_give_the_same_verdicts_in_every_format() {
         dir.path(),
     );
     let json: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
-    assert_eq!(json["schema"], "glint-grade/1");
+    assert_eq!(json["schema"], "glint-grade/2");
     assert_eq!(
         (
             json["pass"].as_u64(),
@@ -364,12 +364,25 @@ fn fixture(name: &str) -> String {
 
 /// Every submission's verdict, from `--format csv`, by student.
 fn verdicts(o: &std::process::Output) -> Vec<(String, String)> {
-    stdout(o)
-        .lines()
-        .skip(1)
-        .map(|line| {
-            let cells: Vec<&str> = line.split(',').collect();
-            (cells[0].to_owned(), cells[3].to_owned())
+    csv_rows(&stdout(o))
+        .into_iter()
+        .map(|row| (row["student"].clone(), row["verdict"].clone()))
+        .collect()
+}
+
+/// A CSV's rows, each by column name.
+fn csv_rows(text: &str) -> Vec<std::collections::HashMap<String, String>> {
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let header = reader.headers().unwrap().clone();
+    reader
+        .records()
+        .map(|r| {
+            let r = r.unwrap();
+            header
+                .iter()
+                .zip(r.iter())
+                .map(|(k, v)| (k.to_owned(), v.to_owned()))
+                .collect()
         })
         .collect()
 }

@@ -1,6 +1,7 @@
-//! Any bytes as an image file, the format chosen by the first byte (PNG, JPEG,
-//! Radiance HDR, OpenEXR, PFM, PPM): the texture loader, `Film::load` and
-//! `Film::load_with_encoding` (what `glint diff` and `glint grade` read) and
+//! Any bytes as an image file named by the first byte (PNG, JPEG, Radiance
+//! HDR, OpenEXR, PFM, PPM, BMP, TGA; `Film::read` tells them by content, TGA
+//! by its name): the texture loader, `Film::read` (what `glint diff` and
+//! `glint grade` read) and
 //! `PartialFilm::load` (what `--resume` reads: an EXR's pixels, coverage and
 //! header) each give an image or an error, never a panic, and refuse absurd
 //! sizes before allocating.
@@ -19,11 +20,10 @@ fuzz_target!(|data: &[u8]| {
     let Some((&kind, bytes)) = data.split_first() else {
         return;
     };
-    let extension = ["png", "jpg", "hdr", "exr", "pfm", "ppm"][kind as usize % 6];
+    let extension = ["png", "jpg", "hdr", "exr", "pfm", "ppm", "bmp", "tga"][kind as usize % 8];
     let path = dir().join(format!("image.{extension}"));
     std::fs::write(&path, bytes).unwrap();
     let _ = glint_texture::load_image(&path);
-    let _ = glint_camera::Film::load(&path);
-    let _ = glint_camera::Film::load_with_encoding(&path);
+    let _ = glint_camera::Film::read(&path);
     let _ = glint_camera::PartialFilm::load(&path);
 });

@@ -362,7 +362,7 @@ impl<'a> PixelRenderer<'a> {
     /// row fill the lanes (1 where they do not divide evenly).
     pub(crate) fn run_length(&self) -> usize {
         let spp = self.settings.spp as usize;
-        if spp < LANES && LANES % spp == 0 {
+        if spp < LANES && LANES.is_multiple_of(spp) {
             LANES / spp
         } else {
             1

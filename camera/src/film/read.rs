@@ -1,132 +1,217 @@
-//! Reading images back into a [`Film`]: PNG and JPEG (8- or 16-bit sRGB, decoded
-//! to linear), OpenEXR and PFM (linear floats, kept exactly as stored).
+//! Reading image files back into a [`Film`], whatever wrote them: PNG (8 and
+//! 16 bit, RGB, gray, palette, with or without alpha), JPEG, BMP, TGA, Netpbm
+//! (PPM, PGM, PBM, PAM; binary and ASCII, any maxval), Radiance HDR, OpenEXR
+//! (half and float) and PFM. The format is told by the file's content, not its
+//! name ([`FileFormat::sniff`]); every format but PFM is decoded by the `image`
+//! crate.
 //!
-//! Unlike texture loading, nothing is cleaned up: NaN, infinite and negative
-//! values stay as they are, so that a comparison sees them.
+//! Integer formats are taken to be sRGB-encoded and decoded to linear with the
+//! exact curve; float formats are kept as stored: NaN, infinite and negative
+//! values stay, so that a comparison sees them. [`Film::read`] also says what
+//! the file did to the radiance it was written from ([`SampleEncoding`]: the
+//! step its values were rounded to, found from the data), whether it had an
+//! alpha channel that is not opaque, and whether it was gray or a palette:
+//! what a grader needs to allow for.
 
 use super::checks::{check_expansion, check_size, regular_file, MAX_LOAD_SIDE};
+use super::depth::CodeSet;
+use super::formats::{header_layout, FileFormat, Layout};
 use super::{srgb_to_linear, Film, FilmError};
 use glam::{UVec2, Vec3};
-use std::io::{BufReader, Read};
+use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
-use std::sync::OnceLock;
 
-/// The formats [`Film::load`] reads, chosen by file extension.
+/// How an image file stores its samples: what reading it had to undo, and so
+/// how far a loaded value may lie from the radiance it was written from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum InputFormat {
-    Png,
-    Jpeg,
-    Exr,
-    Pfm,
-    Ppm,
+pub enum SampleEncoding {
+    /// Integer codes of the sRGB curve: values were clamped to [0, 1] and
+    /// rounded, per channel (R, G, B), to `levels` steps in the encoded
+    /// domain: the coarsest step the data shows, which may be coarser than
+    /// the `stored` codes the file holds (8-bit data in a 16-bit PNG).
+    Srgb { levels: [u32; 3], stored: u32 },
+    /// Linear floats with `mantissa_bits` bits of mantissa (23 for 32-bit
+    /// floats, 10 for OpenEXR's half).
+    Float { mantissa_bits: u32 },
+    /// Radiance RGBE: three 8-bit mantissas sharing one exponent, so each
+    /// channel is rounded to 1/256 of the pixel's largest power of two.
+    SharedExponent,
 }
 
-impl InputFormat {
-    fn from_path(path: &Path) -> Result<Self, FilmError> {
-        match super::lowercase_extension(path).as_deref() {
-            Some("png") => Ok(Self::Png),
-            Some("jpg" | "jpeg") => Ok(Self::Jpeg),
-            Some("exr") => Ok(Self::Exr),
-            Some("pfm") => Ok(Self::Pfm),
-            Some("ppm") => Ok(Self::Ppm),
-            _ => Err(FilmError::UnknownInputFormat(path.to_path_buf())),
+/// A file's alpha channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AlphaChannel {
+    Absent,
+    /// Every pixel fully opaque: nothing is lost by dropping it.
+    Opaque,
+    /// `pixels` pixels are not fully opaque; the film holds their colour
+    /// channels as stored.
+    Translucent {
+        pixels: u64,
+    },
+}
+
+/// An image file as [`Film::read`] found it.
+#[derive(Clone, Debug)]
+pub struct ImageFile {
+    /// The colour channels, linear (a gray file's one channel in all three).
+    pub film: Film,
+    pub format: FileFormat,
+    pub encoding: SampleEncoding,
+    pub alpha: AlphaChannel,
+    /// The file holds one gray channel.
+    pub gray: bool,
+    /// The file's pixels are indices into a colour map (a palette).
+    pub indexed: bool,
+    /// What the header says of the layout.
+    layout: Layout,
+    /// The file's extension, where it names another format than its content.
+    pub misnamed: Option<String>,
+}
+
+impl ImageFile {
+    /// What the file was read as, in words: "PNG, 16-bit RGB, values on
+    /// 8-bit steps", "PPM (P3), maxval 1023", "OpenEXR, half float, alpha
+    /// below 1 in 12 pixels", "TGA, 24-bit RGB, RLE (named .png)".
+    pub fn description(&self) -> String {
+        let mut parts = vec![self.layout.label.clone()];
+        let channels = match (self.gray, self.indexed) {
+            (_, true) => Some("palette"),
+            (true, _) => Some("gray"),
+            _ if self.layout.bits.is_some() => Some("RGB"),
+            _ => None,
+        };
+        let bits = self.layout.bits.map(|b| format!("{b}-bit"));
+        let words: Vec<String> = bits.into_iter().chain(channels.map(String::from)).collect();
+        if !words.is_empty() {
+            parts.push(words.join(" "));
         }
+        parts.extend(self.layout.extras.iter().cloned());
+        match self.encoding {
+            SampleEncoding::Srgb { stored, .. } if self.format == FileFormat::Pnm => {
+                parts.push(format!("maxval {stored}"))
+            }
+            _ => {}
+        }
+        match self.encoding {
+            SampleEncoding::Srgb { levels, stored } if levels.iter().any(|&l| l != stored) => {
+                parts.push(format!("values on {}", steps_text(levels)))
+            }
+            SampleEncoding::Float { mantissa_bits: 10 } => parts.push("half float".into()),
+            _ => {}
+        }
+        match self.alpha {
+            AlphaChannel::Absent => {}
+            AlphaChannel::Opaque => parts.push("opaque alpha".into()),
+            AlphaChannel::Translucent { pixels } => {
+                parts.push(format!("alpha below 1 in {pixels} pixels"))
+            }
+        }
+        let mut text = parts.join(", ");
+        if let Some(extension) = &self.misnamed {
+            text += &format!(" (named .{extension})");
+        }
+        text
+    }
+}
+
+/// "8-bit steps", "32 levels", or one per channel when they differ.
+fn steps_text(levels: [u32; 3]) -> String {
+    let one = |l: u32| match l {
+        255 => "8-bit steps".to_string(),
+        65535 => "16-bit steps".to_string(),
+        l => format!("{} levels", l + 1),
+    };
+    if levels.iter().all(|&l| l == levels[0]) {
+        one(levels[0])
+    } else {
+        format!(
+            "{}, {} and {} (R, G, B)",
+            one(levels[0]),
+            one(levels[1]),
+            one(levels[2])
+        )
     }
 }
 
 impl Film {
-    /// Reads an image file into a film of linear RGB, the format chosen by the
-    /// extension (case-insensitive):
+    /// Reads an image file into a film of linear RGB, with what the file did
+    /// to the values it was written from ([`ImageFile`]). The format is told
+    /// by the content; TGA, which has no magic bytes, by its `.tga` name.
     ///
-    /// - `.png`, `.jpg`, `.jpeg`: 8- or 16-bit integers, taken to be sRGB-encoded
-    ///   and decoded to linear with the exact sRGB curve ([`srgb_to_linear`]);
-    ///   grayscale is replicated to RGB, alpha is dropped.
-    /// - `.exr`: OpenEXR with R, G and B channels (half or float), linear; alpha
-    ///   is dropped.
-    /// - `.pfm`: Portable Float Map as [`Film::save`] writes it (`PF`, three
-    ///   channels, little-endian, bottom row first); big-endian files (a positive
-    ///   scale) and grayscale `Pf` files are read too. Values are multiplied by
-    ///   the absolute value of the scale (so ±1.0, as Glint writes, keeps them bit
-    ///   for bit).
-    /// - `.ppm`: Netpbm PPM, binary (`P6`) or ASCII (`P3`), any maxval up to
-    ///   65535: codes taken to be sRGB-encoded, `code / maxval` decoded to linear.
+    /// - Integer formats (PNG, JPEG, BMP, TGA, Netpbm): codes taken to be
+    ///   sRGB-encoded, `code / max` decoded to linear with the exact curve
+    ///   ([`srgb_to_linear`]); a Netpbm file's `max` is its maxval. Gray is
+    ///   replicated to RGB; alpha is dropped (and reported in
+    ///   [`ImageFile::alpha`]); a palette is looked up. PNG's colour chunks
+    ///   (gAMA, sRGB, iCCP) are ignored: the values are taken as sRGB.
+    /// - OpenEXR (R, G, B, half or float), Radiance HDR (divided by its
+    ///   EXPOSURE, if any) and PFM: linear floats kept as stored. PFM is read
+    ///   as [`Film::save`] writes it (`PF`, little-endian, bottom row first),
+    ///   and big-endian and gray (`Pf`) files too, multiplied by the absolute
+    ///   value of the scale (±1.0, as Glint writes, keeps them bit for bit).
     ///
-    /// Float values are kept exactly as stored: NaN, infinite and negative values
-    /// are not cleaned up. Images wider or taller than [`MAX_LOAD_SIDE`], or
-    /// empty, are refused from their header, before any pixel memory is taken; so
-    /// are truncated files. Every error names the file.
-    pub fn load(path: &Path) -> Result<Film, FilmError> {
-        let format = InputFormat::from_path(path)?;
+    /// Images wider or taller than [`MAX_LOAD_SIDE`], empty, or whose header
+    /// claims more pixels than the file could hold, are refused before any
+    /// pixel memory is taken; so are truncated files. Every error names the file.
+    pub fn read(path: &Path) -> Result<ImageFile, FilmError> {
         let fail = |message: String| FilmError::Read {
             path: path.to_path_buf(),
             message,
         };
-        match format {
-            InputFormat::Pfm => read_pfm(path).map_err(fail),
-            InputFormat::Ppm => super::ppm::read_ppm(path).map_err(fail),
-            InputFormat::Png => read_with_image_crate(path, image::ImageFormat::Png).map_err(fail),
-            InputFormat::Jpeg => {
-                read_with_image_crate(path, image::ImageFormat::Jpeg).map_err(fail)
-            }
-            InputFormat::Exr => {
-                read_with_image_crate(path, image::ImageFormat::OpenExr).map_err(fail)
-            }
-        }
-    }
-}
-
-/// How an image file stores its samples: what [`Film::load`] had to undo, and
-/// so how much a loaded value can differ from the radiance it was written from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SampleEncoding {
-    /// Integer codes `0..=max_code` of the sRGB curve (PNG, JPEG, PPM): values
-    /// were clamped to [0, 1] and rounded to a step of `1 / max_code` in the
-    /// encoded domain.
-    Srgb { max_code: u32 },
-    /// Linear floats (OpenEXR, PFM), kept as written.
-    Linear,
-}
-
-impl Film {
-    /// [`Film::load`], and how the file stored its samples.
-    pub fn load_with_encoding(path: &Path) -> Result<(Film, SampleEncoding), FilmError> {
-        let format = InputFormat::from_path(path)?;
-        let film = Film::load(path)?;
-        let encoding = match format {
-            InputFormat::Exr | InputFormat::Pfm => SampleEncoding::Linear,
-            InputFormat::Ppm => SampleEncoding::Srgb {
-                max_code: super::ppm::maxval(path).map_err(|message| FilmError::Read {
-                    path: path.to_path_buf(),
-                    message,
-                })?,
-            },
-            InputFormat::Png | InputFormat::Jpeg => SampleEncoding::Srgb {
-                max_code: integer_max_code(path, format),
-            },
+        let (head, tail) = ends(path).map_err(fail)?;
+        let format = match FileFormat::sniff(&head, &tail) {
+            Ok(format) => format,
+            Err(_) if FileFormat::from_extension(path) == Some(FileFormat::Tga) => FileFormat::Tga,
+            Err(message) => return Err(fail(message)),
         };
-        Ok((film, encoding))
+        let mut file = match format {
+            FileFormat::Pfm => read_pfm(path).map(|film| ImageFile {
+                film,
+                format,
+                encoding: SampleEncoding::Float { mantissa_bits: 23 },
+                alpha: AlphaChannel::Absent,
+                gray: false,
+                indexed: false,
+                layout: Layout {
+                    label: format.name().into(),
+                    ..Layout::default()
+                },
+                misnamed: None,
+            }),
+            _ => read_with_image_crate(path, format, &head),
+        }
+        .map_err(fail)?;
+        file.misnamed = super::lowercase_extension(path)
+            .filter(|_| FileFormat::from_extension(path).is_some_and(|f| f != format));
+        Ok(file)
+    }
+
+    /// [`Film::read`]'s film alone.
+    pub fn load(path: &Path) -> Result<Film, FilmError> {
+        Ok(Film::read(path)?.film)
     }
 }
 
-/// 65535 for a 16-bit PNG, 255 otherwise (JPEG is always 8-bit).
-fn integer_max_code(path: &Path, format: InputFormat) -> u32 {
-    let sixteen_bit = format == InputFormat::Png
-        && open(path)
-            .ok()
-            .and_then(|r| {
-                image::ImageReader::with_format(r, image::ImageFormat::Png)
-                    .into_decoder()
-                    .ok()
-            })
-            .is_some_and(|d| {
-                use image::ImageDecoder;
-                d.color_type().bytes_per_pixel() / d.color_type().channel_count() == 2
-            });
-    if sixteen_bit {
-        65535
-    } else {
-        255
+/// The first and last bytes of the file at `path` (for its magic and a TGA
+/// footer).
+fn ends(path: &Path) -> Result<(Vec<u8>, Vec<u8>), String> {
+    const SPAN: u64 = 64;
+    regular_file(path)?;
+    let mut file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut head = Vec::new();
+    (&mut file)
+        .take(SPAN)
+        .read_to_end(&mut head)
+        .map_err(|e| e.to_string())?;
+    let len = file.metadata().map_err(|e| e.to_string())?.len();
+    let mut tail = Vec::new();
+    if len > SPAN {
+        file.seek(SeekFrom::Start(len - SPAN.min(len)))
+            .map_err(|e| e.to_string())?;
+        file.read_to_end(&mut tail).map_err(|e| e.to_string())?;
     }
+    Ok((head, tail))
 }
 
 fn open(path: &Path) -> Result<BufReader<std::fs::File>, String> {
@@ -136,22 +221,93 @@ fn open(path: &Path) -> Result<BufReader<std::fs::File>, String> {
         .map_err(|e| e.to_string())
 }
 
-/// PNG, JPEG and OpenEXR through the `image` crate: the header first (size
+/// Every format but PFM, through the `image` crate: the header first (size
 /// check), then the pixels.
-fn read_with_image_crate(path: &Path, format: image::ImageFormat) -> Result<Film, String> {
-    Ok(from_dynamic(decode(path, format)?))
+fn read_with_image_crate(
+    path: &Path,
+    format: FileFormat,
+    head: &[u8],
+) -> Result<ImageFile, String> {
+    let decoded = decode(path, format)?;
+    let layout = header_layout(format, head);
+    let (film, codes, alpha, gray) = pixels(decoded, stored_max(path, format)?);
+    let encoding = match codes {
+        Some(sets) => SampleEncoding::Srgb {
+            levels: std::array::from_fn(|c| sets[c].levels()),
+            stored: sets[0].max(),
+        },
+        None if format == FileFormat::RadianceHdr => SampleEncoding::SharedExponent,
+        None if format == FileFormat::OpenExr && exr_is_half(path) => {
+            SampleEncoding::Float { mantissa_bits: 10 }
+        }
+        None => SampleEncoding::Float { mantissa_bits: 23 },
+    };
+    let film = match format {
+        FileFormat::RadianceHdr => match hdr_exposure(path)? {
+            Some(exposure) => film.divided_by(exposure),
+            None => film,
+        },
+        _ => film,
+    };
+    Ok(ImageFile {
+        film,
+        format,
+        encoding,
+        alpha,
+        gray,
+        indexed: layout.indexed,
+        layout,
+        misnamed: None,
+    })
+}
+
+impl Film {
+    fn divided_by(mut self, exposure: f32) -> Film {
+        self.pixels.iter_mut().for_each(|p| *p /= exposure);
+        self
+    }
+}
+
+/// The largest code a Netpbm file declares (its maxval); `None` for other
+/// formats, whose codes fill their bytes.
+fn stored_max(path: &Path, format: FileFormat) -> Result<Option<u32>, String> {
+    if format != FileFormat::Pnm {
+        return Ok(None);
+    }
+    let decoder = image::codecs::pnm::PnmDecoder::new(open(path)?).map_err(|e| e.to_string())?;
+    Ok(Some(decoder.into_inner().1.maximal_sample()))
+}
+
+/// The EXPOSURE a Radiance file's header gives, where it is not 1.
+fn hdr_exposure(path: &Path) -> Result<Option<f32>, String> {
+    let decoder = image::codecs::hdr::HdrDecoder::new(open(path)?).map_err(|e| e.to_string())?;
+    Ok(decoder
+        .metadata()
+        .exposure
+        .filter(|&e| e.is_finite() && e > 0.0 && e != 1.0))
+}
+
+/// Whether an OpenEXR file stores its colour channels as half floats.
+fn exr_is_half(path: &Path) -> bool {
+    let Ok(meta) = exr::meta::MetaData::read_from_file(path, false) else {
+        return false;
+    };
+    meta.headers.first().is_some_and(|header| {
+        header.channels.list.iter().any(|channel| {
+            matches!(channel.name.to_string().as_str(), "R" | "G" | "B")
+                && channel.sample_type == exr::meta::attribute::SampleType::F16
+        })
+    })
 }
 
 /// The image at `path` decoded by the image crate, its size checked from the
 /// header before any pixel memory is taken.
-pub(super) fn decode(
-    path: &Path,
-    format: image::ImageFormat,
-) -> Result<image::DynamicImage, String> {
+fn decode(path: &Path, file_format: FileFormat) -> Result<image::DynamicImage, String> {
     use image::ImageDecoder;
+    let format = file_format.image_crate().expect("not PFM");
     let header = image::ImageReader::with_format(open(path)?, format)
         .into_decoder()
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| decoding_error(e, file_format))?;
     let (w, h) = header.dimensions();
     check_size(w as u64, h as u64)?;
     let file_len = std::fs::metadata(path).map_err(|e| e.to_string())?.len();
@@ -164,40 +320,113 @@ pub(super) fn decode(
     // size is 4 GiB); the default allocation limit would refuse large renders.
     limits.max_alloc = None;
     reader.limits(limits);
-    reader.decode().map_err(|e| e.to_string())
+    reader.decode().map_err(|e| decoding_error(e, file_format))
 }
 
-/// A decoded image as linear RGB: integers are sRGB, floats linear and kept as is.
-fn from_dynamic(decoded: image::DynamicImage) -> Film {
+/// An `image` crate error as one line: a file that ends early is truncated;
+/// a decoder's complaint is about this file's format.
+fn decoding_error(error: image::ImageError, format: FileFormat) -> String {
+    use image::ImageError as E;
+    match error {
+        E::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+            "the file is truncated: it ends before its pixels do".into()
+        }
+        E::Decoding(e) => {
+            let text = e.to_string();
+            let reason = text.split_once(": ").map_or(text.as_str(), |(_, r)| r);
+            format!("not a valid {} file: {reason}", format.name())
+        }
+        other => other.to_string(),
+    }
+}
+
+/// A decoded image as linear RGB, with the codes each integer channel holds
+/// (`None` for floats), its alpha, and whether it was gray. `maxval` is a
+/// Netpbm file's: the image crate scales its codes to fill 8 or 16 bits,
+/// which is undone exactly (the scaling is one to one).
+fn pixels(
+    decoded: image::DynamicImage,
+    maxval: Option<u32>,
+) -> (Film, Option<[CodeSet; 3]>, AlphaChannel, bool) {
     use image::DynamicImage as D;
     let resolution = UVec2::new(decoded.width(), decoded.height());
-    let pixels: Vec<Vec3> = match decoded {
-        D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_) => {
-            let lut = srgb8_table();
-            decoded
-                .into_rgb8()
-                .pixels()
-                .map(|p| Vec3::from_array(p.0.map(|c| lut[c as usize])))
-                .collect()
+    let gray = matches!(
+        decoded,
+        D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageLuma16(_) | D::ImageLumaA16(_)
+    );
+    let channels = decoded.color().channel_count() as usize;
+    let (pixels, codes, alpha) = match decoded {
+        D::ImageRgb32F(_) | D::ImageRgba32F(_) => {
+            let has_alpha = decoded.color().has_alpha();
+            let samples = decoded.into_rgba32f().into_raw();
+            let opaque = samples.chunks_exact(4).map(|p| p[3] >= 1.0);
+            let alpha = alpha_channel(has_alpha, opaque);
+            let pixels = samples
+                .chunks_exact(4)
+                .map(|p| Vec3::new(p[0], p[1], p[2]))
+                .collect();
+            (pixels, None, alpha)
         }
-        D::ImageRgb32F(_) | D::ImageRgba32F(_) => decoded
-            .into_rgb32f()
-            .pixels()
-            .map(|p| Vec3::from_array(p.0))
-            .collect(),
-        // 16-bit integers (PNG), and any other integer layout.
-        _ => decoded
-            .into_rgb16()
-            .pixels()
-            .map(|p| Vec3::from_array(p.0.map(|c| srgb_to_linear(c as f32 / 65535.0))))
-            .collect(),
+        D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_) => {
+            integer_pixels(&decoded.into_bytes(), channels, 255, maxval)
+        }
+        D::ImageLuma16(b) => integer_pixels(b.as_raw(), channels, 65535, maxval),
+        D::ImageLumaA16(b) => integer_pixels(b.as_raw(), channels, 65535, maxval),
+        D::ImageRgb16(b) => integer_pixels(b.as_raw(), channels, 65535, maxval),
+        D::ImageRgba16(b) => integer_pixels(b.as_raw(), channels, 65535, maxval),
+        other => integer_pixels(other.into_rgb16().as_raw(), 3, 65535, maxval),
     };
-    Film { resolution, pixels }
+    (Film { resolution, pixels }, codes, alpha, gray)
 }
 
-fn srgb8_table() -> &'static [f32; 256] {
-    static TABLE: OnceLock<[f32; 256]> = OnceLock::new();
-    TABLE.get_or_init(|| std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)))
+/// Integer samples (`channels` a pixel: gray, gray and alpha, RGB or RGBA)
+/// filling `0..=full`, as linear RGB; the codes of each colour channel,
+/// rescaled to `0..=maxval` where a Netpbm maxval is given; and the alpha.
+fn integer_pixels<T: Copy + Into<u32>>(
+    samples: &[T],
+    channels: usize,
+    full: u32,
+    maxval: Option<u32>,
+) -> (Vec<Vec3>, Option<[CodeSet; 3]>, AlphaChannel) {
+    let max = maxval.unwrap_or(full);
+    let code = |s: T| -> u32 {
+        let s: u32 = s.into();
+        match max == full {
+            true => s,
+            false => ((s as u64 * max as u64 + full as u64 / 2) / full as u64) as u32,
+        }
+    };
+    let table: Vec<f32> = (0..=max)
+        .map(|c| srgb_to_linear(c as f32 / max as f32))
+        .collect();
+    let mut sets: [CodeSet; 3] = std::array::from_fn(|_| CodeSet::new(max));
+    let colour = if channels >= 3 { 3 } else { 1 };
+    let pixels = samples
+        .chunks_exact(channels)
+        .map(|p| {
+            let rgb: [u32; 3] = std::array::from_fn(|c| code(p[c.min(colour - 1)]));
+            for (set, &c) in sets.iter_mut().zip(&rgb) {
+                set.insert(c);
+            }
+            Vec3::from_array(rgb.map(|c| table[c as usize]))
+        })
+        .collect();
+    let has_alpha = channels == 2 || channels == 4;
+    let opaque = samples
+        .chunks_exact(channels)
+        .map(|p| p[channels - 1].into() == full);
+    (pixels, Some(sets), alpha_channel(has_alpha, opaque))
+}
+
+/// The alpha channel, from whether each pixel is fully opaque.
+fn alpha_channel(present: bool, opaque: impl Iterator<Item = bool>) -> AlphaChannel {
+    if !present {
+        return AlphaChannel::Absent;
+    }
+    match opaque.filter(|&o| !o).count() as u64 {
+        0 => AlphaChannel::Opaque,
+        pixels => AlphaChannel::Translucent { pixels },
+    }
 }
 
 /// The longest PFM header accepted, in bytes: generous for two sizes and a scale.

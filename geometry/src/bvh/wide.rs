@@ -50,7 +50,7 @@ impl Link {
     }
 
     pub(super) fn leaf(first: usize, count: usize) -> Link {
-        debug_assert!(first % LEAF_WIDTH == 0 && (1..=LEAF_WIDTH).contains(&count));
+        debug_assert!(first.is_multiple_of(LEAF_WIDTH) && (1..=LEAF_WIDTH).contains(&count));
         let first = index_u32(first);
         assert!(first < LEAF_BIT, "BVH leaf position exceeds 2³¹");
         Link(LEAF_BIT | first | (count as u32 - 1))

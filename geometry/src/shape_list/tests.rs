@@ -97,7 +97,7 @@ mod bvh_agreement {
     /// `build_acceleration` builds for them, spheres and parallelograms in
     /// packets beside a BVH over the rest.
     fn build(list: &mut ShapeList, scene: u32) {
-        if scene % 2 == 0 {
+        if scene.is_multiple_of(2) {
             list.build_bvh();
         } else {
             list.build_acceleration();

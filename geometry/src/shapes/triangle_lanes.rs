@@ -370,8 +370,8 @@ mod tests {
             1 => corners[2] = corners[0] + 2.0 * (corners[1] - corners[0]),
             _ => {}
         }
-        let shared = round % 3 == 0;
-        let axis = Vec3::AXES[round % 3] * if round % 2 == 0 { 1.0 } else { -1.0 };
+        let shared = round.is_multiple_of(3);
+        let axis = Vec3::AXES[round % 3] * if round.is_multiple_of(2) { 1.0 } else { -1.0 };
         let origin = rng.vec3(-4.0, 4.0);
         let rays = std::array::from_fn(|k| {
             let corner = corners[k % 3];

@@ -4,7 +4,8 @@
 
 use crate::course::Scenes;
 use crate::hypothesis::{ReferencePlan, StatedSettings};
-use crate::reference::{references, Cache, GradeScene, References};
+use crate::jpeg::JpegEncoding;
+use crate::reference::{references, with_jpeg, Cache, GradeScene, References};
 use crate::submission::Submission;
 use crate::test::TestOptions;
 use crate::text::shorten;
@@ -18,8 +19,12 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
-/// The image extensions a submission may have.
-pub const IMAGE_EXTENSIONS: [&str; 6] = ["png", "ppm", "jpg", "jpeg", "exr", "pfm"];
+/// The image extensions a class folder's submissions may have (a file's
+/// content, not its name, says what it is).
+pub const IMAGE_EXTENSIONS: [&str; 14] = [
+    "png", "ppm", "pgm", "pnm", "jpg", "jpeg", "bmp", "tga", "hdr", "pic", "exr", "pfm", "pam",
+    "pbm",
+];
 
 /// The columns a manifest may have; the first three are required.
 pub const MANIFEST_COLUMNS: [&str; 8] = [
@@ -79,7 +84,7 @@ pub fn entries_from_folder(dir: &Path, stated: &StatedSettings) -> Result<Vec<En
     }
     if entries.is_empty() {
         return Err(GradeError::Input(format!(
-            "{}: no submissions found; expected images at {}/STUDENT/SCENE.png (or .ppm, .exr, .pfm, .jpg)",
+            "{}: no submissions found; expected images at {}/STUDENT/SCENE.png (or .jpg, .ppm, .bmp, .tga, .hdr, .exr, .pfm)",
             dir.display(),
             dir.display()
         )));
@@ -245,8 +250,8 @@ pub struct ClassOptions {
 #[derive(Clone, Debug, Serialize)]
 #[serde(tag = "status", rename_all = "snake_case")]
 pub enum Outcome {
-    /// Graded: passed or failed.
-    Graded(ImageGrade),
+    /// Graded: passed, failed, or found unreadable for grading.
+    Graded(Box<ImageGrade>),
     /// Not graded: the file could not be read, or its scene not found.
     Unreadable { message: String },
 }
@@ -371,17 +376,19 @@ pub fn render_references(
     part: Option<crate::parts::Part>,
 ) -> Result<(usize, usize), GradeError> {
     let (entries, loaded, probes) = probe(entries, scenes, base)?;
-    let (keys, _) = reference_keys(&entries, &probes);
-    let mine: Vec<&ReferenceKey> = keys
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| part.is_none_or(|p| p.has(*i)))
-        .map(|(_, key)| key)
-        .collect();
-    for key in &mine {
-        reference_group(key, &loaded, options, progress)?;
+    let (keys, row_groups) = reference_keys(&entries, &probes);
+    let mut groups = Vec::new();
+    let mut mine = vec![None; keys.len()];
+    for (i, key) in keys.iter().enumerate() {
+        if part.is_none_or(|p| p.has(i)) {
+            mine[i] = Some(groups.len());
+            groups.push(reference_group(key, &loaded, options, progress)?);
+        }
     }
-    Ok((mine.len(), keys.len()))
+    let row_groups: Vec<Option<usize>> =
+        row_groups.iter().map(|g| g.and_then(|g| mine[g])).collect();
+    through_jpeg(&mut groups, &probes, &row_groups, options, progress)?;
+    Ok((groups.len(), keys.len()))
 }
 
 /// The entries with their settings completed, what each submission needs,
@@ -402,10 +409,11 @@ fn prepare(
 ) -> Result<Prepared, GradeError> {
     let (entries, loaded, probes) = probe(entries, scenes, base)?;
     let (keys, row_groups) = reference_keys(&entries, &probes);
-    let groups = keys
+    let mut groups: Vec<Group> = keys
         .iter()
         .map(|key| reference_group(key, &loaded, options, progress))
         .collect::<Result<_, _>>()?;
+    through_jpeg(&mut groups, &probes, &row_groups, options, progress)?;
     Ok(Prepared {
         entries,
         probes,
@@ -430,14 +438,17 @@ fn probe(
             let path = found.clone()?;
             loaded[&path].as_ref().map_err(Clone::clone)?;
             let submission = Submission::load(&entry.file)?;
-            Ok((path, submission.resolution()))
+            let resolution = submission.resolution();
+            let jpeg = submission.jpeg.and_then(Result::ok);
+            Ok((path, resolution, jpeg))
         })
         .collect();
     Ok((entries, loaded, probes))
 }
 
-/// A submission's scene file and resolution, or why it cannot be graded.
-type Probe = Result<(PathBuf, UVec2), String>;
+/// A submission's scene file, resolution and JPEG encoding (if it is a JPEG
+/// Glint can encode its renders as), or why it cannot be graded.
+type Probe = Result<(PathBuf, UVec2, Option<JpegEncoding>), String>;
 
 /// The scenes, each loaded once, by file; one that is missing or does not
 /// load fails only its rows.
@@ -475,7 +486,7 @@ fn reference_keys(
         .iter()
         .zip(probes)
         .map(|((entry, _), probe)| {
-            let (path, resolution) = probe.as_ref().ok()?;
+            let (path, resolution, _) = probe.as_ref().ok()?;
             let key = (path.clone(), *resolution, entry.stated);
             Some(keys.iter().position(|k| *k == key).unwrap_or_else(|| {
                 keys.push(key);
@@ -484,6 +495,33 @@ fn reference_keys(
         })
         .collect();
     (keys, row_groups)
+}
+
+/// Passes the references of each group through the JPEG encodings of the
+/// submissions judged against them (each row's group in `row_groups`).
+fn through_jpeg(
+    groups: &mut [Group],
+    probes: &[Probe],
+    row_groups: &[Option<usize>],
+    options: &ClassOptions,
+    progress: &dyn Progress,
+) -> Result<(), GradeError> {
+    for (probe, group) in probes.iter().zip(row_groups) {
+        let (Ok((_, _, Some(encoding))), Some(g)) = (probe, group) else {
+            continue;
+        };
+        let group = &mut groups[*g];
+        let rendering = |what: &str| progress.rendering(what);
+        let scene = Arc::clone(&group.scene);
+        with_jpeg(
+            &mut group.references,
+            &scene,
+            encoding,
+            &options.cache,
+            &rendering,
+        )?;
+    }
+    Ok(())
 }
 
 /// The references of `key`, rendered or read from the cache.
@@ -595,7 +633,7 @@ fn grade_row(
         &entry.stated,
         &options.test,
     );
-    row.outcome = Outcome::Graded(grade);
+    row.outcome = Outcome::Graded(Box::new(grade));
     on_graded(index, &row, &submission, group)?;
     Ok(row)
 }

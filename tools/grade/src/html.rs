@@ -180,16 +180,13 @@ fn page(rows: &[ReportRow]) -> String {
         .enumerate()
         .map(|(k, s)| format!("<th data-column=\"{}\">{}</th>", k + 2, escape(s)))
         .collect();
-    let count = |v: &str| rows.iter().filter(|r| r.verdict == v).count();
+    let counts = crate::report::counts(rows);
     format!(
         include_str!("report.html"),
-        summary = format!(
-            "{} submissions from {} students: {} pass, {} fail, {} not graded",
-            rows.len(),
-            students.len(),
-            count("pass"),
-            count("fail"),
-            count("error")
+        summary = counts.replacen(
+            " submissions:",
+            &format!(" submissions from {} students:", students.len()),
+            1
         ),
         header = header,
         body = body,
@@ -210,9 +207,10 @@ fn cell(index: usize, row: &ReportRow) -> String {
         None => String::new(),
     };
     format!(
-        "<td data-sort=\"{}\" class=\"{v}\"><span class=\"verdict\">{v}</span>{images}<div class=\"note\">{}</div><div class=\"file\">{}</div></td>",
+        "<td data-sort=\"{}\" class=\"{v}\"><span class=\"verdict\">{v}</span>{images}<div class=\"note\">{}</div><div class=\"file\" title=\"{}\">{}</div></td>",
         row.sort_key,
         escape(&row.summary),
+        escape(&row.format),
         escape(&row.file),
     )
 }

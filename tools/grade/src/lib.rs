@@ -30,6 +30,7 @@ pub mod course;
 pub mod heatmap;
 pub mod html;
 pub mod hypothesis;
+pub mod jpeg;
 pub mod output;
 pub mod parts;
 pub mod reference;
@@ -40,10 +41,11 @@ pub mod test;
 pub mod text;
 
 pub use hypothesis::{ReferencePlan, StatedSettings};
-pub use reference::{references, Cache, GradeScene, References};
+pub use reference::{references, with_jpeg, Cache, GradeScene, References};
 pub use submission::Submission;
 pub use test::{Outcome, Place, TestOptions};
 
+use glam::Vec3;
 use serde::Serialize;
 
 /// Why grading could not be done: bad input (exit status 2 on the command
@@ -64,6 +66,17 @@ pub const CHANNELS: [&str; 3] = ["R", "G", "B"];
 pub struct ImageGrade {
     pub file: String,
     pub passed: bool,
+    /// Why the file cannot be graded, where its format lost what the test
+    /// needs (a JPEG below quality 50, a palette of fewer colours than the
+    /// render, a gray image of a colour scene): neither a pass nor a fail.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unreadable: Option<String>,
+    /// What the file was read as ("JPEG, quality 75, 4:2:0").
+    pub format: String,
+    /// What the grade should be read with (an alpha channel that was not
+    /// opaque, ignored).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
     pub resolution: [u32; 2],
     /// The settings the submission was judged under.
     pub settings: String,
@@ -115,7 +128,9 @@ impl RegionFinding {
     }
 }
 
-/// Grades `submission` against `refs` of `scene`.
+/// Grades `submission` against `refs` of `scene`. A JPEG submission's
+/// references must have been passed through its encoding first
+/// ([`with_jpeg`]).
 pub fn grade_image(
     scene: &GradeScene,
     refs: &References,
@@ -124,11 +139,42 @@ pub fn grade_image(
     options: &TestOptions,
 ) -> ImageGrade {
     let size = refs.resolution;
+    let mut grade = ImageGrade {
+        file: submission.path.display().to_string(),
+        passed: false,
+        unreadable: None,
+        format: submission.format.clone(),
+        notes: notes(submission),
+        resolution: [size.x, size.y],
+        settings: stated.describe(),
+        tests: 0,
+        alpha: options.alpha,
+        rejected: Vec::new(),
+        largest_accepted_z: 0.0,
+        noise: 0.0,
+        outcome: Outcome {
+            findings: Vec::new(),
+            alpha: options.alpha,
+            largest_accepted_z: 0.0,
+            noise: 0.0,
+        },
+        regions: Vec::new(),
+    };
+    if let Some(reason) = unreadable_for_grading(submission, refs) {
+        grade.unreadable = Some(reason);
+        return grade;
+    }
+    let jpeg = match &submission.jpeg {
+        Some(Ok(encoding)) => Some(refs.through_jpeg(encoding).expect(
+            "the references of a JPEG submission are passed through its encoding (with_jpeg) before grading",
+        )),
+        _ => None,
+    };
     let block = options
         .block
         .unwrap_or_else(|| test::block_side(size.x, size.y));
     let regions = test::regions(size.x, size.y, block, &refs.objects);
-    let bands = test::Bands::new(submission, refs);
+    let bands = test::Bands::new(submission, refs, jpeg);
     let outcome = test::test(submission, &bands, &regions, options);
     let mut rejected: Vec<RegionFinding> = Vec::new();
     for f in outcome.rejections() {
@@ -152,18 +198,77 @@ pub fn grade_image(
         }
     }
     ImageGrade {
-        file: submission.path.display().to_string(),
         passed: outcome.passed(),
-        resolution: [size.x, size.y],
-        settings: stated.describe(),
         tests: outcome.findings.len(),
-        alpha: options.alpha,
         rejected,
         largest_accepted_z: outcome.largest_accepted_z,
         noise: outcome.noise,
         regions: regions.into_iter().map(|r| r.place).collect(),
         outcome,
+        ..grade
     }
+}
+
+/// What a grade of `submission` should be read with.
+fn notes(submission: &Submission) -> Vec<String> {
+    match submission.alpha {
+        glint_camera::AlphaChannel::Translucent { pixels } => vec![format!(
+            "its alpha channel is below 1 in {pixels} pixels; alpha is not graded, the colour channels are, as stored"
+        )],
+        _ => Vec::new(),
+    }
+}
+
+/// Why the file of `submission` cannot be graded against `refs`, if its
+/// format lost what the test needs: then it neither passes nor fails.
+fn unreadable_for_grading(submission: &Submission, refs: &References) -> Option<String> {
+    if let Some(jpeg) = &submission.jpeg {
+        match jpeg {
+            Err(reason) => return Some(reason.clone()),
+            Ok(encoding) => {
+                if let Some(reason) = encoding.too_lossy() {
+                    return Some(reason);
+                }
+            }
+        }
+    }
+    if submission.gray && colourful(&refs.mean.mean) {
+        return Some(
+            "a gray image of a scene in colour: its format kept one channel of three".into(),
+        );
+    }
+    if let Some(colours) = submission.palette {
+        let rendered = eight_bit_colours(&refs.mean.mean);
+        if colours < rendered {
+            return Some(format!(
+                "a palette image of {colours} colours, where Glint's render of the scene has {rendered}: the palette merged colours the test needs"
+            ));
+        }
+    }
+    None
+}
+
+/// Whether at least 1% of the pixels differ between channels by more than
+/// 0.01 (linear).
+fn colourful(pixels: &[Vec3]) -> bool {
+    let coloured = pixels
+        .iter()
+        .filter(|p| {
+            let p = p.min(Vec3::ONE);
+            p.max_element() - p.min_element() > 0.01
+        })
+        .count();
+    coloured * 100 > pixels.len()
+}
+
+/// The number of distinct 8-bit sRGB colours of `pixels`: the fewest a
+/// lossless palette of the render needs (noise only adds more).
+fn eight_bit_colours(pixels: &[Vec3]) -> usize {
+    let colours: std::collections::HashSet<[u8; 3]> = pixels
+        .iter()
+        .map(|p| p.to_array().map(glint_camera::linear_to_srgb8))
+        .collect();
+    colours.len()
 }
 
 /// A region's name: its object's, or a block's pixels and the objects its

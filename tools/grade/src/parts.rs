@@ -377,6 +377,7 @@ mod tests {
             student: "ada".into(),
             scene: "set1".into(),
             file: "ada/set1.png".into(),
+            format: String::new(),
             verdict: "error".into(),
             summary: String::new(),
             numbers: Default::default(),

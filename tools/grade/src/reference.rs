@@ -2,11 +2,13 @@
 //! resolution: the mean reference `M` and the clamp-gap reference `G` (see
 //! [`hypothesis`](crate::hypothesis)), each the mean of independent rounds
 //! with the variance of that mean; and the object seen at each pixel's
-//! centre, which names the regions of a report. Rendered references are
+//! centre, which names the regions of a report; and, for a JPEG submission,
+//! both passed through its encoding ([`with_jpeg`]). Rendered references are
 //! cached (the same files and key as `glint bench`'s), so that a class's
 //! submissions of one scene pay for them once.
 
 use crate::hypothesis::ReferencePlan;
+use crate::jpeg::JpegEncoding;
 use crate::GradeError;
 use glam::{UVec2, Vec3};
 use glint_bench::reference::{cache_key, round_seed, CachePaths, Origin, RoundSums};
@@ -95,6 +97,28 @@ pub struct References {
     pub objects: Vec<u32>,
     /// Time spent rendering (zero when everything came from the cache).
     pub render_time: Duration,
+    /// The references through each JPEG encoding a submission judged
+    /// against them has ([`with_jpeg`]).
+    pub jpeg: Vec<JpegReference>,
+}
+
+impl References {
+    /// The references through `encoding`, if they were made.
+    pub fn through_jpeg(&self, encoding: &JpegEncoding) -> Option<&JpegReference> {
+        self.jpeg.iter().find(|j| &j.encoding == encoding)
+    }
+}
+
+/// Glint's renders as a JPEG submission's file would hold them: each passed
+/// through its encoding ([`JpegEncoding::round_trip`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct JpegReference {
+    pub encoding: JpegEncoding,
+    /// Each round of the sample reference through the encoding: `E[J(X_s)]`,
+    /// what a file of the submission's own estimator holds, noise included.
+    pub samples: Estimate,
+    /// The mean reference through the encoding: `J(M)`, the noiseless end.
+    pub mean: Vec<Vec3>,
 }
 
 /// Where rendered references are kept; `None` renders them every time.
@@ -113,11 +137,7 @@ pub fn references(
     progress: &(dyn Fn(&str) + Sync),
 ) -> Result<References, GradeError> {
     let start = Instant::now();
-    let mut rendered = scene.description.scene.clone();
-    rendered.camera = rendered
-        .camera
-        .with_resolution(resolution)
-        .map_err(|e| GradeError::Input(format!("{}: {e}", scene.path.display())))?;
+    let rendered = at_resolution(scene, resolution)?;
     let job = Job {
         scene,
         rendered: &rendered,
@@ -125,10 +145,11 @@ pub fn references(
         cache,
         progress,
     };
-    let [mean] = job.estimates("mean", &[identity], &plan.mean, plan.mean_rounds)?;
+    let [mean] = job.estimates("mean", "", [&each(identity)], &plan.mean, plan.mean_rounds)?;
     let [radiance, clamped, gap] = job.estimates(
         "sample",
-        &[identity, clamp, excess],
+        "",
+        [&each(identity), &each(clamp), &each(excess)],
         &plan.samples,
         plan.sample_rounds,
     )?;
@@ -148,7 +169,79 @@ pub fn references(
         } else {
             start.elapsed()
         },
+        jpeg: Vec::new(),
     })
+}
+
+/// Adds to `refs` (of `scene`) the references through `encoding`, unless
+/// they are there: the sample reference's rounds rendered again (the same
+/// seeds, so the same rounds) and each passed through the encoding, or read
+/// from the cache; and the mean reference through it.
+pub fn with_jpeg(
+    refs: &mut References,
+    scene: &GradeScene,
+    encoding: &JpegEncoding,
+    cache: &Cache,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<(), GradeError> {
+    if refs.through_jpeg(encoding).is_some() {
+        return Ok(());
+    }
+    let (w, h) = (refs.resolution.x, refs.resolution.y);
+    let rendered = at_resolution(scene, refs.resolution)?;
+    let job = Job {
+        scene,
+        rendered: &rendered,
+        resolution: refs.resolution,
+        cache,
+        progress,
+    };
+    let through = |pixels: &[Vec3], out: &mut Vec<Vec3>| {
+        out.extend(encoding.round_trip(pixels, w, h)?);
+        Ok(())
+    };
+    let tag = format!(" through JPEG {}", encoding.key());
+    let [samples] = job.estimates(
+        "sample",
+        &tag,
+        [&through],
+        &refs.plan.samples,
+        refs.plan.sample_rounds,
+    )?;
+    let mean = encoding
+        .round_trip(&refs.mean.mean, w, h)
+        .map_err(GradeError::Internal)?;
+    refs.jpeg.push(JpegReference {
+        encoding: encoding.clone(),
+        samples,
+        mean,
+    });
+    Ok(())
+}
+
+/// `scene`'s scene with its camera's film at `resolution`.
+fn at_resolution(
+    scene: &GradeScene,
+    resolution: UVec2,
+) -> Result<glint_integrator::Scene, GradeError> {
+    let mut rendered = scene.description.scene.clone();
+    rendered.camera = rendered
+        .camera
+        .with_resolution(resolution)
+        .map_err(|e| GradeError::Input(format!("{}: {e}", scene.path.display())))?;
+    Ok(rendered)
+}
+
+/// What a reference keeps of each round's film: its pixels transformed
+/// (clamped, say), or the whole image passed through a file format.
+type Transform<'a> = &'a (dyn Fn(&[Vec3], &mut Vec<Vec3>) -> Result<(), String> + Sync);
+
+/// The transform that applies `f` to each pixel.
+fn each(f: fn(Vec3) -> Vec3) -> impl Fn(&[Vec3], &mut Vec<Vec3>) -> Result<(), String> + Sync {
+    move |pixels, out| {
+        out.extend(pixels.iter().map(|&p| f(p)));
+        Ok(())
+    }
 }
 
 fn identity(x: Vec3) -> Vec3 {
@@ -181,19 +274,22 @@ struct Job<'a> {
 
 impl Job<'_> {
     /// The mean and variance of the mean of each of `transforms` of the
-    /// radiance, over `rounds` renders with `settings`: from the cache when
-    /// all are there, else rendered (and stored).
+    /// radiance, over `rounds` renders with `settings` (seeded by `name`):
+    /// from the cache when all are there, else rendered (and stored). `tag`
+    /// tells transforms of the same name apart in the cache (a JPEG
+    /// encoding's tables).
     fn estimates<const K: usize>(
         &self,
         name: &str,
-        transforms: &[fn(Vec3) -> Vec3; K],
+        tag: &str,
+        transforms: [Transform; K],
         settings: &RenderSettings,
         rounds: u32,
     ) -> Result<[Estimate; K], GradeError> {
         let (w, h) = (self.resolution.x, self.resolution.y);
         let fingerprint = |k: usize| {
             format!(
-                "glint-grade {name} reference, transform {k} of {K}, rounds={rounds} {}",
+                "glint-grade {name} reference{tag}, transform {k} of {K}, rounds={rounds} {}",
                 glint_bench::reference::settings_fingerprint(settings, w, h)
             )
         };
@@ -244,7 +340,7 @@ impl Job<'_> {
                 .map_err(|e| GradeError::Internal(format!("reference render: {e}")))?;
             for (sum, transform) in sums.iter_mut().zip(transforms) {
                 buffer.clear();
-                buffer.extend(output.film.pixels().iter().map(|&p| transform(p)));
+                transform(output.film.pixels(), &mut buffer).map_err(GradeError::Internal)?;
                 sum.add(&buffer);
             }
         }

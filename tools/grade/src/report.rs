@@ -10,11 +10,13 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 /// The schema name of the JSON document.
-pub const SCHEMA: &str = "glint-grade/1";
+pub const SCHEMA: &str = "glint-grade/2";
 
-/// A submission's verdict in one word.
+/// A submission's verdict in one word: "pass", "fail", "unreadable" (for
+/// grading: its format lost what the test needs) or "error" (not read).
 pub fn verdict(row: &Row) -> &'static str {
     match &row.outcome {
+        Outcome::Graded(g) if g.unreadable.is_some() => "unreadable",
         Outcome::Graded(g) if g.passed => "pass",
         Outcome::Graded(_) => "fail",
         Outcome::Unreadable { .. } => "error",
@@ -57,6 +59,10 @@ pub fn finding_phrase(f: &RegionFinding) -> String {
 /// What the table and CSV say of a row beyond its verdict.
 pub fn summary(row: &Row) -> String {
     match &row.outcome {
+        Outcome::Graded(g) if g.unreadable.is_some() => format!(
+            "unreadable for grading: {}",
+            g.unreadable.as_deref().unwrap_or_default()
+        ),
         Outcome::Graded(g) if g.passed => format!(
             "largest |z| {} of {} tests",
             z_text(g.largest_accepted_z),
@@ -107,7 +113,9 @@ pub struct ReportRow {
     pub student: String,
     pub scene: String,
     pub file: String,
-    /// "pass", "fail" or "error" ([`verdict`]).
+    /// What the file was read as, where it could be read.
+    pub format: String,
+    /// "pass", "fail", "unreadable" or "error" ([`verdict`]).
     pub verdict: String,
     /// What the table and CSV say beyond the verdict ([`summary`]).
     pub summary: String,
@@ -115,8 +123,8 @@ pub struct ReportRow {
     pub numbers: [String; 5],
     /// The submission in `grades.json`.
     pub json: Value,
-    /// The HTML cell's sort key: failures by their evidence, then errors,
-    /// then passes.
+    /// The HTML cell's sort key: failures by their evidence, then the
+    /// unreadable, then errors, then passes.
     pub sort_key: String,
     /// The reference set it is judged against, where its scene and
     /// resolution could be read: the report's `images/reference-G.png`.
@@ -131,6 +139,10 @@ impl ReportRow {
             student: row.student.clone(),
             scene: row.scene.clone(),
             file: row.file.clone(),
+            format: match &row.outcome {
+                Outcome::Graded(g) => g.format.clone(),
+                Outcome::Unreadable { .. } => String::new(),
+            },
             verdict: verdict(row).to_owned(),
             summary: summary(row),
             numbers: csv_numbers(row),
@@ -150,9 +162,11 @@ impl ReportRow {
     }
 }
 
-/// Orders failures by their evidence, then errors, then passes.
+/// Orders failures by their evidence, then the unreadable, then errors, then
+/// passes.
 fn sort_key(row: &Row) -> f64 {
     match &row.outcome {
+        Outcome::Graded(g) if g.unreadable.is_some() => 4e8,
         Outcome::Graded(g) if g.passed => 1e9 - g.largest_accepted_z,
         Outcome::Graded(g) => g
             .rejected
@@ -204,29 +218,49 @@ pub fn table(report: &[ReportRow]) -> String {
     for r in &rows {
         out += &line([&r[0], &r[1], &r[2], &r[3]]);
     }
-    out += &format!(
-        "\n{} submissions: {} pass, {} fail, {} not graded\n",
+    out += &format!("\n{}\n", counts(report));
+    out
+}
+
+/// "3 submissions: 1 pass, 1 fail, 1 not graded", with the unreadable for
+/// grading where there are any.
+pub fn counts(report: &[ReportRow]) -> String {
+    let unreadable = match count(report, "unreadable") {
+        0 => String::new(),
+        n => format!(", {n} unreadable for grading"),
+    };
+    format!(
+        "{} submissions: {} pass, {} fail{unreadable}, {} not graded",
         report.len(),
         count(report, "pass"),
         count(report, "fail"),
         count(report, "error")
-    );
-    out
+    )
 }
 
-/// One submission in detail: every rejected region (up to `limit`) with its
-/// numbers.
+/// One submission in detail: what its file was read as, every rejected
+/// region (up to `limit`) with its numbers.
 pub fn details(grade: &ImageGrade, limit: usize) -> String {
+    if let Some(reason) = &grade.unreadable {
+        return format!(
+            "{}: unreadable for grading ({}x{}, {}): {reason}\n",
+            grade.file, grade.resolution[0], grade.resolution[1], grade.format,
+        );
+    }
     let mut out = format!(
-        "{}: {} ({}x{}, settings {}; {} tests at α = {})\n",
+        "{}: {} ({}x{}, {}, settings {}; {} tests at α = {})\n",
         grade.file,
         if grade.passed { "pass" } else { "FAIL" },
         grade.resolution[0],
         grade.resolution[1],
+        grade.format,
         grade.settings,
         grade.tests,
         grade.alpha,
     );
+    for note in &grade.notes {
+        out += &format!("  note: {note}\n");
+    }
     if grade.passed {
         out += &format!(
             "  no region differs beyond its noise; largest |z| {}; noise {} per pixel\n",
@@ -259,10 +293,11 @@ pub fn details(grade: &ImageGrade, limit: usize) -> String {
 }
 
 /// The CSV columns.
-pub const CSV_COLUMNS: [&str; 10] = [
+pub const CSV_COLUMNS: [&str; 11] = [
     "student",
     "scene",
     "file",
+    "format",
     "verdict",
     "rejected",
     "tests",
@@ -276,6 +311,7 @@ pub const CSV_COLUMNS: [&str; 10] = [
 /// submission was not graded.
 fn csv_numbers(row: &Row) -> [String; 5] {
     match &row.outcome {
+        Outcome::Graded(g) if g.unreadable.is_some() => Default::default(),
         Outcome::Graded(g) => {
             let worst = g.rejected.first();
             let largest = worst.map_or(g.largest_accepted_z, |f| f.strongest().z);
@@ -302,6 +338,7 @@ pub fn csv(report: &[ReportRow]) -> String {
                 row.student.as_str(),
                 &row.scene,
                 &row.file,
+                &row.format,
                 &row.verdict,
                 rejected,
                 tests,
@@ -323,6 +360,7 @@ pub fn json(report: &[ReportRow]) -> Value {
         "submissions": rows,
         "pass": count(report, "pass"),
         "fail": count(report, "fail"),
+        "unreadable": count(report, "unreadable"),
         "error": count(report, "error"),
     })
 }

@@ -1,8 +1,10 @@
-//! A submitted image, decoded to linear RGB, and what its file format did to
-//! the radiance it was written from: clamping and quantisation.
+//! A submitted image, decoded to linear RGB, and what its file did to the
+//! radiance it was written from: clamping, rounding to the step its values
+//! show, and, for JPEG, the encoding the references are put through.
 
+use crate::jpeg::JpegEncoding;
 use glam::{UVec2, Vec3};
-use glint_camera::{srgb_to_linear, Film, SampleEncoding};
+use glint_camera::{srgb_to_linear, AlphaChannel, FileFormat, Film, SampleEncoding};
 use std::path::{Path, PathBuf};
 
 /// A submission: linear RGB per pixel and how it was stored.
@@ -14,19 +16,30 @@ pub struct Submission {
     /// Whether values above 1 were clamped: always for integer formats, and
     /// for a float image none of whose values exceeds 1.
     pub clamped: bool,
+    /// What the file was read as, in words ("JPEG, quality 75, 4:2:0").
+    pub format: String,
+    pub alpha: AlphaChannel,
+    /// The file holds one gray channel.
+    pub gray: bool,
+    /// The file's pixels index a palette of this many colours (those it uses).
+    pub palette: Option<usize>,
+    /// A JPEG's encoding (its tables and subsampling), or why Glint cannot
+    /// encode its renders the same way.
+    pub jpeg: Option<Result<JpegEncoding, String>>,
 }
 
 impl Submission {
-    /// Reads a PNG, PPM, JPEG, OpenEXR or PFM file.
+    /// Reads an image file of any format Glint reads ([`Film::read`]).
     pub fn load(path: &Path) -> Result<Submission, String> {
-        let (film, encoding) = Film::load_with_encoding(path).map_err(|e| e.to_string())?;
-        if let Some((i, _)) = film
+        let file = Film::read(path).map_err(|e| e.to_string())?;
+        if let Some((i, _)) = file
+            .film
             .pixels()
             .iter()
             .enumerate()
             .find(|(_, p)| !p.is_finite())
         {
-            let width = film.resolution().x as usize;
+            let width = file.film.resolution().x as usize;
             return Err(format!(
                 "{}: pixel ({}, {}) is not a finite number; a render's pixels are finite",
                 path.display(),
@@ -34,20 +47,39 @@ impl Submission {
                 i / width
             ));
         }
-        Ok(Submission::new(path.to_owned(), film, encoding))
+        let jpeg = (file.format == FileFormat::Jpeg).then(|| JpegEncoding::from_file(path));
+        let mut format = file.description();
+        if let Some(Ok(encoding)) = &jpeg {
+            // "JPEG, gray" + ", quality 90" reads better without the repeat.
+            format = format.replacen("JPEG, gray", "JPEG", 1);
+            format = format.replacen("JPEG", &format!("JPEG, {}", encoding.description()), 1);
+        }
+        let palette = file.indexed.then(|| distinct_colours(&file.film));
+        let mut submission = Submission::new(path.to_owned(), file.film, file.encoding);
+        submission.format = format;
+        submission.alpha = file.alpha;
+        submission.gray = file.gray;
+        submission.palette = palette;
+        submission.jpeg = jpeg;
+        Ok(submission)
     }
 
     /// A submission from an image already in memory.
     pub fn new(path: PathBuf, film: Film, encoding: SampleEncoding) -> Submission {
         let clamped = match encoding {
             SampleEncoding::Srgb { .. } => true,
-            SampleEncoding::Linear => film.pixels().iter().all(|p| p.max_element() <= 1.0),
+            _ => film.pixels().iter().all(|p| p.max_element() <= 1.0),
         };
         Submission {
             path,
             film,
             encoding,
             clamped,
+            format: "an image in memory".into(),
+            alpha: AlphaChannel::Absent,
+            gray: false,
+            palette: None,
+            jpeg: None,
         }
     }
 
@@ -56,27 +88,84 @@ impl Submission {
     }
 
     /// Per pixel and channel, how far the stored value may lie from the value
-    /// it was written from, in linear units: one code step of an integer
-    /// format at that value (rounding costs half a step, truncation up to one),
-    /// or a relative 1e-5 of a float.
+    /// it was written from, in linear units: one step of what the file
+    /// rounded to (an integer format's code step at that value, in the
+    /// levels the data shows: rounding costs half a step, truncation up to
+    /// one; a shared exponent's mantissa step), or a relative 1e-5 of a
+    /// 32-bit float (a relative step of a half float).
     pub fn tolerance(&self) -> Vec<Vec3> {
+        let pixels = self.film.pixels();
         match self.encoding {
-            SampleEncoding::Linear => self
-                .film
-                .pixels()
-                .iter()
-                .map(|p| p.abs() * 1e-5 + Vec3::splat(1e-7))
-                .collect(),
-            SampleEncoding::Srgb { max_code } => {
-                let steps = CodeSteps::new(max_code);
-                self.film
-                    .pixels()
+            SampleEncoding::Float { mantissa_bits } => {
+                let relative = 1e-5f32.max(2f32.powi(-(mantissa_bits as i32)));
+                pixels
                     .iter()
-                    .map(|p| Vec3::from_array(p.to_array().map(|c| steps.at(c))))
+                    .map(|p| p.abs() * relative + Vec3::splat(1e-7))
+                    .collect()
+            }
+            SampleEncoding::SharedExponent => pixels
+                .iter()
+                .map(|p| Vec3::splat(shared_exponent_step(p.max_element()) + 1e-7))
+                .collect(),
+            SampleEncoding::Srgb { levels, .. } => {
+                let steps = levels.map(CodeSteps::new);
+                pixels
+                    .iter()
+                    .map(|p| Vec3::from_array(std::array::from_fn(|c| steps[c].at(p[c]))))
                     .collect()
             }
         }
     }
+}
+
+impl Submission {
+    /// Per pixel and channel, the variance of what the file's rounding adds
+    /// to the pixel, scaled so that its sum over a region divided by the
+    /// region's pixel count squared bounds the variance it adds to the
+    /// region's mean: `step² / 12` of a code step; for a JPEG also the
+    /// rounding of each block's DC coefficient, which an encoder other than
+    /// the submission's (Glint's, re-encoding its renders) may round the
+    /// other way where it lies near a half step. Each block's mean then
+    /// moves by one DC step (`Q₀ / 8` codes) or not, a variance of at most
+    /// `(Q₀ / 16)²` shared by the block's `B²` pixels, independent between
+    /// blocks; carried by each pixel as `B² (Q₀ / 16)²`, its sum over a
+    /// region of `n` pixels divided by `n²` is at least that variance. So no
+    /// region is without noise, and a block whose encoders disagree by one
+    /// step is no failure.
+    pub fn precision(&self) -> Vec<Vec3> {
+        let rounding = self.tolerance().into_iter().map(|t| t * t / 12.0);
+        let Some(Ok(jpeg)) = &self.jpeg else {
+            return rounding.collect();
+        };
+        let steps = CodeSteps::new(255);
+        let dc = jpeg.dc_flip_variance();
+        rounding
+            .zip(self.film.pixels())
+            .map(|(r, p)| {
+                let code = Vec3::from_array(std::array::from_fn(|c| steps.at(p[c])));
+                r + dc * code * code
+            })
+            .collect()
+    }
+}
+
+/// The number of distinct colours in `film`.
+fn distinct_colours(film: &Film) -> usize {
+    let colours: std::collections::HashSet<[u32; 3]> = film
+        .pixels()
+        .iter()
+        .map(|p| p.to_array().map(f32::to_bits))
+        .collect();
+    colours.len()
+}
+
+/// One mantissa step of a Radiance RGBE pixel whose largest channel is
+/// `top`: its 8 bits span the power of two above `top`.
+fn shared_exponent_step(top: f32) -> f32 {
+    if top <= 0.0 || !top.is_finite() {
+        return 0.0;
+    }
+    2f32.powi(top.log2().floor() as i32 + 1 - 8)
 }
 
 /// The linear width of the code steps of an sRGB-encoded integer format.
@@ -133,15 +222,58 @@ mod tests {
     }
 
     #[test]
+    fn the_tolerance_follows_the_levels_the_data_shows() {
+        let mut film = Film::new(UVec2::new(1, 1));
+        film.set_pixel(0, 0, Vec3::splat(0.2));
+        let eight = Submission::new(
+            "a.png".into(),
+            film.clone(),
+            SampleEncoding::Srgb {
+                levels: [255; 3],
+                stored: 65535,
+            },
+        );
+        let sixteen = Submission::new(
+            "a.png".into(),
+            film.clone(),
+            SampleEncoding::Srgb {
+                levels: [65535; 3],
+                stored: 65535,
+            },
+        );
+        let ratio = eight.tolerance()[0].x / sixteen.tolerance()[0].x;
+        assert!((ratio - 257.0).abs() < 3.0, "{ratio}");
+        // A half float's step is 2⁻¹⁰ of the value, a 32-bit float's 1e-5.
+        let half = Submission::new(
+            "a.exr".into(),
+            film.clone(),
+            SampleEncoding::Float { mantissa_bits: 10 },
+        );
+        assert!((half.tolerance()[0].x - 0.2 / 1024.0 - 1e-7).abs() < 1e-9);
+        // RGBE: 1/256 of the power of two above the pixel's largest channel.
+        film.set_pixel(0, 0, Vec3::new(0.3, 0.1, 0.01));
+        let rgbe = Submission::new("a.hdr".into(), film, SampleEncoding::SharedExponent);
+        assert_eq!(rgbe.tolerance()[0], Vec3::splat(0.5 / 256.0 + 1e-7));
+    }
+
+    #[test]
     fn float_images_count_as_clamped_only_when_nothing_exceeds_one() {
         let mut film = Film::new(UVec2::new(2, 1));
         film.set_pixel(0, 0, Vec3::splat(0.5));
-        let clamped = Submission::new("a.pfm".into(), film.clone(), SampleEncoding::Linear);
+        let float = SampleEncoding::Float { mantissa_bits: 23 };
+        let clamped = Submission::new("a.pfm".into(), film.clone(), float);
         assert!(clamped.clamped);
         film.set_pixel(1, 0, Vec3::new(0.0, 1.5, 0.0));
-        let open = Submission::new("a.pfm".into(), film.clone(), SampleEncoding::Linear);
+        let open = Submission::new("a.pfm".into(), film.clone(), float);
         assert!(!open.clamped);
-        let png = Submission::new("a.png".into(), film, SampleEncoding::Srgb { max_code: 255 });
+        let png = Submission::new(
+            "a.png".into(),
+            film,
+            SampleEncoding::Srgb {
+                levels: [255; 3],
+                stored: 255,
+            },
+        );
         assert!(png.clamped);
         assert!(open.tolerance()[1].y < 2e-5);
     }

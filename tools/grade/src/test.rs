@@ -28,7 +28,7 @@
 //! which keeps the chance of failing a correct image at `α` or below (as
 //! Nori's Student's t-tests of integrators do with Šidák's correction).
 
-use crate::reference::{References, BACKGROUND};
+use crate::reference::{JpegReference, References, BACKGROUND};
 use crate::submission::Submission;
 use glam::Vec3;
 use serde::Serialize;
@@ -191,12 +191,31 @@ pub struct Bands {
     pub noise: Vec<Vec3>,
     /// What `noise` is multiplied by (`None`: fitted to the submission).
     pub noise_scale: Option<f64>,
+    /// How a noise scale is fitted to the submission.
+    pub fit: NoiseFit,
+}
+
+/// How the scale of a submission's noise is fitted when its sample counts
+/// are not known.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NoiseFit {
+    /// The median over blocks of the submission's own spread within each
+    /// block against the sample reference's noise.
+    WithinBlocks,
+    /// From the differences of neighbouring `side × side` blocks' means
+    /// against their noise: for a JPEG, which smooths the spread within a
+    /// block away but keeps each block's mean and so its noise.
+    BetweenBlocks { side: u32 },
 }
 
 impl Bands {
     /// The bands of `submission` under `refs` (`lo = hi = M` unclamped, else
-    /// `[M − G, min(M, 1)]`).
-    pub fn new(submission: &Submission, refs: &References) -> Bands {
+    /// `[M − G, min(M, 1)]`), or, for a JPEG, under the references through its
+    /// encoding, `jpeg`: between `E[J(X_s)]` and `J(M)`.
+    pub fn new(submission: &Submission, refs: &References, jpeg: Option<&JpegReference>) -> Bands {
+        if let Some(jpeg) = jpeg {
+            return Bands::through_jpeg(refs, jpeg);
+        }
         let (mean, samples) = (&refs.mean, &refs.samples);
         let pixels = mean.mean.len();
         let (lo, hi, reference_variance, noise) = match submission.clamped {
@@ -228,6 +247,33 @@ impl Bands {
             reference_variance,
             noise,
             noise_scale: refs.plan.variance_scale,
+            fit: NoiseFit::WithinBlocks,
+        }
+    }
+
+    /// A JPEG's bands: its expected value lies between that of a file of the
+    /// sample reference's estimator, `E[J(X_s)]` (its noise), and `J(M)` (no
+    /// noise), as a clamped one lies between `M − G` and `min(M, 1)`. The
+    /// encoding smooths each block's noise but keeps its mean, so the noise
+    /// floor and the references' variance are those before it (exact for the
+    /// blocks the encoding keeps; an upper bound elsewhere, since it acts as
+    /// a projection).
+    fn through_jpeg(refs: &References, jpeg: &JpegReference) -> Bands {
+        let (a, b) = (&jpeg.samples.mean, &jpeg.mean);
+        let pixels = a.len();
+        Bands {
+            lo: (0..pixels).map(|i| a[i].min(b[i])).collect(),
+            hi: (0..pixels).map(|i| a[i].max(b[i])).collect(),
+            reference_variance: (0..pixels)
+                .map(|i| refs.mean.variance[i] + refs.samples.clamped.variance[i])
+                .collect(),
+            noise: (0..pixels)
+                .map(|i| refs.samples.clamped.round_variance(i))
+                .collect(),
+            noise_scale: refs.plan.variance_scale,
+            fit: NoiseFit::BetweenBlocks {
+                side: jpeg.encoding.block(),
+            },
         }
     }
 }
@@ -241,18 +287,23 @@ pub fn test(
 ) -> Outcome {
     let values = submission.film.pixels();
     let tolerance = &submission.tolerance();
+    let precision = &submission.precision();
     let sums: Vec<(usize, usize, Sums)> = regions
         .iter()
         .enumerate()
         .filter(|(_, region)| region.pixels.len() >= MIN_PIXELS)
         .flat_map(|(r, region)| {
-            (0..3).map(move |c| (r, c, Sums::over(region, c, values, tolerance, bands)))
+            (0..3).map(move |c| {
+                let file = (tolerance.as_slice(), precision.as_slice());
+                (r, c, Sums::over(region, c, values, file, bands))
+            })
         })
         .collect();
     let is_block = |r: usize| matches!(regions[r].place, Place::Block { .. });
-    let scale = bands
-        .noise_scale
-        .unwrap_or_else(|| fitted_noise_scale(sums.iter().filter(|(r, ..)| is_block(*r))));
+    let scale = bands.noise_scale.unwrap_or_else(|| match bands.fit {
+        NoiseFit::WithinBlocks => fitted_noise_scale(sums.iter().filter(|(r, ..)| is_block(*r))),
+        NoiseFit::BetweenBlocks { side } => between_blocks_noise_scale(submission, bands, side),
+    });
     let mut findings: Vec<Finding> = sums
         .iter()
         .map(|(r, c, s)| s.finding(*r, *c, scale))
@@ -289,6 +340,62 @@ fn fitted_noise_scale<'a>(blocks: impl Iterator<Item = &'a (usize, usize, Sums)>
     ratios.get(ratios.len() / 2).copied().unwrap_or(0.0)
 }
 
+/// The noise scale from neighbouring `side × side` blocks (whole ones, from
+/// the top left): per channel, the difference `d` of two neighbours' mean
+/// residuals has variance `λ (v₁ + v₂)` under the hypothesis (`v` the sample
+/// reference's noise of a block's mean) plus the square of the difference
+/// of their biases, which a smooth mistake (everything too dark) cancels and
+/// an edge inflates; so `λ` is the median of `d² / (v₁ + v₂)` over all pairs
+/// divided by the median of χ²₁ (0.4549). 0 when no block is noisy.
+fn between_blocks_noise_scale(submission: &Submission, bands: &Bands, side: u32) -> f64 {
+    let size = submission.resolution();
+    let (columns, rows) = (size.x / side, size.y / side);
+    let values = submission.film.pixels();
+    let block = |bx: u32, by: u32, c: usize| -> (f64, f64) {
+        let (mut residual, mut noise) = (0.0, 0.0);
+        for y in by * side..(by + 1) * side {
+            for x in bx * side..(bx + 1) * side {
+                let i = (y * size.x + x) as usize;
+                let mid = 0.5 * (bands.lo[i][c] + bands.hi[i][c]) as f64;
+                residual += values[i][c] as f64 - mid;
+                noise += bands.noise[i][c] as f64;
+            }
+        }
+        let n = (side * side) as f64;
+        (residual / n, noise / (n * n))
+    };
+    let mut ratios = Vec::new();
+    for c in 0..3 {
+        let means: Vec<(f64, f64)> = (0..rows)
+            .flat_map(|by| (0..columns).map(move |bx| (bx, by)))
+            .map(|(bx, by)| block(bx, by, c))
+            .collect();
+        let at = |bx: u32, by: u32| means[(by * columns + bx) as usize];
+        for by in 0..rows {
+            for bx in 0..columns {
+                let neighbours = [(bx + 1, by), (bx, by + 1)];
+                for (nx, ny) in neighbours
+                    .into_iter()
+                    .filter(|&(x, y)| x < columns && y < rows)
+                {
+                    let ((d1, v1), (d2, v2)) = (at(bx, by), at(nx, ny));
+                    if v1 + v2 > 1e-14 {
+                        ratios.push((d1 - d2).powi(2) / (v1 + v2));
+                    }
+                }
+            }
+        }
+    }
+    if ratios.is_empty() {
+        return 0.0;
+    }
+    ratios.sort_by(f64::total_cmp);
+    ratios[ratios.len() / 2] / MEDIAN_CHI_SQUARED_1
+}
+
+/// The median of the χ² distribution with one degree of freedom.
+const MEDIAN_CHI_SQUARED_1: f64 = 0.454_936_423;
+
 /// Running sums of one region and channel, in f64.
 #[derive(Default)]
 struct Sums {
@@ -297,6 +404,8 @@ struct Sums {
     lo: f64,
     hi: f64,
     tolerance: f64,
+    /// The variance of the file's own rounding ([`Submission::precision`]).
+    precision: f64,
     reference_variance: f64,
     noise: f64,
     residual: f64,
@@ -304,11 +413,13 @@ struct Sums {
 }
 
 impl Sums {
+    /// `file`: the file's tolerance and precision per pixel
+    /// ([`Submission::tolerance`], [`Submission::precision`]).
     fn over(
         region: &Region,
         channel: usize,
         values: &[Vec3],
-        tolerance: &[Vec3],
+        (tolerance, precision): (&[Vec3], &[Vec3]),
         bands: &Bands,
     ) -> Sums {
         let mut s = Sums::default();
@@ -325,6 +436,7 @@ impl Sums {
             s.lo += lo;
             s.hi += hi;
             s.tolerance += tolerance[i][channel] as f64;
+            s.precision += precision[i][channel] as f64;
             s.reference_variance += bands.reference_variance[i][channel] as f64;
             s.noise += bands.noise[i][channel] as f64;
             s.residual += residual;
@@ -353,7 +465,14 @@ impl Sums {
         } else {
             0.0
         };
-        let pixel_variance = self.residual_variance().max(noise_scale * self.noise / n);
+        // Never below the estimator's noise, nor below the file's own
+        // rounding: a region where both the submission and the references
+        // are constant (a light, the background) still has the precision of
+        // its format, so a difference far inside a code step is no failure.
+        let pixel_variance = self
+            .residual_variance()
+            .max(noise_scale * self.noise / n)
+            .max(self.precision / n);
         let variance = pixel_variance / n + self.reference_variance / (n * n);
         let standard_error = variance.sqrt();
         let (z, p) = match (difference == 0.0, standard_error > 0.0) {

@@ -95,6 +95,7 @@ fn references(noise: Noise) -> References {
             .map(|i| (i % SIZE >= SIZE / 2) as u32 + 2 * (i / SIZE >= SIZE / 2) as u32)
             .collect(),
         render_time: Duration::ZERO,
+        jpeg: Vec::new(),
     }
 }
 
@@ -117,7 +118,11 @@ fn submission(
         let shift = if biased(x, y) { bias } else { 0.0 };
         *pixel = mean + Vec3::new(noise.draw(rng), noise.draw(rng), noise.draw(rng)) + shift;
     }
-    Submission::new("synthetic.pfm".into(), film, SampleEncoding::Linear)
+    Submission::new(
+        "synthetic.pfm".into(),
+        film,
+        SampleEncoding::Float { mantissa_bits: 23 },
+    )
 }
 
 fn scene() -> GradeScene {

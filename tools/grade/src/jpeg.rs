@@ -1,0 +1,332 @@
+//! A JPEG submission's encoding, read from its file, and Glint's renders
+//! passed through the same encoding.
+//!
+//! JPEG changes a render before the grader sees it: it rounds each 8 × 8
+//! block's cosine coefficients to the steps of its quantisation tables, after
+//! averaging the chroma of 2 × 2 pixels (4:2:0) or not (4:4:4), in the sRGB
+//! domain. The grader's question is whether the submission's expected value
+//! is Glint's, and so with JPEG whether it is the expected value of Glint's
+//! render *after the same encoding*: the tables and the subsampling are in
+//! the file (read by `gufo-jpeg`), and Glint's renders are encoded with them
+//! (by `jpeg-encoder`: the same tables, sampling factors, box-averaged chroma,
+//! as libjpeg does) and decoded by the same decoder as the submission (the
+//! `image` crate's). For files written by libjpeg (Pillow, OpenCV, most
+//! programs) this reproduces the submission's codes bit for bit on nearly
+//! every pixel, and the rest within a code or two
+//! (`docs/grading.md#lossy-formats`).
+
+use glam::Vec3;
+use glint_camera::{linear_to_srgb8, srgb_to_linear};
+use jpeg_encoder::{ChromaSubsamplingMethod, ColorType, QuantizationTableType, SamplingFactor};
+use std::path::Path;
+
+/// The lowest quality (on libjpeg's scale) a JPEG may have to be graded:
+/// below it the loss drowns the mistakes a grader looks for, and the grade
+/// says so instead of passing or failing.
+pub const MIN_QUALITY: u32 = 50;
+
+/// How a JPEG file was encoded: what Glint's renders are encoded with.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct JpegEncoding {
+    /// The luma and chroma quantisation tables, in natural (row) order.
+    pub luma: [u16; 64],
+    pub chroma: [u16; 64],
+    /// The luma's horizontal and vertical sampling factors against the
+    /// chroma's: (2, 2) is 4:2:0, (1, 1) 4:4:4.
+    pub sampling: (u8, u8),
+    /// 1 (gray) or 3 (YCbCr).
+    pub components: u8,
+    pub progressive: bool,
+}
+
+impl JpegEncoding {
+    /// The encoding of the JPEG file at `path`, or why Glint cannot encode
+    /// its renders the same way.
+    pub fn from_file(path: &Path) -> Result<JpegEncoding, String> {
+        let data = std::fs::read(path).map_err(|e| e.to_string())?;
+        let jpeg = gufo_jpeg::Jpeg::new(data).map_err(|e| e.to_string())?;
+        let unsupported =
+            |what: String| format!("a JPEG Glint cannot encode its renders as: {what}");
+        let sof = jpeg
+            .sof()
+            .map_err(|_| unsupported("not a Huffman-coded baseline or progressive JPEG".into()))?;
+        if sof.p != 8 {
+            return Err(unsupported(format!("{}-bit samples", sof.p)));
+        }
+        let model = jpeg.color_model().map_err(|e| unsupported(e.to_string()))?;
+        let components = match model {
+            gufo_jpeg::ColorModel::Grayscale => 1,
+            gufo_jpeg::ColorModel::YCbCr => 3,
+            other => return Err(unsupported(format!("{other:?} colour"))),
+        };
+        let (luma, chroma) = jpeg
+            .quantization_tables()
+            .map_err(|e| unsupported(e.to_string()))?;
+        let table = |t: QuantizationTableType| match t {
+            QuantizationTableType::Custom(table) => Ok(*table),
+            _ => Err(unsupported("no quantisation table".into())),
+        };
+        let sampling = match components {
+            1 => (1, 1),
+            _ => {
+                let luma = jpeg
+                    .components_specification_parameters(0)
+                    .map_err(|e| unsupported(e.to_string()))?;
+                SamplingFactor::from_factors(luma.h, luma.v).ok_or_else(|| {
+                    unsupported(format!("sampling factors {}×{}", luma.h, luma.v))
+                })?;
+                (luma.h, luma.v)
+            }
+        };
+        Ok(JpegEncoding {
+            luma: table(luma)?,
+            chroma: table(chroma)?,
+            sampling,
+            components,
+            progressive: jpeg.is_progressive().unwrap_or(false),
+        })
+    }
+
+    /// The libjpeg quality whose tables these are (`Exact`), or the nearest
+    /// one (`Near`) for tables of other encoders.
+    pub fn quality(&self) -> Quality {
+        let distance = |q: u32| -> f64 {
+            let (luma, chroma) = ijg_tables(q);
+            let mut d: f64 = self
+                .luma
+                .iter()
+                .zip(luma)
+                .map(|(&a, b)| (a as f64 / b as f64).ln().abs())
+                .sum();
+            if self.components == 3 {
+                d += self
+                    .chroma
+                    .iter()
+                    .zip(chroma)
+                    .map(|(&a, b)| (a as f64 / b as f64).ln().abs())
+                    .sum::<f64>();
+            }
+            d
+        };
+        let (best, d) = (1..=100)
+            .map(|q| (q, distance(q)))
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
+            .expect("qualities");
+        if d == 0.0 {
+            Quality::Exact(best)
+        } else {
+            Quality::Near(best)
+        }
+    }
+
+    /// "quality 75, 4:2:0", "progressive, tables near quality 90, 4:4:4", "gray, quality 90".
+    pub fn description(&self) -> String {
+        let mut parts = Vec::new();
+        if self.progressive {
+            parts.push("progressive".to_string());
+        }
+        if self.components == 1 {
+            parts.push("gray".into());
+        }
+        parts.push(match self.quality() {
+            Quality::Exact(q) => format!("quality {q}"),
+            Quality::Near(q) => format!("tables near quality {q}"),
+        });
+        if self.components == 3 {
+            parts.push(
+                match self.sampling {
+                    (1, 1) => "4:4:4",
+                    (2, 1) => "4:2:2",
+                    (2, 2) => "4:2:0",
+                    (1, 2) => "4:4:0",
+                    (4, 1) => "4:1:1",
+                    _ => "subsampled",
+                }
+                .into(),
+            );
+        }
+        parts.join(", ")
+    }
+
+    /// Why the encoding is too lossy to grade through, if it is.
+    pub fn too_lossy(&self) -> Option<String> {
+        let q = self.quality().value();
+        (q < MIN_QUALITY).then(|| {
+            format!(
+                "a JPEG of quality {q} (on libjpeg's scale) loses more than the test can see through; grading needs quality {MIN_QUALITY} or more, or a lossless format (PNG)"
+            )
+        })
+    }
+
+    /// A short stable name for the cache: the tables and sampling, hashed.
+    pub fn key(&self) -> String {
+        let mut hasher = blake3::Hasher::new();
+        for v in self.luma.iter().chain(&self.chroma) {
+            hasher.update(&v.to_le_bytes());
+        }
+        hasher.update(&[self.sampling.0, self.sampling.1, self.components]);
+        hasher.finalize().to_hex()[..16].to_string()
+    }
+
+    /// The side of the pixel blocks whose means the encoding keeps (up to
+    /// the DC coefficient's rounding): 8, or 16 where chroma is halved.
+    pub fn block(&self) -> u32 {
+        8 * self.sampling.0.max(self.sampling.1) as u32
+    }
+
+    /// Per channel (R, G, B), in 8-bit codes squared, the variance a block's
+    /// DC coefficients rounded either way add to a pixel's value, times the
+    /// pixels of its block: `8² (Q₀ʸ / 16)²` from luma, and from each of Cb
+    /// and Cr `B² (k Q₀ᶜ / 16)²` with `k` the channel's share of it (R =
+    /// Y + 1.402 Cr, G = Y − 0.344 Cb − 0.714 Cr, B = Y + 1.772 Cb), `B`
+    /// the chroma block's side ([`JpegEncoding::block`]).
+    pub fn dc_flip_variance(&self) -> Vec3 {
+        let half_step = |q: u16| q as f32 / 16.0;
+        let luma = 64.0 * half_step(self.luma[0]).powi(2);
+        if self.components == 1 {
+            return Vec3::splat(luma);
+        }
+        let area = (self.block() * self.block()) as f32;
+        let chroma = half_step(self.chroma[0]).powi(2) * area;
+        let (cb, cr) = (Vec3::new(0.0, 0.344, 1.772), Vec3::new(1.402, 0.714, 0.0));
+        Vec3::splat(luma) + (cb * cb + cr * cr) * chroma
+    }
+
+    /// `pixels` (linear, `width × height`, from the top left) as a file of
+    /// this encoding would hold them: sRGB-encoded to 8 bits
+    /// ([`linear_to_srgb8`]), encoded with these tables and subsampling,
+    /// decoded by the `image` crate, linear again.
+    pub fn round_trip(
+        &self,
+        pixels: &[Vec3],
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<Vec3>, String> {
+        let rgb: Vec<u8> = pixels
+            .iter()
+            .flat_map(|p| p.to_array())
+            .map(linear_to_srgb8)
+            .collect();
+        let (data, color) = match self.components {
+            1 => (
+                rgb.chunks_exact(3).map(luma).collect::<Vec<u8>>(),
+                ColorType::Luma,
+            ),
+            _ => (rgb, ColorType::Rgb),
+        };
+        let (w, h) = (
+            u16::try_from(width).map_err(|_| "wider than 65535 pixels".to_string())?,
+            u16::try_from(height).map_err(|_| "taller than 65535 pixels".to_string())?,
+        );
+        let mut bytes = Vec::new();
+        let mut encoder = jpeg_encoder::Encoder::new(&mut bytes, 100);
+        encoder.set_quantization_tables(
+            QuantizationTableType::Custom(Box::new(self.luma)),
+            QuantizationTableType::Custom(Box::new(self.chroma)),
+        );
+        let sampling = SamplingFactor::from_factors(self.sampling.0, self.sampling.1)
+            .expect("checked when read");
+        encoder.set_sampling_factor(sampling);
+        encoder.set_chroma_subsampling_method(ChromaSubsamplingMethod::Average);
+        encoder
+            .encode(&data, w, h, color)
+            .map_err(|e| format!("encoding Glint's render as the JPEG: {e}"))?;
+        let decoded = image::load_from_memory_with_format(&bytes, image::ImageFormat::Jpeg)
+            .map_err(|e| format!("decoding Glint's render as the JPEG: {e}"))?
+            .into_rgb8();
+        let table: Vec<f32> = (0..256).map(|c| srgb_to_linear(c as f32 / 255.0)).collect();
+        Ok(decoded
+            .pixels()
+            .map(|p| Vec3::from_array(p.0.map(|c| table[c as usize])))
+            .collect())
+    }
+}
+
+/// Rec. 601 luma of 8-bit codes, rounded, as libjpeg turns RGB into gray.
+fn luma(p: &[u8]) -> u8 {
+    let y = 0.299 * p[0] as f32 + 0.587 * p[1] as f32 + 0.114 * p[2] as f32;
+    y.round().clamp(0.0, 255.0) as u8
+}
+
+/// A JPEG's quality on libjpeg's scale.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quality {
+    /// Its tables are libjpeg's at this quality.
+    Exact(u32),
+    /// Its tables are others'; these are the nearest libjpeg's.
+    Near(u32),
+}
+
+impl Quality {
+    pub fn value(self) -> u32 {
+        match self {
+            Quality::Exact(q) | Quality::Near(q) => q,
+        }
+    }
+}
+
+/// The JPEG standard's example tables (ITU-T T.81 Annex K), natural order.
+const ANNEX_K_LUMA: [u16; 64] = [
+    16, 11, 10, 16, 24, 40, 51, 61, 12, 12, 14, 19, 26, 58, 60, 55, 14, 13, 16, 24, 40, 57, 69, 56,
+    14, 17, 22, 29, 51, 87, 80, 62, 18, 22, 37, 56, 68, 109, 103, 77, 24, 35, 55, 64, 81, 104, 113,
+    92, 49, 64, 78, 87, 103, 121, 120, 101, 72, 92, 95, 98, 112, 100, 103, 99,
+];
+const ANNEX_K_CHROMA: [u16; 64] = [
+    17, 18, 24, 47, 99, 99, 99, 99, 18, 21, 26, 66, 99, 99, 99, 99, 24, 26, 56, 99, 99, 99, 99, 99,
+    47, 66, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99,
+    99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99,
+];
+
+/// libjpeg's tables at `quality` (`jpeg_quality_scaling`, baseline).
+fn ijg_tables(quality: u32) -> ([u16; 64], [u16; 64]) {
+    let scale = if quality < 50 {
+        5000 / quality
+    } else {
+        200 - 2 * quality
+    };
+    let scaled = |t: &[u16; 64]| t.map(|v| ((v as u32 * scale + 50) / 100).clamp(1, 255) as u16);
+    (scaled(&ANNEX_K_LUMA), scaled(&ANNEX_K_CHROMA))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn encoding(quality: u32, sampling: (u8, u8)) -> JpegEncoding {
+        let (luma, chroma) = ijg_tables(quality);
+        JpegEncoding {
+            luma,
+            chroma,
+            sampling,
+            components: 3,
+            progressive: false,
+        }
+    }
+
+    #[test]
+    fn libjpeg_qualities_are_recognised_and_others_placed_near() {
+        assert_eq!(encoding(75, (2, 2)).quality(), Quality::Exact(75));
+        assert_eq!(encoding(100, (1, 1)).quality(), Quality::Exact(100));
+        let mut custom = encoding(90, (2, 2));
+        custom.luma[5] += 1;
+        assert_eq!(custom.quality(), Quality::Near(90));
+        assert_eq!(encoding(85, (2, 2)).description(), "quality 85, 4:2:0");
+        assert!(encoding(49, (2, 2))
+            .too_lossy()
+            .unwrap()
+            .contains("quality 49"));
+        assert!(encoding(50, (2, 2)).too_lossy().is_none());
+        assert_ne!(encoding(75, (2, 2)).key(), encoding(75, (1, 1)).key());
+        assert_eq!(encoding(75, (2, 2)).block(), 16);
+    }
+
+    #[test]
+    fn a_flat_image_survives_the_round_trip() {
+        // A flat block has one DC coefficient, a multiple of its step here.
+        let grey = Vec3::splat(srgb_to_linear(128.0 / 255.0));
+        let out = encoding(90, (2, 2))
+            .round_trip(&vec![grey; 24 * 16], 24, 16)
+            .unwrap();
+        assert!(out.iter().all(|p| (*p - grey).abs().max_element() < 0.01));
+    }
+}

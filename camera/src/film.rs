@@ -118,12 +118,22 @@ impl Film {
     /// renamed over `path`, so a failed write never leaves a partial file and
     /// never destroys what was at `path` before.
     pub fn save(&self, path: &Path) -> Result<(), FilmError> {
+        let io_err = |source| FilmError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        self.stage(path)?.persist().map_err(io_err)
+    }
+
+    /// [`Film::save`] up to putting the file in place
+    /// ([`StagedFile::persist`](crate::StagedFile::persist)).
+    pub fn stage(&self, path: &Path) -> Result<crate::StagedFile, FilmError> {
         let format = ImageFormat::from_path(path)?;
         let io_err = |source| FilmError::Io {
             path: path.to_path_buf(),
             source,
         };
-        crate::write_atomically(path, io_err, |out| self.encode(format, out, path))
+        crate::stage_atomically(path, io_err, |out| self.encode(format, out, path))
     }
 
     fn encode<W: Write + Seek>(

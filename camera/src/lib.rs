@@ -44,7 +44,7 @@ mod camera;
 mod film;
 mod output_paths;
 
-pub use atomic_file::write_atomically;
+pub use atomic_file::{stage_atomically, write_atomically, StagedFile};
 pub use camera::{
     Camera, CameraError, CameraRay, CameraRayDifferential, CameraRayLanes, F32Lanes, LANES,
 };

@@ -12,6 +12,9 @@ pub const MAX_NAME_BYTES: usize = 255;
 /// long, and it is not a folder. Nothing is left behind.
 pub fn check_output_file(path: &Path) -> Result<(), String> {
     check_names(path)?;
+    if names_a_folder(path) {
+        return Err("ends in a slash, which names a folder; expected a file name".into());
+    }
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
     if let Some(dir) = dir {
         if !dir.is_dir() {
@@ -59,6 +62,14 @@ pub fn check_output_folder(dir: &Path) -> Result<(), String> {
     probe(existing).map_err(|e| format!("cannot be made in {}: {e}", existing.display()))
 }
 
+/// Whether `path` ends in a separator (`out/`, `h.png/`): a folder's name,
+/// whatever the name before it looks like.
+fn names_a_folder(path: &Path) -> bool {
+    let text = path.as_os_str().as_encoded_bytes();
+    text.last()
+        .is_some_and(|&b| b == b'/' || (cfg!(windows) && b == b'\\'))
+}
+
 /// Every name along `path` within [`MAX_NAME_BYTES`].
 fn check_names(path: &Path) -> Result<(), String> {
     match path
@@ -104,6 +115,11 @@ mod tests {
             .unwrap_err()
             .contains("does not exist"));
         assert!(check_output_file(d).unwrap_err().contains("is a directory"));
+        // A trailing slash names a folder, even one that does not exist.
+        for name in ["h.png/", "st/"] {
+            let e = check_output_file(&d.join(name)).unwrap_err();
+            assert!(e.contains("ends in a slash"), "{name}: {e}");
+        }
         std::fs::write(d.join("file"), "").unwrap();
         assert!(check_output_folder(&d.join("file"))
             .unwrap_err()

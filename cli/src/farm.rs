@@ -577,6 +577,66 @@ fn parse_render(scene: &Path, dir: &Path, options: &[String]) -> Result<RenderAr
 
 /// `glint COMMAND FIXED... OPTIONS...` as glint parses it; a usage error
 /// is bad input in the options after `--`.
+/// For `glint farm ENGINE JOB … --flag value …` where `--flag` is not the
+/// farm's but the job's command's own (`glint render --resolution`), what to
+/// say: that the job's options go after `--`, with the command corrected.
+pub(crate) fn misplaced_option(args: &[String], flag: &str) -> Option<String> {
+    let farm = args.iter().position(|a| a == "farm")?;
+    let (job_at, job) = args
+        .iter()
+        .enumerate()
+        .skip(farm + 2)
+        .find(|(_, a)| ["render", "bench", "grade"].contains(&a.as_str()))?;
+    let name = flag.split('=').next().unwrap_or(flag);
+    let command = <crate::Cli as clap::CommandFactory>::command();
+    let takes_value = command
+        .find_subcommand(job)?
+        .get_arguments()
+        .find(|a| a.get_long().is_some_and(|l| format!("--{l}") == name))?
+        .get_action()
+        .takes_values();
+    let joined = format!("{name}=");
+    let at = args
+        .iter()
+        .skip(job_at)
+        .position(|a| a == name || a.starts_with(&joined))?
+        + job_at;
+    let end = args.iter().position(|a| a == "--").unwrap_or(args.len());
+    if at > end {
+        return None;
+    }
+    let with_value = takes_value && args[at] == name && at + 1 < end;
+    let moved: Vec<&String> = args[at..=at + with_value as usize].iter().collect();
+    let mut fixed: Vec<&String> = args[..end]
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !(at..=at + with_value as usize).contains(i))
+        .map(|(_, a)| a)
+        .collect();
+    let dashes = "--".to_string();
+    fixed.push(&dashes);
+    fixed.extend(moved);
+    fixed.extend(args.iter().skip(end + 1));
+    let shown: Vec<String> = fixed.iter().map(|a| shell_word(a)).collect();
+    Some(format!(
+        "{name} is an option of glint {job}, not of glint farm: the options of every task's glint {job} go after --; try: glint {}",
+        shown.join(" ")
+    ))
+}
+
+/// `word` as a shell reads it back: quoted where it holds anything but
+/// plain characters.
+fn shell_word(word: &str) -> String {
+    let plain = !word.is_empty()
+        && word
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=,:+@%".contains(c));
+    match plain {
+        true => word.to_owned(),
+        false => format!("'{}'", word.replace('\'', "'\\''")),
+    }
+}
+
 pub(crate) fn parse_command(
     command: &str,
     fixed: &[std::ffi::OsString],

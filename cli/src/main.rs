@@ -216,6 +216,13 @@ fn usage_error(e: clap::Error) -> ExitCode {
     if let Some(ContextValue::Strings(values)) = e.get(ContextKind::ValidValue) {
         problem = format!("{problem} [possible values: {}]", values.join(", "));
     }
+    if let Some(ContextValue::String(flag)) = e.get(ContextKind::InvalidArg) {
+        let args: Vec<String> = std::env::args().skip(1).collect();
+        if let Some(hint) = farm::misplaced_option(&args, flag) {
+            output::tell(&format!("glint: error: {}", output::readable(&hint)));
+            return ExitCode::from(2);
+        }
+    }
     output::tell(&format!(
         "glint: error: {} (see glint --help)",
         output::readable(&problem)

@@ -60,9 +60,16 @@ fn real(path: &Path) -> Option<std::path::PathBuf> {
 
 /// Writes `text` to `path` atomically.
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), Failure> {
+    stage_text(path, text)?
+        .persist()
+        .map_err(|e| Failure::Other(format!("{}: {e}", path.display())))
+}
+
+/// [`write_text`] up to putting the file in place.
+pub(crate) fn stage_text(path: &Path, text: &str) -> Result<glint_camera::StagedFile, Failure> {
     use std::io::Write;
     let fail = |e: std::io::Error| Failure::Other(format!("{}: {e}", path.display()));
-    glint_camera::write_atomically(path, fail, |out| {
+    glint_camera::stage_atomically(path, fail, |out| {
         out.write_all(text.as_bytes()).map_err(fail)
     })
 }

@@ -311,21 +311,46 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         }
         _ => None,
     };
+    // Every output is written beside its place first and put there only when
+    // all are written: a failure in the last leaves the first as it was.
+    let staged_image = match &piece {
+        Some(piece) => piece.stage(&output),
+        None => film.stage(&output),
+    }
+    .map_err(|e| Failure::Other(e.to_string()))?;
+    let write = write_start.elapsed();
+
+    let stats = rendered.stats;
+    let report = StatsReport {
+        stats: &stats,
+        scene: &scene,
+        load: timings,
+        write,
+    };
+    let staged_json = match &args.stats_json {
+        Some(path) => {
+            let text = serde_json::to_string_pretty(&report.to_json()).expect("JSON of numbers");
+            Some(crate::output::stage_text(path, &(text + "\n"))?)
+        }
+        None => None,
+    };
     {
         let _writing = interrupts.writing();
-        match &piece {
-            Some(piece) => piece.save(&output),
-            None => film.save(&output),
+        let persist = |staged: glint_camera::StagedFile, path: &Path| {
+            staged
+                .persist()
+                .map_err(|e| Failure::Other(format!("{}: {e}", path.display())))
+        };
+        persist(staged_image, &output)?;
+        if let (Some(staged), Some(path)) = (staged_json, &args.stats_json) {
+            persist(staged, path)?;
         }
-        .map_err(|e| Failure::Other(e.to_string()))?;
         if partial.is_some() {
             // Finished: the partial render has served.
             let _ = std::fs::remove_file(&partial_file);
         }
     }
-    let write = write_start.elapsed();
 
-    let stats = rendered.stats;
     let resolution = film.resolution();
     let environment_samples = match scene.environment {
         Some(_) => format!(", {} environment samples", settings.environment_samples),
@@ -350,19 +375,8 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         stats.rays(),
         stats.rays_per_second() / 1e6,
     ));
-    let report = StatsReport {
-        stats: &stats,
-        scene: &scene,
-        load: timings,
-        write,
-    };
     if args.stats {
         crate::output::say(&format!("{}\n", report.to_text()));
-    }
-    if let Some(path) = &args.stats_json {
-        let text = serde_json::to_string_pretty(&report.to_json()).expect("JSON of numbers");
-        let _writing = interrupts.writing();
-        crate::output::write_text(path, &(text + "\n"))?;
     }
     if stats.shading.nonfinite_samples > 0 {
         crate::output::tell(&format!("glint: warning: {} camera samples were NaN or infinite and were left out of their pixels",

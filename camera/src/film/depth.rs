@@ -12,7 +12,10 @@
 //! grid with probability `p` (the share of codes that do), so `d` distinct
 //! codes all do with probability `pᵈ`; a coarser depth is taken only where that
 //! is below [`CHANCE`]. An image of few distinct codes (all black, say) keeps
-//! its header's depth.
+//! its header's depth. The channels of one file were most likely written
+//! alike, so one depth for all three is tried first, on the evidence of all
+//! their codes ([`levels`]): a channel that shows few codes of its own (the
+//! blue of a red and yellow scene) takes the depth the others show.
 
 /// The largest chance of taking a finer encoding for a coarser one.
 pub const CHANCE: f64 = 1e-6;
@@ -49,21 +52,41 @@ impl CodeSet {
             .map(|(c, _)| c as u32)
     }
 
-    /// The number of levels the data was quantised to: the coarsest depth
-    /// `2ⁿ − 1` below the header's `max` that every code fits and chance
-    /// cannot explain; else `max`.
+    /// The number of levels this channel alone shows it was quantised to:
+    /// the coarsest depth `2ⁿ − 1` below the header's `max` that every code
+    /// fits and chance cannot explain; else `max`.
     pub fn levels(&self) -> u32 {
-        let distinct = self.codes().count() as i32;
-        (1..32)
-            .map(|n| (1u64 << n) - 1)
-            .take_while(|&m| m < self.max as u64)
-            .map(|m| m as u32)
-            .find(|&m| {
-                let grid = Grid::new(self.max, m);
-                grid.chance().powi(distinct) < CHANCE && self.codes().all(|c| grid.fits(c))
-            })
-            .unwrap_or(self.max)
+        common_levels(std::slice::from_ref(self))
     }
+}
+
+/// The levels of each of a file's channels (which share its `max`): one
+/// depth for all where their codes together show it, else each channel's
+/// own ([`CodeSet::levels`]).
+pub fn levels(channels: &[CodeSet; 3]) -> [u32; 3] {
+    match common_levels(channels) {
+        m if m < channels[0].max => [m; 3],
+        _ => std::array::from_fn(|c| channels[c].levels()),
+    }
+}
+
+/// The coarsest depth `2ⁿ − 1` below `max` that every code of every one of
+/// `channels` fits, on the evidence of all their distinct codes; else `max`.
+fn common_levels(channels: &[CodeSet]) -> u32 {
+    let max = channels[0].max;
+    let distinct: i32 = channels.iter().map(|c| c.codes().count() as i32).sum();
+    (1..32)
+        .map(|n| (1u64 << n) - 1)
+        .take_while(|&m| m < max as u64)
+        .map(|m| m as u32)
+        .find(|&m| {
+            let grid = Grid::new(max, m);
+            grid.chance().powi(distinct) < CHANCE
+                && channels
+                    .iter()
+                    .all(|c| c.codes().all(|code| grid.fits(code)))
+        })
+        .unwrap_or(max)
 }
 
 /// The codes `j · max / m` of `m` levels stored in codes of `max`.
@@ -139,6 +162,20 @@ mod tests {
         assert_eq!(set(255, rounded).levels(), 31);
         assert_eq!(set(255, truncated).levels(), 31);
         assert_eq!(set(255, replicated).levels(), 31);
+    }
+
+    #[test]
+    fn a_channel_of_few_codes_takes_the_depth_the_others_show() {
+        let five = |x: u32| x * 255 / 31;
+        // Red and green use every 5-bit level, blue only five of them: alone,
+        // blue would keep its 8 bits.
+        let blue = set(255, [0, 3, 9, 20, 31].map(five));
+        assert_eq!(blue.levels(), 255);
+        let full = set(255, (0..32).map(five));
+        assert_eq!(levels(&[full.clone(), full.clone(), blue]), [31; 3]);
+        // 5-6-5: no common depth, each channel its own.
+        let six = set(255, (0..64).map(|x| x * 255 / 63));
+        assert_eq!(levels(&[full.clone(), six, full]), [31, 63, 31]);
     }
 
     #[test]

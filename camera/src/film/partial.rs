@@ -136,6 +136,16 @@ impl PartialFilm {
     /// header; in PNG and PFM, which keep none of them, the film alone, with
     /// the pixels not held black.
     pub fn save(&self, path: &Path) -> Result<(), FilmError> {
+        let io_err = |source| FilmError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        self.stage(path)?.persist().map_err(io_err)
+    }
+
+    /// [`PartialFilm::save`] up to putting the file in place
+    /// ([`StagedFile::persist`](crate::StagedFile::persist)).
+    pub fn stage(&self, path: &Path) -> Result<crate::StagedFile, FilmError> {
         if ImageFormat::from_path(path)? != ImageFormat::Exr {
             let mut film = self.film.clone();
             for (pixel, &done) in film.pixels_mut().iter_mut().zip(&self.finished) {
@@ -143,7 +153,7 @@ impl PartialFilm {
                     *pixel = Vec3::ZERO;
                 }
             }
-            return film.save(path);
+            return film.stage(path);
         }
         use exr::prelude::{
             Encoding, Image, ImageAttributes, IntegerBounds, Layer, LayerAttributes,
@@ -185,7 +195,7 @@ impl PartialFilm {
             path: path.to_path_buf(),
             source,
         };
-        crate::write_atomically(path, io_err, |out| {
+        crate::stage_atomically(path, io_err, |out| {
             image
                 .write()
                 .to_buffered(out)

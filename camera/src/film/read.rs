@@ -232,8 +232,13 @@ fn read_with_image_crate(
     let layout = header_layout(format, head);
     let (film, codes, alpha, gray) = pixels(decoded, stored_max(path, format)?);
     let encoding = match codes {
+        // A gray file's three channels are one: its codes are evidence once.
+        Some(sets) if gray => SampleEncoding::Srgb {
+            levels: [sets[0].levels(); 3],
+            stored: sets[0].max(),
+        },
         Some(sets) => SampleEncoding::Srgb {
-            levels: std::array::from_fn(|c| sets[c].levels()),
+            levels: super::depth::levels(&sets),
             stored: sets[0].max(),
         },
         None if format == FileFormat::RadianceHdr => SampleEncoding::SharedExponent,

@@ -87,6 +87,19 @@ impl JpegEncoding {
         })
     }
 
+    /// libjpeg's baseline encoding at `quality` with the luma sampled
+    /// `sampling` times as densely as the chroma ((2, 2): 4:2:0), in colour.
+    pub fn libjpeg(quality: u32, sampling: (u8, u8)) -> JpegEncoding {
+        let (luma, chroma) = ijg_tables(quality.clamp(1, 100));
+        JpegEncoding {
+            luma,
+            chroma,
+            sampling,
+            components: 3,
+            progressive: false,
+        }
+    }
+
     /// The libjpeg quality whose tables these are (`Exact`), or the nearest
     /// one (`Near`) for tables of other encoders.
     pub fn quality(&self) -> Quality {
@@ -293,14 +306,7 @@ mod tests {
     use super::*;
 
     fn encoding(quality: u32, sampling: (u8, u8)) -> JpegEncoding {
-        let (luma, chroma) = ijg_tables(quality);
-        JpegEncoding {
-            luma,
-            chroma,
-            sampling,
-            components: 3,
-            progressive: false,
-        }
+        JpegEncoding::libjpeg(quality, sampling)
     }
 
     #[test]

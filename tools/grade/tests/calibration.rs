@@ -5,7 +5,8 @@
 
 use glam::{UVec2, Vec3};
 use glint_camera::{Film, SampleEncoding};
-use glint_grade::reference::{Estimate, SampleEstimates};
+use glint_grade::jpeg::JpegEncoding;
+use glint_grade::reference::{Estimate, JpegReference, SampleEstimates};
 use glint_grade::{GradeScene, ReferencePlan, References, StatedSettings, Submission, TestOptions};
 use glint_integrator::RenderSettings;
 use rand_core::{RngCore, SeedableRng};
@@ -193,4 +194,122 @@ fn a_bias_hidden_in_noise_is_caught() {
     // The same block a hundredth as far off is lost in the noise.
     let caught = failures(Noise::Normal { sigma: 0.05 }, 20, 0.01, -0.001, block);
     assert!(caught <= 2, "{caught}");
+}
+
+/// References as [`references`] makes them, and through `encoding`: its
+/// sample estimate from `rounds` noisy images each through the encoding.
+fn jpeg_references(noise: Noise, encoding: &JpegEncoding, rounds: u32, stated: bool) -> References {
+    let mut refs = references(noise);
+    if !stated {
+        refs.plan.variance_scale = None;
+    }
+    let mut rng = Pcg64::seed_from_u64(7);
+    let n = (SIZE * SIZE) as usize;
+    let (mut sum, mut squares) = (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]);
+    for _ in 0..rounds {
+        let noisy = noisy_image(noise, &mut rng, 0.0, |_, _| false);
+        let coded = encoding.round_trip(&noisy, SIZE, SIZE).unwrap();
+        for (i, p) in coded.into_iter().enumerate() {
+            sum[i] += p;
+            squares[i] += p * p;
+        }
+    }
+    let r = rounds as f32;
+    let mean: Vec<Vec3> = sum.iter().map(|s| *s / r).collect();
+    let variance = (0..n)
+        .map(|i| (squares[i] / r - mean[i] * mean[i]).max(Vec3::ZERO) / (r - 1.0))
+        .collect();
+    refs.jpeg.push(JpegReference {
+        encoding: encoding.clone(),
+        samples: Estimate {
+            mean,
+            variance,
+            rounds,
+            cached: false,
+        },
+        mean: encoding.round_trip(&refs.mean.mean, SIZE, SIZE).unwrap(),
+    });
+    refs
+}
+
+/// The expected image plus `bias` where `biased` says, plus noise.
+fn noisy_image(
+    noise: Noise,
+    rng: &mut Pcg64,
+    bias: f32,
+    biased: impl Fn(u32, u32) -> bool,
+) -> Vec<Vec3> {
+    submission(noise, rng, bias, biased).film.pixels().to_vec()
+}
+
+/// How many of `trials` JPEG submissions (the noisy image through
+/// `encoding`) fail, with the sample counts stated or not.
+fn jpeg_failures(
+    encoding: &JpegEncoding,
+    stated: bool,
+    (trials, alpha): (u64, f64),
+    bias: f32,
+    biased: impl Fn(u32, u32) -> bool + Copy,
+) -> u64 {
+    let noise = Noise::Normal { sigma: 0.05 };
+    let (scene, refs) = (scene(), jpeg_references(noise, encoding, 32, stated));
+    let options = TestOptions {
+        alpha,
+        block: Some(8),
+    };
+    let mut rng = Pcg64::seed_from_u64(31);
+    let eight_bit = SampleEncoding::Srgb {
+        levels: [255; 3],
+        stored: 255,
+    };
+    (0..trials)
+        .filter(|_| {
+            let noisy = noisy_image(noise, &mut rng, bias, biased);
+            let coded = encoding.round_trip(&noisy, SIZE, SIZE).unwrap();
+            let mut film = Film::new(UVec2::splat(SIZE));
+            film.pixels_mut().copy_from_slice(&coded);
+            let mut s = Submission::new("synthetic.jpg".into(), film, eight_bit);
+            s.jpeg = Some(Ok(encoding.clone()));
+            !glint_grade::grade_image(&scene, &refs, &s, &StatedSettings::default(), &options)
+                .passed
+        })
+        .count() as u64
+}
+
+#[test]
+fn correct_jpegs_fail_at_most_as_often_as_alpha() {
+    // JPEG smooths the noise within each block and keeps each block's mean:
+    // the test must neither take the smoothed spread for the noise nor the
+    // Jensen shift of averaging in sRGB for a bias, whether the counts are
+    // known or the noise is fitted.
+    let (trials, alpha) = (100, 0.05);
+    for encoding in [
+        JpegEncoding::libjpeg(75, (2, 2)),
+        JpegEncoding::libjpeg(95, (1, 1)),
+    ] {
+        for stated in [true, false] {
+            let failed = jpeg_failures(&encoding, stated, (trials, alpha), 0.0, |_, _| false);
+            assert_false_alarms_within_alpha(failed, trials, alpha);
+        }
+    }
+}
+
+#[test]
+fn a_bias_through_a_jpeg_is_caught() {
+    // A quarter of the image too bright under noise of 0.05 a pixel, through
+    // quality 75 and 4:2:0. The band is wider than a PNG's by the shift that
+    // averaging in sRGB gives each end (about 0.01 at this noise): 0.02 is
+    // caught with the counts stated, 0.04 also with the noise fitted.
+    let quadrant = |x: u32, y: u32| x >= SIZE / 2 && y < SIZE / 2;
+    let encoding = JpegEncoding::libjpeg(75, (2, 2));
+    assert_eq!(
+        jpeg_failures(&encoding, true, (10, 0.01), 0.02, quadrant),
+        10
+    );
+    assert_eq!(
+        jpeg_failures(&encoding, false, (10, 0.01), 0.04, quadrant),
+        10
+    );
+    // A hundredth as far off is lost in the noise.
+    assert!(jpeg_failures(&encoding, true, (10, 0.01), 0.0002, quadrant) <= 1);
 }

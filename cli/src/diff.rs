@@ -13,11 +13,12 @@ use std::path::PathBuf;
 
 #[derive(Args)]
 #[command(
-    after_help = "Compares TEST with REFERENCE (PNG, PPM, JPEG, EXR or PFM; the same size): \
-                  per-channel means, RMSE, relative MSE, mean FLIP and the largest \
-                  difference, printed as a table, then whether the difference is within \
-                  the tolerance. Metrics are computed on linear RGB (PNG and JPEG decoded \
-                  from sRGB); docs/comparing-images.md defines them.\n\n\
+    after_help = "Compares TEST with REFERENCE (PNG, JPEG, BMP, TGA, PPM/PGM, Radiance HDR, \
+                  OpenEXR or PFM, told by content; the same size): per-channel means, RMSE, \
+                  relative MSE, mean FLIP and the largest difference, printed as a table, \
+                  then whether the difference is within the tolerance. Metrics are computed \
+                  on linear RGB (integer formats decoded from sRGB); \
+                  docs/comparing-images.md defines them.\n\n\
                   Exit status: 0 within the tolerance, 1 beyond it, 2 for bad input \
                   (unreadable or invalid files, different sizes, a bad region, tolerance \
                   or heat map path), 3 for a failure of Glint's own (a failed write)."

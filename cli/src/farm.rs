@@ -617,24 +617,11 @@ pub(crate) fn misplaced_option(args: &[String], flag: &str) -> Option<String> {
     fixed.push(&dashes);
     fixed.extend(moved);
     fixed.extend(args.iter().skip(end + 1));
-    let shown: Vec<String> = fixed.iter().map(|a| shell_word(a)).collect();
+    let shown: Vec<String> = fixed.iter().map(|a| quote_str(a)).collect();
     Some(format!(
         "{name} is an option of glint {job}, not of glint farm: the options of every task's glint {job} go after --; try: glint {}",
         shown.join(" ")
     ))
-}
-
-/// `word` as a shell reads it back: quoted where it holds anything but
-/// plain characters.
-fn shell_word(word: &str) -> String {
-    let plain = !word.is_empty()
-        && word
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || "-_./=,:+@%".contains(c));
-    match plain {
-        true => word.to_owned(),
-        false => format!("'{}'", word.replace('\'', "'\\''")),
-    }
 }
 
 pub(crate) fn parse_command(

@@ -17,7 +17,8 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 #[command(
-    after_help = "Exit status: 0 when every submission passes, 1 when one fails or \
+    after_help = "Exit status: 0 when every submission passes, 1 when one fails, is \
+                  unreadable for grading (its format lost what the test needs) or \
                   cannot be read, 2 for bad input (flags, scene, manifest, output paths), \
                   3 for a failure of Glint's own, 128 + the signal's number when \
                   stopped (Ctrl-C, SIGTERM; a report being made is removed). The test \
@@ -25,7 +26,9 @@ use std::path::{Path, PathBuf};
 )]
 pub(crate) struct GradeArgs {
     /// The scene the submissions render (TOML), then the submitted images
-    /// (PNG, PPM, EXR, PFM or JPEG), each graded at its own resolution
+    /// (PNG, JPEG, BMP, TGA, PPM/PGM, Radiance HDR, OpenEXR or PFM, told by
+    /// content), each graded at its own resolution through what its format
+    /// did to it
     #[arg(value_name = "SCENE.toml SUBMISSION")]
     inputs: Vec<PathBuf>,
 

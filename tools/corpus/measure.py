@@ -18,7 +18,6 @@ the tracer makes the submissions.
 import argparse
 import csv
 import json
-import os
 import random
 import statistics
 import subprocess
@@ -126,12 +125,15 @@ def build(corpus, quick):
                            corpus.trace(scene, 128, *settings, s, mistakes=(m,)), mistake=m)
 
 
-def grade(corpus):
-    manifest = corpus.out / "manifest.csv"
+def grade_class(corpus, rows, name="manifest"):
+    """Grades `rows` as one class with `glint grade --class` (each row's
+    settings stated or not) against the corpus's reference cache: each
+    submission's JSON by student, and the seconds it took."""
+    manifest = corpus.out / f"{name}.csv"
     with open(manifest, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["student", "scene", "file", "spp", "sampler", "light_samples", "light_sampler", "note"])
-        for r in corpus.rows:
+        for r in rows:
             stated = [r["spp"], r["sampler"], r["light"], r["light_sampler"]] if r["stated"] else ["", "", "", ""]
             w.writerow([r["student"], str(SCENES[r["scene"]]), r["file"], *stated, r["kind"]])
     start = time.time()
@@ -140,7 +142,11 @@ def grade(corpus):
     if out.returncode not in (0, 1):
         sys.exit(f"glint grade failed ({out.returncode}): {out.stderr}")
     elapsed = time.time() - start
-    graded = {s["student"]: s for s in json.loads(out.stdout)["submissions"]}
+    return {s["student"]: s for s in json.loads(out.stdout)["submissions"]}, elapsed
+
+
+def grade(corpus):
+    graded, elapsed = grade_class(corpus, corpus.rows)
     for r in corpus.rows:
         g = graded[r["student"]]
         r["verdict"] = g["verdict"]

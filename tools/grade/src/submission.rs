@@ -225,23 +225,15 @@ mod tests {
     fn the_tolerance_follows_the_levels_the_data_shows() {
         let mut film = Film::new(UVec2::new(1, 1));
         film.set_pixel(0, 0, Vec3::splat(0.2));
-        let eight = Submission::new(
-            "a.png".into(),
-            film.clone(),
-            SampleEncoding::Srgb {
-                levels: [255; 3],
-                stored: 65535,
-            },
-        );
-        let sixteen = Submission::new(
-            "a.png".into(),
-            film.clone(),
-            SampleEncoding::Srgb {
-                levels: [65535; 3],
-                stored: 65535,
-            },
-        );
-        let ratio = eight.tolerance()[0].x / sixteen.tolerance()[0].x;
+        let step = |levels: u32| {
+            let stored = 65535;
+            let encoding = SampleEncoding::Srgb {
+                levels: [levels; 3],
+                stored,
+            };
+            Submission::new("a.png".into(), film.clone(), encoding).tolerance()[0].x
+        };
+        let ratio = step(255) / step(65535);
         assert!((ratio - 257.0).abs() < 3.0, "{ratio}");
         // A half float's step is 2⁻¹⁰ of the value, a 32-bit float's 1e-5.
         let half = Submission::new(

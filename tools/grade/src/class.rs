@@ -439,7 +439,11 @@ fn probe(
             loaded[&path].as_ref().map_err(Clone::clone)?;
             let submission = Submission::load(&entry.file)?;
             let resolution = submission.resolution();
-            let jpeg = submission.jpeg.and_then(Result::ok);
+            // Too lossy a JPEG is not graded: its encoding needs no references.
+            let jpeg = submission
+                .jpeg
+                .and_then(Result::ok)
+                .filter(|e| e.too_lossy().is_none());
             Ok((path, resolution, jpeg))
         })
         .collect();

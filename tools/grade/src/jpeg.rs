@@ -37,6 +37,12 @@ pub struct JpegEncoding {
     /// 1 (gray) or 3 (YCbCr).
     pub components: u8,
     pub progressive: bool,
+    /// Its segments are laid out as libjpeg writes them (one table a DQT
+    /// and a DHT segment): libjpeg and what is built on it (Pillow, OpenCV,
+    /// ImageMagick, GIMP), whose arithmetic Glint's re-encoding repeats.
+    /// Other encoders (stb_image_write's one DQT for both tables) round
+    /// otherwise, by up to a code.
+    pub libjpeg_layout: bool,
 }
 
 impl JpegEncoding {
@@ -84,6 +90,7 @@ impl JpegEncoding {
             sampling,
             components,
             progressive: jpeg.is_progressive().unwrap_or(false),
+            libjpeg_layout: one_table_a_segment(&jpeg),
         })
     }
 
@@ -97,6 +104,7 @@ impl JpegEncoding {
             sampling,
             components: 3,
             progressive: false,
+            libjpeg_layout: true,
         }
     }
 
@@ -187,22 +195,93 @@ impl JpegEncoding {
         8 * self.sampling.0.max(self.sampling.1) as u32
     }
 
-    /// Per channel (R, G, B), in 8-bit codes squared, the variance a block's
-    /// DC coefficients rounded either way add to a pixel's value, times the
-    /// pixels of its block: `8² (Q₀ʸ / 16)²` from luma, and from each of Cb
-    /// and Cr `B² (k Q₀ᶜ / 16)²` with `k` the channel's share of it (R =
-    /// Y + 1.402 Cr, G = Y − 0.344 Cb − 0.714 Cr, B = Y + 1.772 Cb), `B`
-    /// the chroma block's side ([`JpegEncoding::block`]).
-    pub fn dc_flip_variance(&self) -> Vec3 {
-        let half_step = |q: u16| q as f32 / 16.0;
-        let luma = 64.0 * half_step(self.luma[0]).powi(2);
-        if self.components == 1 {
-            return Vec3::splat(luma);
+    /// What the rounding of each block's DC coefficient may do to a file of
+    /// this encoding of a render whose noiseless 8-bit image is `rgb` (row by
+    /// row, `width × height`) and whose pixels have the variance `noise`
+    /// (per channel, in 8-bit codes squared): per pixel, in codes of R, G
+    /// and B, the band it adds and the variance it adds ([`DcRounding`]).
+    ///
+    /// A block's DC coefficient is the sum of its 64 samples less 128 each,
+    /// divided by `8 Q₀` and rounded (libjpeg's integer DCT; its
+    /// fixed-point YCbCr; its chroma averages with alternating rounding), so
+    /// its mean moves in steps of `Q₀ / 8` codes. Two encoders whose
+    /// arithmetic differs in a sample's last rounding may round a sum that
+    /// lies within [`TIE_WINDOW`] of a half step apart: the band spans both
+    /// roundings there. A submission's sum differs from this one by its
+    /// noise and the reference's, `σ` (of the 64 samples' noise, the
+    /// channels taken as fully correlated, the largest it can be); one lying
+    /// `δ` from the nearest half step comes within the window with chance
+    /// `p = Φ(−(δ − window)/σ)`, which grows with `σ`, so no submission less
+    /// noisy than the one `noise` describes has a larger one; its block mean
+    /// then varies by `p (1 − p)` steps squared from the rounding (at most a
+    /// fair coin's, whatever the encoder does there). Blocks past the
+    /// image's edge, padded by the encoder, count as ties.
+    pub fn dc_rounding(&self, rgb: &[u8], noise: &[Vec3], width: u32, height: u32) -> DcRounding {
+        let (w, h) = (width as usize, height as usize);
+        let ycc: Vec<[i32; 3]> = rgb.chunks_exact(3).map(ycbcr).collect();
+        let deviation: Vec<[f32; 3]> = noise.iter().map(|v| component_deviations(*v)).collect();
+        let mut out = DcRounding {
+            band: vec![Vec3::ZERO; w * h],
+            variance: vec![Vec3::ZERO; w * h],
+        };
+        let image = Samples {
+            ycc: &ycc,
+            deviation: &deviation,
+            w,
+            h,
+        };
+        let luma_step = self.luma[0] as f32 / 8.0;
+        self.add_component(&image, 0, (1, 1), Vec3::ONE * luma_step, &mut out);
+        if self.components == 3 {
+            let chroma_step = self.chroma[0] as f32 / 8.0;
+            let factors = (self.sampling.0 as usize, self.sampling.1 as usize);
+            self.add_component(&image, 1, factors, CB_SHARE * chroma_step, &mut out);
+            self.add_component(&image, 2, factors, CR_SHARE * chroma_step, &mut out);
         }
-        let area = (self.block() * self.block()) as f32;
-        let chroma = half_step(self.chroma[0]).powi(2) * area;
-        let (cb, cr) = (Vec3::new(0.0, 0.344, 1.772), Vec3::new(1.402, 0.714, 0.0));
-        Vec3::splat(luma) + (cb * cb + cr * cr) * chroma
+        out
+    }
+
+    /// [`JpegEncoding::dc_rounding`] of component `c` (sampled once per
+    /// `sx × sy` pixels), whose DC step moves R, G and B by `step` codes.
+    fn add_component(
+        &self,
+        image: &Samples,
+        c: usize,
+        (sx, sy): (usize, usize),
+        step: Vec3,
+        out: &mut DcRounding,
+    ) {
+        let q = if c == 0 { self.luma[0] } else { self.chroma[0] } as i64;
+        let (bw, bh) = (8 * sx, 8 * sy);
+        let n = (sx * sy) as i32;
+        for by in 0..image.h.div_ceil(bh) {
+            for bx in 0..image.w.div_ceil(bw) {
+                let whole = (bx + 1) * bw <= image.w && (by + 1) * bh <= image.h;
+                let (band, chance) = if whole {
+                    let (sum, variance) = image.block_sum(c, (bx * bw, by * bh), (sx, sy), n);
+                    // How far the sum lies from the nearest half step, and
+                    // from where encoders may round it apart.
+                    let from_tie = (sum.rem_euclid(8 * q) - 4 * q).abs();
+                    let beyond = (from_tie - TIE_WINDOW) as f64;
+                    let sigma = variance.sqrt();
+                    let apart = match sigma > 0.0 {
+                        true => normal_tail(beyond / sigma),
+                        false => 0.0,
+                    };
+                    (beyond <= 0.0, apart.max(FLIP_CHANCE as f64) as f32)
+                } else {
+                    (true, 0.5)
+                };
+                let band = if band { step } else { Vec3::ZERO };
+                let variance = step * step * chance * (1.0 - chance) * (bw * bh) as f32;
+                for y in by * bh..((by + 1) * bh).min(image.h) {
+                    for x in bx * bw..((bx + 1) * bw).min(image.w) {
+                        out.band[y * image.w + x] += band;
+                        out.variance[y * image.w + x] += variance;
+                    }
+                }
+            }
+        }
     }
 
     /// `pixels` (linear, `width × height`, from the top left) as a file of
@@ -253,6 +332,129 @@ impl JpegEncoding {
             .map(|p| Vec3::from_array(p.0.map(|c| table[c as usize])))
             .collect())
     }
+}
+
+/// What the rounding of DC coefficients may do to a JPEG's pixels
+/// ([`JpegEncoding::dc_rounding`]), in 8-bit codes of R, G and B.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DcRounding {
+    /// How far a pixel's block mean may lie either way from the re-encoded
+    /// one, where its DC coefficient lies at a tie.
+    pub band: Vec<Vec3>,
+    /// The variance the rounding adds to the pixel's block mean, times the
+    /// block's pixels: summed over a region of `n` pixels and divided by
+    /// `n²`, at least the variance it adds to the region's mean (blocks
+    /// round independently).
+    pub variance: Vec<Vec3>,
+}
+
+/// A noiseless image's YCbCr and each component's noise (standard
+/// deviation, codes), per pixel.
+struct Samples<'a> {
+    ycc: &'a [[i32; 3]],
+    deviation: &'a [[f32; 3]],
+    w: usize,
+    h: usize,
+}
+
+impl Samples<'_> {
+    /// The sum of a block's 64 samples of component `c` less 128 each (the
+    /// block from pixel `(x0, y0)`, each sample the rounded average of `n =
+    /// sx × sy` pixels, as libjpeg's h2v2 and h2v1 averages round,
+    /// alternately down and up), and the variance of that sum in codes².
+    fn block_sum(
+        &self,
+        c: usize,
+        (x0, y0): (usize, usize),
+        (sx, sy): (usize, usize),
+        n: i32,
+    ) -> (i64, f64) {
+        let (mut sum, mut variance) = (0i64, 0f64);
+        for v in 0..8 {
+            for u in 0..8 {
+                let (mut s, mut spread) = (0, 0f64);
+                for dy in 0..sy {
+                    for dx in 0..sx {
+                        let i = (y0 + v * sy + dy) * self.w + x0 + u * sx + dx;
+                        s += self.ycc[i][c];
+                        spread += (self.deviation[i][c] as f64).powi(2);
+                    }
+                }
+                let bias = if u % 2 == 0 { (n - 1) / 2 } else { n / 2 };
+                sum += ((s + bias) / n - 128) as i64;
+                variance += spread / (n * n) as f64;
+            }
+        }
+        (sum, variance)
+    }
+}
+
+/// The standard deviation of Y, Cb and Cr from those of R, G and B (the
+/// square roots of `variance`), the channels taken as fully correlated: the
+/// largest they can be.
+fn component_deviations(variance: Vec3) -> [f32; 3] {
+    let sd = Vec3::new(variance.x.sqrt(), variance.y.sqrt(), variance.z.sqrt());
+    [
+        Vec3::new(0.299, 0.587, 0.114).dot(sd),
+        Vec3::new(0.168_74, 0.331_26, 0.5).dot(sd),
+        Vec3::new(0.5, 0.418_69, 0.081_31).dot(sd),
+    ]
+}
+
+/// `P(Z > z)` for a standard normal `Z`.
+fn normal_tail(z: f64) -> f64 {
+    0.5 * statrs::function::erf::erfc(z / std::f64::consts::SQRT_2)
+}
+
+/// How close, in sums of a block's 64 samples, a DC coefficient may lie to
+/// a half step and still be rounded apart by two encoders: libjpeg and
+/// Glint's re-encoding round a sample's YCbCr apart now and then (by one),
+/// which moves the sum by one; measured flips lay within 3 of a tie.
+pub const TIE_WINDOW: i64 = 3;
+
+/// The least chance taken that a block's DC coefficient is rounded the other
+/// way than Glint's re-encoding rounds it, away from ties and noise: below
+/// 1% of blocks measured for libjpeg on the same input; 3% leaves room for
+/// what the model leaves out (clamping after a coefficient rounded apart).
+pub const FLIP_CHANCE: f32 = 0.03;
+
+/// What one code of Cb and of Cr adds to R, G and B (their magnitudes).
+const CB_SHARE: Vec3 = Vec3::new(0.0, 0.344, 1.772);
+const CR_SHARE: Vec3 = Vec3::new(1.402, 0.714, 0.0);
+
+/// libjpeg's fixed-point YCbCr of an 8-bit RGB pixel (`jccolor.c`, as
+/// `jpeg-encoder` repeats it).
+fn ycbcr(p: &[u8]) -> [i32; 3] {
+    let (r, g, b) = (p[0] as i32, p[1] as i32, p[2] as i32);
+    let y = (19595 * r + 38470 * g + 7471 * b + 0x7FFF) >> 16;
+    let cb = (-11059 * r - 21709 * g + 32768 * b + (128 << 16) + 0x7FFF) >> 16;
+    let cr = (32768 * r - 27439 * g - 5329 * b + (128 << 16) + 0x7FFF) >> 16;
+    [y, cb, cr]
+}
+
+/// Whether every DQT and DHT segment of `jpeg` holds one table, as libjpeg
+/// writes them.
+fn one_table_a_segment(jpeg: &gufo_jpeg::Jpeg) -> bool {
+    let dqt_ok = jpeg
+        .segments_marker(gufo_jpeg::Marker::DQT)
+        .all(|s| gufo_jpeg::Dqt::from_data(s.data()).is_ok_and(|tables| tables.len() == 1));
+    let dht_ok = jpeg
+        .segments_marker(gufo_jpeg::Marker::DHT)
+        .all(|s| huffman_tables(s.data()) == Some(1));
+    dqt_ok && dht_ok
+}
+
+/// How many Huffman tables a DHT segment's data holds (each a class and id
+/// byte, 16 counts, and as many values as they sum to).
+fn huffman_tables(mut data: &[u8]) -> Option<usize> {
+    let mut tables = 0;
+    while !data.is_empty() {
+        let counts = data.get(1..17)?;
+        let values: usize = counts.iter().map(|&c| c as usize).sum();
+        data = data.get(17 + values..)?;
+        tables += 1;
+    }
+    Some(tables)
 }
 
 /// Rec. 601 luma of 8-bit codes, rounded, as libjpeg turns RGB into gray.

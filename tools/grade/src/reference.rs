@@ -8,7 +8,7 @@
 //! submissions of one scene pay for them once.
 
 use crate::hypothesis::ReferencePlan;
-use crate::jpeg::JpegEncoding;
+use crate::jpeg::{DcRounding, JpegEncoding};
 use crate::GradeError;
 use glam::{UVec2, Vec3};
 use glint_bench::reference::{cache_key, round_seed, CachePaths, Origin, RoundSums};
@@ -119,6 +119,9 @@ pub struct JpegReference {
     pub samples: Estimate,
     /// The mean reference through the encoding: `J(M)`, the noiseless end.
     pub mean: Vec<Vec3>,
+    /// What the rounding of `M`'s DC coefficients may do, under the sample
+    /// reference's noise ([`JpegEncoding::dc_rounding`]).
+    pub dc: DcRounding,
 }
 
 /// Where rendered references are kept; `None` renders them every time.
@@ -211,12 +214,36 @@ pub fn with_jpeg(
     let mean = encoding
         .round_trip(&refs.mean.mean, w, h)
         .map_err(GradeError::Internal)?;
+    let dc = dc_rounding(refs, encoding);
     refs.jpeg.push(JpegReference {
         encoding: encoding.clone(),
         samples,
         mean,
+        dc,
     });
     Ok(())
+}
+
+/// [`JpegEncoding::dc_rounding`] of the mean reference `M` under the sample
+/// reference's noise (clamped, as an 8-bit file stores it) and `M`'s own,
+/// in codes.
+pub fn dc_rounding(refs: &References, encoding: &JpegEncoding) -> DcRounding {
+    let m = &refs.mean.mean;
+    let codes: Vec<u8> = m
+        .iter()
+        .flat_map(|p| p.to_array())
+        .map(glint_camera::linear_to_srgb8)
+        .collect();
+    let noise: Vec<Vec3> = (0..m.len())
+        .map(|i| {
+            let variance = refs.samples.clamped.round_variance(i) + refs.mean.variance[i];
+            Vec3::from_array(std::array::from_fn(|c| {
+                variance[c] / crate::submission::code_step(m[i][c]).powi(2)
+            }))
+        })
+        .collect();
+    let size = refs.resolution;
+    encoding.dc_rounding(&codes, &noise, size.x, size.y)
 }
 
 /// `scene`'s scene with its camera's film at `resolution`.

@@ -91,8 +91,9 @@ impl Submission {
     /// it was written from, in linear units: one step of what the file
     /// rounded to (an integer format's code step at that value, in the
     /// levels the data shows: rounding costs half a step, truncation up to
-    /// one; a shared exponent's mantissa step), or a relative 1e-5 of a
-    /// 32-bit float (a relative step of a half float).
+    /// one; two for a JPEG of an encoder other than libjpeg; a shared
+    /// exponent's mantissa step), or a relative 1e-5 of a 32-bit float (a
+    /// relative step of a half float).
     pub fn tolerance(&self) -> Vec<Vec3> {
         let pixels = self.film.pixels();
         match self.encoding {
@@ -109,9 +110,15 @@ impl Submission {
                 .collect(),
             SampleEncoding::Srgb { levels, .. } => {
                 let steps = levels.map(CodeSteps::new);
+                // Another encoder than libjpeg rounds otherwise than Glint's
+                // re-encoding, by up to a code: one more step.
+                let encoder = match &self.jpeg {
+                    Some(Ok(jpeg)) if !jpeg.libjpeg_layout => 2.0,
+                    _ => 1.0,
+                };
                 pixels
                     .iter()
-                    .map(|p| Vec3::from_array(std::array::from_fn(|c| steps[c].at(p[c]))))
+                    .map(|p| Vec3::from_array(std::array::from_fn(|c| encoder * steps[c].at(p[c]))))
                     .collect()
             }
         }
@@ -120,32 +127,11 @@ impl Submission {
 
 impl Submission {
     /// Per pixel and channel, the variance of what the file's rounding adds
-    /// to the pixel, scaled so that its sum over a region divided by the
-    /// region's pixel count squared bounds the variance it adds to the
-    /// region's mean: `step² / 12` of a code step; for a JPEG also the
-    /// rounding of each block's DC coefficient, which an encoder other than
-    /// the submission's (Glint's, re-encoding its renders) may round the
-    /// other way where it lies near a half step. Each block's mean then
-    /// moves by one DC step (`Q₀ / 8` codes) or not, a variance of at most
-    /// `(Q₀ / 16)²` shared by the block's `B²` pixels, independent between
-    /// blocks; carried by each pixel as `B² (Q₀ / 16)²`, its sum over a
-    /// region of `n` pixels divided by `n²` is at least that variance. So no
-    /// region is without noise, and a block whose encoders disagree by one
-    /// step is no failure.
+    /// to the pixel, `step² / 12` of [`Submission::tolerance`]'s step: so no
+    /// region is without noise (a JPEG's DC coefficients add theirs in its
+    /// bands, [`crate::test::Bands`]).
     pub fn precision(&self) -> Vec<Vec3> {
-        let rounding = self.tolerance().into_iter().map(|t| t * t / 12.0);
-        let Some(Ok(jpeg)) = &self.jpeg else {
-            return rounding.collect();
-        };
-        let steps = CodeSteps::new(255);
-        let dc = jpeg.dc_flip_variance();
-        rounding
-            .zip(self.film.pixels())
-            .map(|(r, p)| {
-                let code = Vec3::from_array(std::array::from_fn(|c| steps.at(p[c])));
-                r + dc * code * code
-            })
-            .collect()
+        self.tolerance().into_iter().map(|t| t * t / 12.0).collect()
     }
 }
 
@@ -166,6 +152,12 @@ fn shared_exponent_step(top: f32) -> f32 {
         return 0.0;
     }
     2f32.powi(top.log2().floor() as i32 + 1 - 8)
+}
+
+/// The linear width of an 8-bit code step at `linear` (the wider of those
+/// either side).
+pub(crate) fn code_step(linear: f32) -> f32 {
+    CodeSteps::new(255).at(linear)
 }
 
 /// The linear width of the code steps of an sRGB-encoded integer format.

@@ -193,6 +193,9 @@ pub struct Bands {
     pub noise_scale: Option<f64>,
     /// How a noise scale is fitted to the submission.
     pub fit: NoiseFit,
+    /// What the format's own rounding adds to the file's
+    /// ([`Submission::precision`]): a JPEG's DC coefficients'.
+    pub precision: Option<Vec<Vec3>>,
 }
 
 /// How the scale of a submission's noise is fitted when its sample counts
@@ -248,6 +251,7 @@ impl Bands {
             noise,
             noise_scale: refs.plan.variance_scale,
             fit: NoiseFit::WithinBlocks,
+            precision: None,
         }
     }
 
@@ -261,9 +265,13 @@ impl Bands {
     fn through_jpeg(refs: &References, jpeg: &JpegReference) -> Bands {
         let (a, b) = (&jpeg.samples.mean, &jpeg.mean);
         let pixels = a.len();
+        // A block whose DC coefficient lies at a tie may be rounded either
+        // way by the submission's encoder: its band spans both.
+        let code = |i: usize| Vec3::from_array(b[i].to_array().map(crate::submission::code_step));
+        let tie = |i: usize| jpeg.dc.band[i] * code(i);
         Bands {
-            lo: (0..pixels).map(|i| a[i].min(b[i])).collect(),
-            hi: (0..pixels).map(|i| a[i].max(b[i])).collect(),
+            lo: (0..pixels).map(|i| a[i].min(b[i]) - tie(i)).collect(),
+            hi: (0..pixels).map(|i| a[i].max(b[i]) + tie(i)).collect(),
             reference_variance: (0..pixels)
                 .map(|i| refs.mean.variance[i] + refs.samples.clamped.variance[i])
                 .collect(),
@@ -274,6 +282,11 @@ impl Bands {
             fit: NoiseFit::BetweenBlocks {
                 side: jpeg.encoding.block(),
             },
+            precision: Some(
+                (0..pixels)
+                    .map(|i| jpeg.dc.variance[i] * code(i) * code(i))
+                    .collect(),
+            ),
         }
     }
 }
@@ -287,7 +300,11 @@ pub fn test(
 ) -> Outcome {
     let values = submission.film.pixels();
     let tolerance = &submission.tolerance();
-    let precision = &submission.precision();
+    let mut precision = submission.precision();
+    if let Some(more) = &bands.precision {
+        precision.iter_mut().zip(more).for_each(|(p, m)| *p += *m);
+    }
+    let precision = &precision;
     let sums: Vec<(usize, usize, Sums)> = regions
         .iter()
         .enumerate()

@@ -228,6 +228,7 @@ fn jpeg_references(noise: Noise, encoding: &JpegEncoding, rounds: u32, stated: b
             cached: false,
         },
         mean: encoding.round_trip(&refs.mean.mean, SIZE, SIZE).unwrap(),
+        dc: glint_grade::reference::dc_rounding(&refs, encoding),
     });
     refs
 }
@@ -296,20 +297,19 @@ fn correct_jpegs_fail_at_most_as_often_as_alpha() {
 
 #[test]
 fn a_bias_through_a_jpeg_is_caught() {
-    // A quarter of the image too bright under noise of 0.05 a pixel, through
-    // quality 75 and 4:2:0. The band is wider than a PNG's by the shift that
-    // averaging in sRGB gives each end (about 0.01 at this noise): 0.02 is
-    // caught with the counts stated, 0.04 also with the noise fitted.
+    // A quarter of the image too bright under noise of 0.05 a pixel (a dozen
+    // 8-bit codes), through quality 75 and 4:2:0. The band is wider than a
+    // PNG's by the shift that averaging in sRGB gives each end (about 0.01
+    // at this noise), and the chroma's DC steps (2 codes of blue) round at
+    // random under such noise: 0.03 is caught, counts stated or not.
     let quadrant = |x: u32, y: u32| x >= SIZE / 2 && y < SIZE / 2;
     let encoding = JpegEncoding::libjpeg(75, (2, 2));
-    assert_eq!(
-        jpeg_failures(&encoding, true, (10, 0.01), 0.02, quadrant),
-        10
-    );
-    assert_eq!(
-        jpeg_failures(&encoding, false, (10, 0.01), 0.04, quadrant),
-        10
-    );
+    for stated in [true, false] {
+        assert_eq!(
+            jpeg_failures(&encoding, stated, (10, 0.01), 0.03, quadrant),
+            10
+        );
+    }
     // A hundredth as far off is lost in the noise.
-    assert!(jpeg_failures(&encoding, true, (10, 0.01), 0.0002, quadrant) <= 1);
+    assert!(jpeg_failures(&encoding, true, (10, 0.01), 0.0003, quadrant) <= 1);
 }

@@ -157,31 +157,38 @@ fn shared_exponent_step(top: f32) -> f32 {
 /// The linear width of an 8-bit code step at `linear` (the wider of those
 /// either side).
 pub(crate) fn code_step(linear: f32) -> f32 {
-    CodeSteps::new(255).at(linear)
+    static EIGHT_BIT: std::sync::OnceLock<CodeSteps> = std::sync::OnceLock::new();
+    EIGHT_BIT.get_or_init(|| CodeSteps::new(255)).at(linear)
 }
 
-/// The linear width of the code steps of an sRGB-encoded integer format.
+/// The linear width of the code steps of an sRGB-encoded integer format,
+/// for each code (the wider of the two either side).
 struct CodeSteps {
     max_code: u32,
+    widths: Vec<f32>,
 }
 
 impl CodeSteps {
     fn new(max_code: u32) -> CodeSteps {
-        CodeSteps { max_code }
-    }
-
-    fn linear(&self, code: i64) -> f32 {
-        let code = code.clamp(0, self.max_code as i64);
-        srgb_to_linear(code as f32 / self.max_code as f32)
+        let linear = |code: i64| {
+            let code = code.clamp(0, max_code as i64);
+            srgb_to_linear(code as f32 / max_code as f32)
+        };
+        let widths = (0..=max_code as i64)
+            .map(|code| {
+                let here = linear(code);
+                (linear(code + 1) - here).max(here - linear(code - 1))
+            })
+            .collect();
+        CodeSteps { max_code, widths }
     }
 
     /// The wider of the two steps either side of the code that decodes to
     /// `linear`.
     fn at(&self, linear: f32) -> f32 {
         let encoded = linear_to_srgb(linear.clamp(0.0, 1.0));
-        let code = (encoded * self.max_code as f32).round() as i64;
-        let here = self.linear(code);
-        (self.linear(code + 1) - here).max(here - self.linear(code - 1))
+        let code = (encoded * self.max_code as f32).round() as usize;
+        self.widths[code.min(self.max_code as usize)]
     }
 }
 

@@ -7,8 +7,11 @@
 //!
 //! - `hi = M`, `lo = M` for an unclamped float image; for a clamped one
 //!   `hi = min(M, 1)` and `lo = M − G` ([`hypothesis`](crate::hypothesis));
-//! - `ε` is what storing the value may have changed it by: one code step of
-//!   an 8- or 16-bit format, or a relative 1e-5 of a float.
+//!   for a JPEG, between its encoding of the sample reference's rounds and of
+//!   `M`, `E[J(X_s)]` and `J(M)`, and a DC step wider where `M`'s DC lies at
+//!   a tie ([`JpegEncoding::dc_rounding`](crate::jpeg::JpegEncoding::dc_rounding));
+//! - `ε` is what storing the value may have changed it by: one step of what
+//!   the file rounded to ([`Submission::tolerance`]).
 //!
 //! The distance `d` of `S̄` outside the band is judged against the noise of
 //! `S̄`, estimated from the submission itself: the sample variance `s²` of
@@ -21,8 +24,10 @@
 //! small and the test too eager; so the variance is never taken below the
 //! noise the submission's estimator has, `v`, measured per pixel by the sample
 //! reference and scaled to the stated sample counts (or, when they are
-//! unknown, by the median ratio of `s²` to `v` over the blocks). The
-//! statistic `t = d / √(max(s², v̄)/n + var_ref)` is referred to Student's t
+//! unknown, by the median ratio of `s²` to `v` over the blocks, or for a
+//! JPEG over neighbouring blocks' means), nor below the file's own
+//! precision `q` (its rounding's, and a JPEG's DC coefficients'). The
+//! statistic `t = d / √(max(s², v̄, q̄)/n + var_ref)` is referred to Student's t
 //! with `n − 1` degrees of freedom, two-sided. All p-values of an image, every
 //! region and channel, are tested together with Holm's step-down procedure,
 //! which keeps the chance of failing a correct image at `α` or below (as
@@ -267,8 +272,11 @@ impl Bands {
         let pixels = a.len();
         // A block whose DC coefficient lies at a tie may be rounded either
         // way by the submission's encoder: its band spans both.
-        let code = |i: usize| Vec3::from_array(b[i].to_array().map(crate::submission::code_step));
-        let tie = |i: usize| jpeg.dc.band[i] * code(i);
+        let code: Vec<Vec3> = b
+            .iter()
+            .map(|p| Vec3::from_array(p.to_array().map(crate::submission::code_step)))
+            .collect();
+        let tie = |i: usize| jpeg.dc.band[i] * code[i];
         Bands {
             lo: (0..pixels).map(|i| a[i].min(b[i]) - tie(i)).collect(),
             hi: (0..pixels).map(|i| a[i].max(b[i]) + tie(i)).collect(),
@@ -284,7 +292,7 @@ impl Bands {
             },
             precision: Some(
                 (0..pixels)
-                    .map(|i| jpeg.dc.variance[i] * code(i) * code(i))
+                    .map(|i| jpeg.dc.variance[i] * code[i] * code[i])
                     .collect(),
             ),
         }

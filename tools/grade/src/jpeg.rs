@@ -457,6 +457,11 @@ fn huffman_tables(mut data: &[u8]) -> Option<usize> {
     Some(tables)
 }
 
+/// What [`JpegEncoding::round_trip`] computes, for the reference cache's
+/// keys (which name a transform only by its place): change it with anything
+/// that changes the round trip's result.
+pub const ROUND_TRIP: &str = "jpeg-encoder 0.7, box-averaged chroma, image 0.25's decoder";
+
 /// Rec. 601 luma of 8-bit codes, rounded, as libjpeg turns RGB into gray.
 fn luma(p: &[u8]) -> u8 {
     let y = 0.299 * p[0] as f32 + 0.587 * p[1] as f32 + 0.114 * p[2] as f32;

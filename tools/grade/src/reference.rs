@@ -203,7 +203,11 @@ pub fn with_jpeg(
         out.extend(encoding.round_trip(pixels, w, h)?);
         Ok(())
     };
-    let tag = format!(" through JPEG {}", encoding.key());
+    let tag = format!(
+        " through JPEG {} ({})",
+        encoding.key(),
+        crate::jpeg::ROUND_TRIP
+    );
     let [samples] = job.estimates(
         "sample",
         &tag,

@@ -74,6 +74,12 @@ impl ImageFile {
     /// 8-bit steps", "PPM (P3), maxval 1023", "OpenEXR, half float, alpha
     /// below 1 in 12 pixels", "TGA, 24-bit RGB, RLE (named .png)".
     pub fn description(&self) -> String {
+        self.description_with(&[])
+    }
+
+    /// [`ImageFile::description`] with `details` of the format that the
+    /// caller knows (a JPEG's quality and subsampling) after its layout.
+    pub fn description_with(&self, details: &[String]) -> String {
         let mut parts = vec![self.layout.label.clone()];
         let channels = match (self.gray, self.indexed) {
             (_, true) => Some("palette"),
@@ -87,6 +93,7 @@ impl ImageFile {
             parts.push(words.join(" "));
         }
         parts.extend(self.layout.extras.iter().cloned());
+        parts.extend(details.iter().cloned());
         match self.encoding {
             SampleEncoding::Srgb { stored, .. } if self.format == FileFormat::Pnm => {
                 parts.push(format!("maxval {stored}"))

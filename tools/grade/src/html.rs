@@ -180,14 +180,9 @@ fn page(rows: &[ReportRow]) -> String {
         .enumerate()
         .map(|(k, s)| format!("<th data-column=\"{}\">{}</th>", k + 2, escape(s)))
         .collect();
-    let counts = crate::report::counts(rows);
     format!(
         include_str!("report.html"),
-        summary = counts.replacen(
-            " submissions:",
-            &format!(" submissions from {} students:", students.len()),
-            1
-        ),
+        summary = crate::report::counts(rows, Some(students.len())),
         header = header,
         body = body,
     )

@@ -13,7 +13,7 @@
 //! `image` crate's). For files written by libjpeg (Pillow, OpenCV, most
 //! programs) this reproduces the submission's codes bit for bit on nearly
 //! every pixel, and the rest within a code or two
-//! (`docs/grading.md#lossy-formats`).
+//! (`docs/grading-formats.md#jpeg-judged-through-its-own-encoding`).
 
 use glam::Vec3;
 use glint_camera::{linear_to_srgb8, srgb_to_linear};
@@ -140,14 +140,13 @@ impl JpegEncoding {
         }
     }
 
-    /// "quality 75, 4:2:0", "progressive, tables near quality 90, 4:4:4", "gray, quality 90".
-    pub fn description(&self) -> String {
+    /// What the file's description adds for its encoding: ["quality 75",
+    /// "4:2:0"], ["progressive", "tables near quality 90", "4:4:4"] (a gray
+    /// file says so itself).
+    pub fn details(&self) -> Vec<String> {
         let mut parts = Vec::new();
         if self.progressive {
             parts.push("progressive".to_string());
-        }
-        if self.components == 1 {
-            parts.push("gray".into());
         }
         parts.push(match self.quality() {
             Quality::Exact(q) => format!("quality {q}"),
@@ -166,7 +165,7 @@ impl JpegEncoding {
                 .into(),
             );
         }
-        parts.join(", ")
+        parts
     }
 
     /// Why the encoding is too lossy to grade through, if it is.
@@ -512,32 +511,40 @@ fn ijg_tables(quality: u32) -> ([u16; 64], [u16; 64]) {
 mod tests {
     use super::*;
 
-    fn encoding(quality: u32, sampling: (u8, u8)) -> JpegEncoding {
-        JpegEncoding::libjpeg(quality, sampling)
-    }
-
     #[test]
     fn libjpeg_qualities_are_recognised_and_others_placed_near() {
-        assert_eq!(encoding(75, (2, 2)).quality(), Quality::Exact(75));
-        assert_eq!(encoding(100, (1, 1)).quality(), Quality::Exact(100));
-        let mut custom = encoding(90, (2, 2));
+        assert_eq!(
+            JpegEncoding::libjpeg(75, (2, 2)).quality(),
+            Quality::Exact(75)
+        );
+        assert_eq!(
+            JpegEncoding::libjpeg(100, (1, 1)).quality(),
+            Quality::Exact(100)
+        );
+        let mut custom = JpegEncoding::libjpeg(90, (2, 2));
         custom.luma[5] += 1;
         assert_eq!(custom.quality(), Quality::Near(90));
-        assert_eq!(encoding(85, (2, 2)).description(), "quality 85, 4:2:0");
-        assert!(encoding(49, (2, 2))
+        assert_eq!(
+            JpegEncoding::libjpeg(85, (2, 2)).details(),
+            ["quality 85", "4:2:0"]
+        );
+        assert!(JpegEncoding::libjpeg(49, (2, 2))
             .too_lossy()
             .unwrap()
             .contains("quality 49"));
-        assert!(encoding(50, (2, 2)).too_lossy().is_none());
-        assert_ne!(encoding(75, (2, 2)).key(), encoding(75, (1, 1)).key());
-        assert_eq!(encoding(75, (2, 2)).block(), 16);
+        assert!(JpegEncoding::libjpeg(50, (2, 2)).too_lossy().is_none());
+        assert_ne!(
+            JpegEncoding::libjpeg(75, (2, 2)).key(),
+            JpegEncoding::libjpeg(75, (1, 1)).key()
+        );
+        assert_eq!(JpegEncoding::libjpeg(75, (2, 2)).block(), 16);
     }
 
     #[test]
     fn a_flat_image_survives_the_round_trip() {
         // A flat block has one DC coefficient, a multiple of its step here.
         let grey = Vec3::splat(srgb_to_linear(128.0 / 255.0));
-        let out = encoding(90, (2, 2))
+        let out = JpegEncoding::libjpeg(90, (2, 2))
             .round_trip(&vec![grey; 24 * 16], 24, 16)
             .unwrap();
         assert!(out.iter().all(|p| (*p - grey).abs().max_element() < 0.01));

@@ -218,19 +218,20 @@ pub fn table(report: &[ReportRow]) -> String {
     for r in &rows {
         out += &line([&r[0], &r[1], &r[2], &r[3]]);
     }
-    out += &format!("\n{}\n", counts(report));
+    out += &format!("\n{}\n", counts(report, None));
     out
 }
 
 /// "3 submissions: 1 pass, 1 fail, 1 not graded", with the unreadable for
-/// grading where there are any.
-pub fn counts(report: &[ReportRow]) -> String {
+/// grading where there are any, and "from N students" where `students` says.
+pub fn counts(report: &[ReportRow], students: Option<usize>) -> String {
+    let from = students.map_or(String::new(), |n| format!(" from {n} students"));
     let unreadable = match count(report, "unreadable") {
         0 => String::new(),
         n => format!(", {n} unreadable for grading"),
     };
     format!(
-        "{} submissions: {} pass, {} fail{unreadable}, {} not graded",
+        "{} submissions{from}: {} pass, {} fail{unreadable}, {} not graded",
         report.len(),
         count(report, "pass"),
         count(report, "fail"),

@@ -48,12 +48,10 @@ impl Submission {
             ));
         }
         let jpeg = (file.format == FileFormat::Jpeg).then(|| JpegEncoding::from_file(path));
-        let mut format = file.description();
-        if let Some(Ok(encoding)) = &jpeg {
-            // "JPEG, gray" + ", quality 90" reads better without the repeat.
-            format = format.replacen("JPEG, gray", "JPEG", 1);
-            format = format.replacen("JPEG", &format!("JPEG, {}", encoding.description()), 1);
-        }
+        let format = match &jpeg {
+            Some(Ok(encoding)) => file.description_with(&encoding.details()),
+            _ => file.description(),
+        };
         let palette = file.indexed.then(|| distinct_colours(&file.film));
         let mut submission = Submission::new(path.to_owned(), file.film, file.encoding);
         submission.format = format;
@@ -122,16 +120,6 @@ impl Submission {
                     .collect()
             }
         }
-    }
-}
-
-impl Submission {
-    /// Per pixel and channel, the variance of what the file's rounding adds
-    /// to the pixel, `step² / 12` of [`Submission::tolerance`]'s step: so no
-    /// region is without noise (a JPEG's DC coefficients add theirs in its
-    /// bands, [`crate::test::Bands`]).
-    pub fn precision(&self) -> Vec<Vec3> {
-        self.tolerance().into_iter().map(|t| t * t / 12.0).collect()
     }
 }
 

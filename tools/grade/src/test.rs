@@ -199,7 +199,7 @@ pub struct Bands {
     /// How a noise scale is fitted to the submission.
     pub fit: NoiseFit,
     /// What the format's own rounding adds to the file's
-    /// ([`Submission::precision`]): a JPEG's DC coefficients'.
+    /// (`step² / 12` of [`Submission::tolerance`]'s step): a JPEG's DC coefficients'.
     pub precision: Option<Vec<Vec3>>,
 }
 
@@ -308,7 +308,9 @@ pub fn test(
 ) -> Outcome {
     let values = submission.film.pixels();
     let tolerance = &submission.tolerance();
-    let mut precision = submission.precision();
+    // What the file's rounding adds to a pixel: `step² / 12` of its step (a
+    // JPEG's DC coefficients add theirs), so no region is without noise.
+    let mut precision: Vec<Vec3> = tolerance.iter().map(|t| *t * *t / 12.0).collect();
     if let Some(more) = &bands.precision {
         precision.iter_mut().zip(more).for_each(|(p, m)| *p += *m);
     }
@@ -429,7 +431,7 @@ struct Sums {
     lo: f64,
     hi: f64,
     tolerance: f64,
-    /// The variance of the file's own rounding ([`Submission::precision`]).
+    /// The variance of the file's own rounding (`step² / 12` of [`Submission::tolerance`]'s step).
     precision: f64,
     reference_variance: f64,
     noise: f64,
@@ -439,7 +441,7 @@ struct Sums {
 
 impl Sums {
     /// `file`: the file's tolerance and precision per pixel
-    /// ([`Submission::tolerance`], [`Submission::precision`]).
+    /// ([`Submission::tolerance`], and its rounding's variance).
     fn over(
         region: &Region,
         channel: usize,

@@ -36,10 +36,11 @@ pub(crate) struct DiffArgs {
     #[arg(long, value_name = "METRIC", value_enum, default_value_t = Metric::Relmse)]
     metric: Metric,
 
-    /// The largest value of --metric that passes; above it the exit status is 1.
-    /// The default, 0, fails on any difference
-    #[arg(long, value_name = "T", default_value_t = 0.0, value_parser = parse_tolerance)]
-    tolerance: f64,
+    /// The largest value of --metric that passes; above it the exit status is 1
+    /// [default: a match to float precision: relmse 1e-8, rmse 1e-4, flip 1e-3,
+    /// max 1e-3; 0 fails on any difference]
+    #[arg(long, value_name = "T", value_parser = parse_tolerance)]
+    tolerance: Option<f64>,
 
     /// Measure only this rectangle of pixels: columns x0 to x1 and rows y0 to y1
     /// (from the top), x1 and y1 excluded, e.g. 0,0,64,32 [default: the whole image]
@@ -77,6 +78,19 @@ enum Metric {
 }
 
 impl Metric {
+    /// The default tolerance: two renders that agree to float precision
+    /// (a student's 64-bit tracer against Glint's 32-bit one, on the
+    /// deterministic recipe) pass, anything visible does not. Rounding in
+    /// 32 bits moves a value by about 1e-7 of itself: a relative MSE of
+    /// 1e-14, far below 1e-8 (an rms relative difference of 1e-4).
+    fn default_tolerance(self) -> f64 {
+        match self {
+            Metric::Relmse => 1e-8,
+            Metric::Rmse => 1e-4,
+            Metric::Flip | Metric::Max => 1e-3,
+        }
+    }
+
     fn label(self) -> &'static str {
         match self {
             Metric::Relmse => "relMSE",
@@ -149,22 +163,24 @@ pub(crate) fn diff(args: &DiffArgs) -> Result<(), Failure> {
         None => None,
     };
     let value = args.metric.value(&c);
+    let tolerance = args
+        .tolerance
+        .unwrap_or_else(|| args.metric.default_tolerance());
     // NaN (a NaN or infinity in one image only) is never within tolerance.
-    let within = value <= args.tolerance;
+    let within = value <= tolerance;
     let label = args.metric.label();
     let out = match args.json {
         true => {
-            let document = json_document(args, (&test, &reference), region, &c, &heat, within);
+            let verdict = (tolerance, within);
+            let document = json_document(args, (&test, &reference), region, &c, &heat, verdict);
             serde_json::to_string_pretty(&document).expect("JSON of numbers and strings") + "\n"
         }
         false => {
             let mut text = table(args, (&test, &reference), region, &c, &heat);
+            let (value, tolerance) = (number(value), tolerance_text(args, tolerance));
             text += &match within {
-                true => format!("within tolerance: {label} {value} <= {}\n", args.tolerance),
-                false => format!(
-                    "beyond tolerance: {label} {value} > tolerance {}\n",
-                    args.tolerance
-                ),
+                true => format!("within tolerance: {label} {value} <= {tolerance}\n"),
+                false => format!("beyond tolerance: {label} {value} > {tolerance}\n"),
             };
             text
         }
@@ -174,11 +190,23 @@ pub(crate) fn diff(args: &DiffArgs) -> Result<(), Failure> {
         Ok(())
     } else {
         Err(Failure::Verdict(Some(format!(
-            "{}: differs from {}: {label} {value} > tolerance {}",
+            "{} differs from {} beyond the tolerance: {label} {} > {}",
             args.test.display(),
             args.reference.display(),
-            args.tolerance
+            number(value),
+            tolerance_text(args, tolerance)
         ))))
+    }
+}
+
+/// The tolerance as the verdict prints it, saying when it is the default.
+fn tolerance_text(args: &DiffArgs, tolerance: f64) -> String {
+    match args.tolerance {
+        Some(_) => number(tolerance),
+        None => format!(
+            "{} (the default: a match to float precision)",
+            number(tolerance)
+        ),
     }
 }
 
@@ -286,7 +314,7 @@ fn json_document(
     region: Region,
     c: &Comparison,
     heat: &Option<Heat>,
-    within: bool,
+    (tolerance, within): (f64, bool),
 ) -> serde_json::Value {
     use serde_json::json;
     let finite = |v: f64| v.is_finite().then_some(v);
@@ -321,7 +349,7 @@ fn json_document(
         })),
         "metric": args.metric.label(),
         "value": finite(args.metric.value(c)),
-        "tolerance": args.tolerance,
+        "tolerance": tolerance,
         "within_tolerance": within,
     })
 }

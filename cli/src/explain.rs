@@ -138,10 +138,10 @@ fn compare(explanation: &Explanation, path: &Path, args: &ExplainArgs) -> Result
     });
     match comparison.first() {
         None => Ok(()),
-        Some(d) => Err(Failure::Other(format!(
+        Some(d) => Err(Failure::Verdict(Some(format!(
             "{name} parts from Glint in the {} stage, at {}",
             d.stage.heading(),
             d.path
-        ))),
+        )))),
     }
 }

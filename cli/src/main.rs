@@ -160,8 +160,9 @@ fn main() -> ExitCode {
         }
         Err(Failure::Panicked) => ExitCode::from(if judging { 3 } else { 1 }),
         Err(Failure::Verdict(message)) => {
+            // A verdict is the answer asked for, not an error.
             if let Some(message) = message {
-                output::tell(&format!("glint: error: {}", output::readable(&message)));
+                output::tell(&format!("glint: {}", output::readable(&message)));
             }
             ExitCode::from(1)
         }

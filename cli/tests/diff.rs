@@ -34,6 +34,33 @@ fn write(dir: &Path, name: &str, film: &Film) {
     film.save(&dir.join(name)).unwrap();
 }
 
+#[test]
+fn a_match_to_float_precision_passes_by_default_and_tolerance_0_asks_for_equal() {
+    let dir = images();
+    let mut nudged = base();
+    let p = nudged.pixel(2, 0);
+    nudged.set_pixel(2, 0, p * (1.0 + 3.0 * f32::EPSILON));
+    write(dir.path(), "nudged.pfm", &nudged);
+    let o = glint(&["diff", "nudged.pfm", "b.pfm"], dir.path());
+    assert_exit(&o, 0);
+    let out = stdout(&o);
+    let verdict = out.lines().last().unwrap();
+    assert!(verdict.starts_with("within tolerance: relMSE "), "{out}");
+    assert!(
+        verdict.contains("e-1"),
+        "scientific, as in the table: {out}"
+    );
+    assert!(
+        verdict.ends_with("<= 1.00000e-8 (the default: a match to float precision)"),
+        "{out}"
+    );
+    let o = glint(
+        &["diff", "nudged.pfm", "b.pfm", "--tolerance", "0"],
+        dir.path(),
+    );
+    assert_exit(&o, 1);
+}
+
 /// A directory with `a.pfm` (changed) and `b.pfm` (base), and `same.pfm` (base).
 fn images() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
@@ -72,7 +99,12 @@ fn identical_images_exit_0_with_every_metric_0() {
     ] {
         assert!(out.contains(line), "{line:?} in\n{out}");
     }
-    assert!(out.ends_with("within tolerance: relMSE 0 <= 0\n"), "{out}");
+    assert!(
+        out.ends_with(
+            "within tolerance: relMSE 0 <= 1.00000e-8 (the default: a match to float precision)\n"
+        ),
+        "{out}"
+    );
     assert_eq!(stderr(&o), "");
 }
 
@@ -109,11 +141,15 @@ fn different_images_exit_1_beyond_the_tolerance_and_0_within() {
     );
     let err = stderr(&o);
     assert_eq!(err.lines().count(), 1, "{err}");
+    // A verdict, not an error; its number printed as the table prints it.
     assert!(
-        err.starts_with("glint: error: a.pfm: differs from b.pfm: relMSE 0.0"),
+        err.starts_with("glint: a.pfm differs from b.pfm beyond the tolerance: relMSE 0.0"),
         "{err}"
     );
-    assert!(err.contains("> tolerance 0"), "{err}");
+    assert!(
+        err.ends_with("> 1.00000e-8 (the default: a match to float precision)\n"),
+        "{err}"
+    );
 
     for (args, code) in [
         (&["--tolerance", "1"][..], 0),
@@ -207,10 +243,7 @@ fn non_finite_values_are_counted_and_never_within_tolerance() {
         out.contains("max difference  NaN at pixel (1, 0), channel R (A NaN, B"),
         "{out}"
     );
-    assert!(
-        out.contains("beyond tolerance: relMSE NaN > tolerance 1000"),
-        "{out}"
-    );
+    assert!(out.contains("beyond tolerance: relMSE NaN > 1000"), "{out}");
     // The same file against itself is identical, NaN included.
     assert_exit(&glint(&["diff", "nan.pfm", "nan.pfm"], dir.path()), 0);
 }

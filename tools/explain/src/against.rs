@@ -4,29 +4,26 @@
 //! texture, lighting, film), to find the first stage where the student's
 //! numbers part from Glint's.
 //!
-//! Within a stage, keys are compared in the order the student's document
-//! lists them (the file is read keeping its order; a `serde_json::Value`
-//! would sort the keys), samples and mirror reflections in document order.
-//! Only the keys the student gives are compared; the keys that describe
-//! Glint's own work ([`SKIPPED`]) are not.
+//! Within a stage, keys are compared in pipeline order ([`PIPELINE_ORDER`]:
+//! a lookup's level before the texels it reads, its texels before their
+//! value), whatever order the student's document lists them in; samples and
+//! mirror reflections in document order. Only the keys the student gives
+//! are compared; the keys that describe Glint's own work ([`SKIPPED`]) are
+//! not. Before any number, the settings a document records (its sample
+//! counts and patterns) must be the command's.
 //!
-//! Tolerances: numbers within [`RELATIVE`] of Glint's, plus [`FLOOR`];
-//! vectors component by component, relative to their largest component;
-//! unit directions within [`ANGLE`] radians; integers, booleans, strings
+//! Tolerances are [`crate::rules`]', the same as `glint grade --stages`':
+//! numbers within [`RELATIVE`] of Glint's, plus [`FLOOR`]; vectors component
+//! by component, relative to their largest component, a sphere's `u` modulo
+//! 1; unit directions within [`ANGLE`] radians; integers, booleans, strings
 //! (kinds, shadow verdicts) and nulls exactly; the 8-bit sRGB value within 1.
 
+use crate::rules::{self, Rule, ANGLE, FLOOR, RELATIVE, UNIT};
 use crate::Stage;
 use serde::de::{self, Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde_json::{json, Number, Value};
 use std::fmt;
 
-/// The relative tolerance of numbers and vectors.
-pub const RELATIVE: f64 = 1e-3;
-/// The absolute floor added to the relative tolerance, so that a value Glint
-/// rounds to almost nothing (a specular term of 1e-30) matches a zero.
-pub const FLOOR: f64 = 1e-6;
-/// The largest angle between two unit directions that agree, in radians.
-pub const ANGLE: f64 = 1e-3;
 /// Keys that describe Glint's own queries (every object's test, the BVH's
 /// work and path), not numbers a ray tracer must reproduce.
 pub const SKIPPED: [&str; 3] = ["tests", "work", "bvh"];
@@ -44,7 +41,86 @@ const DIRECTIONS: [&str; 10] = [
     "shading_normal",
 ];
 /// The document's own keys besides `samples` and `film`.
-const HEADER: [&str; 5] = ["schema", "pixel", "resolution", "spp", "seed"];
+const HEADER: [&str; 9] = [
+    "schema",
+    "pixel",
+    "resolution",
+    "spp",
+    "sampler",
+    "light_samples",
+    "light_sampler",
+    "environment_samples",
+    "seed",
+];
+/// The settings a document records, checked before any number: with
+/// other sample counts or patterns every later number differs for that
+/// reason alone.
+const SETTINGS: [&str; 7] = [
+    "pixel",
+    "resolution",
+    "spp",
+    "sampler",
+    "light_samples",
+    "light_sampler",
+    "environment_samples",
+];
+/// Keys in the order the pipeline computes them, by which a stage's keys
+/// are compared: what decides a value before the value. Keys not listed
+/// follow, in the student's order.
+pub const PIPELINE_ORDER: [&str; 48] = [
+    // camera
+    "raster",
+    "ndc",
+    "film_point",
+    "origin",
+    "direction",
+    "differentials",
+    "rx_origin",
+    "rx_direction",
+    "ry_origin",
+    "ry_direction",
+    // intersection
+    "depth",
+    "intersect",
+    "hit",
+    "object",
+    "kind",
+    "triangle",
+    "t",
+    "point",
+    "geometric_normal",
+    "shading_normal",
+    "front_face",
+    "uv",
+    "dpdu",
+    "dpdv",
+    // texture: the footprint, the level, the texels, the value
+    "footprint",
+    "material_uv",
+    "duvdx",
+    "duvdy",
+    "diffuse",
+    "specular",
+    "st",
+    "dst_dx",
+    "dst_dy",
+    "report_l",
+    "report_w",
+    "report_m",
+    "report_level",
+    "glint_level",
+    "level",
+    "x",
+    "y",
+    "texels",
+    "weight",
+    // lighting
+    "shading",
+    "v",
+    "ng",
+    "n",
+    "position",
+];
 
 /// A JSON value whose objects keep their keys in the file's order.
 #[derive(Clone, Debug, PartialEq)]
@@ -147,7 +223,10 @@ pub enum Tolerance {
     /// A vector (a point, uv, a color): each component within `RELATIVE`
     /// times Glint's largest component, plus `FLOOR`.
     Vector,
-    /// A unit direction: at most `ANGLE` radians apart.
+    /// A sphere's uv: as `Vector`, its `u` modulo 1.
+    PeriodicU,
+    /// A unit direction: at most `ANGLE` radians apart, of length 1 within
+    /// `UNIT`.
     Angular,
     /// Equal: ids, counts, booleans, strings, nulls, the kind of value.
     Exact,
@@ -162,6 +241,7 @@ impl Tolerance {
         match self {
             Tolerance::Relative => "relative",
             Tolerance::Vector => "relative to the largest component",
+            Tolerance::PeriodicU => "relative to the largest component, u modulo 1",
             Tolerance::Angular => "angular",
             Tolerance::Exact => "exact",
             Tolerance::WithinOne => "within 1",
@@ -175,7 +255,10 @@ impl Tolerance {
             Tolerance::Vector => format!(
                 "each component within {RELATIVE:e}·(Glint's largest |component|) + {FLOOR:e}"
             ),
-            Tolerance::Angular => format!("at most {ANGLE:e} rad apart"),
+            Tolerance::PeriodicU => format!(
+                "each component within {RELATIVE:e}·(Glint's largest |component|) + {FLOOR:e}, u modulo 1 (a sphere's seam)"
+            ),
+            Tolerance::Angular => format!("at most {ANGLE:e} rad apart, of length 1 within {UNIT:e}"),
             Tolerance::Exact => "equal".to_owned(),
             Tolerance::WithinOne => "each component within 1".to_owned(),
         }
@@ -339,16 +422,29 @@ fn difference_json(d: &Difference) -> Value {
         "yours": d.yours,
         "glint": d.glint.clone().unwrap_or(Value::Null),
         "in_glint": d.glint.is_some(),
-        "tolerance": {
-            "kind": d.tolerance.name(),
-            "relative": RELATIVE,
-            "floor": FLOOR,
-            "radians": ANGLE,
-        },
+        "tolerance": tolerance_json(d.tolerance),
     });
     if let Some((gap, allowed)) = d.gap {
         out["apart"] = json!(gap);
         out["allowed"] = json!(allowed);
+    }
+    out
+}
+
+/// A tolerance's kind and the constants it uses, no others.
+fn tolerance_json(tolerance: Tolerance) -> Value {
+    let mut out = json!({ "kind": tolerance.name() });
+    match tolerance {
+        Tolerance::Relative | Tolerance::Vector | Tolerance::PeriodicU => {
+            out["relative"] = json!(RELATIVE);
+            out["floor"] = json!(FLOOR);
+        }
+        Tolerance::Angular => {
+            out["radians"] = json!(ANGLE);
+            out["unit_length"] = json!(UNIT);
+        }
+        Tolerance::WithinOne => out["codes"] = json!(SRGB8_CODES),
+        Tolerance::Exact => {}
     }
     out
 }
@@ -360,6 +456,7 @@ fn difference_json(d: &Difference) -> Value {
 /// sample the flags do not follow.
 pub fn compare(student: &Node, glint: &Value, only: Option<Stage>) -> Result<Comparison, String> {
     check_header(student, glint)?;
+    check_light_sample_counts(student, glint)?;
     let mut walk = Walk {
         only,
         stages: Stage::ALL
@@ -414,16 +511,81 @@ fn check_header(student: &Node, glint: &Value) -> Result<(), String> {
         }
         None => return Err("no \"schema\": expected \"schema\": \"glint-explain/1\"".to_owned()),
     }
-    for key in ["pixel", "resolution", "spp", "seed"] {
-        let Some(yours) = student.get(key).map(Node::to_value) else {
+    let differing: Vec<(&str, Value)> = SETTINGS
+        .iter()
+        .chain(&["seed"])
+        .filter_map(|&key| Some((key, student.get(key)?.to_value())))
+        .filter(|(key, yours)| !same(yours, &glint[*key]))
+        .collect();
+    if differing.is_empty() {
+        return Ok(());
+    }
+    let settings = |values: &mut dyn Iterator<Item = (&str, &Value)>| {
+        values
+            .map(|(key, value)| format!("{key} {value}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    Err(format!(
+        "the document records {}, but this command explains {}: pass {} (or record the settings your tracer used)",
+        settings(&mut differing.iter().map(|(k, v)| (*k, v))),
+        settings(&mut differing.iter().map(|(k, _)| (*k, &glint[*k]))),
+        differing
+            .iter()
+            .map(|(key, yours)| flag_for(key, yours))
+            .collect::<Vec<_>>()
+            .join(" ")
+    ))
+}
+
+/// Each light takes as many samples in the student's document as in
+/// Glint's, where the document lists them: with another count (the
+/// document records no settings) every sample's position differs for that
+/// reason alone.
+fn check_light_sample_counts(student: &Node, glint: &Value) -> Result<(), String> {
+    let Some(Node::Array(samples)) = student.get("samples") else {
+        return Ok(());
+    };
+    for (i, sample) in samples.iter().enumerate() {
+        let index = match sample.get("sample") {
+            Some(Node::Number(n)) => n.as_u64(),
+            _ => Some(i as u64),
+        };
+        let theirs = glint["samples"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .find(|s| s["sample"].as_u64() == index);
+        let (Some(mut ray), Some(mut glint_ray)) = (sample.get("ray"), theirs.map(|t| &t["ray"]))
+        else {
             continue;
         };
-        if !same(&yours, &glint[key]) {
-            return Err(format!(
-                "the document is for {key} {yours}, but this command explains {key} {}: {}",
-                glint[key],
-                flag_for(key, &yours)
-            ));
+        loop {
+            let lights = ray.get("light").and_then(|l| l.get("lights"));
+            if let Some(Node::Array(lights)) = lights {
+                for (j, light) in lights.iter().enumerate() {
+                    let yours = match light.get("samples") {
+                        Some(Node::Array(s)) => s.len(),
+                        _ => continue,
+                    };
+                    let Some(glints) = glint_ray["light"]["lights"][j]["samples"].as_array() else {
+                        continue;
+                    };
+                    if yours != glints.len() {
+                        return Err(format!(
+                            "samples[{i}] takes {yours} sample{} of light {j} where this command takes {} (--light-samples {}, --light-sampler {}): pass --light-samples {yours} with the pattern your tracer used, or record it as \"light_samples\" and \"light_sampler\"",
+                            if yours == 1 { "" } else { "s" },
+                            glints.len(),
+                            glint["light_samples"],
+                            glint["light_sampler"].as_str().unwrap_or("?"),
+                        ));
+                    }
+                }
+            }
+            match (ray.get("reflection"), glint_ray.get("reflection")) {
+                (Some(r), Some(g)) if g.is_object() => (ray, glint_ray) = (r, g),
+                _ => break,
+            }
         }
     }
     Ok(())
@@ -435,10 +597,13 @@ fn flag_for(key: &str, value: &Value) -> String {
         Some([a, b]) => format!("{a}{separator}{b}"),
         _ => value.to_string(),
     };
+    let plain = value
+        .as_str()
+        .map_or_else(|| value.to_string(), str::to_owned);
     match key {
-        "pixel" => format!("pass --pixel {}", pair(",")),
-        "resolution" => format!("pass --resolution {}", pair("x")),
-        other => format!("pass --{other} {value}"),
+        "pixel" => format!("--pixel {}", pair(",")),
+        "resolution" => format!("--resolution {}", pair("x")),
+        other => format!("--{} {plain}", other.replace('_', "-")),
     }
 }
 
@@ -526,19 +691,27 @@ impl Walk {
         }
     }
 
-    /// Any value of `stage` under `key`: objects key by key, arrays of
-    /// objects element by element, anything else as one value.
+    /// Any value of `stage` under `key`: objects key by key in pipeline
+    /// order, arrays of objects element by element, anything else as one
+    /// value.
     fn tree(&mut self, stage: Stage, path: &str, key: &str, yours: &Node, glint: Option<&Value>) {
         if self.only.is_some_and(|only| only != stage) {
             return;
         }
         match (yours, glint) {
             (Node::Object(entries), Some(Value::Object(theirs))) => {
-                for (k, v) in entries
-                    .iter()
-                    .filter(|(k, _)| !SKIPPED.contains(&k.as_str()))
-                {
-                    self.tree(stage, &format!("{path}.{k}"), k, v, theirs.get(k));
+                let on_sphere = theirs.get("kind").and_then(Value::as_str) == Some("sphere");
+                for (k, v) in in_pipeline_order(entries) {
+                    let at = format!("{path}.{k}");
+                    match (k, v, theirs.get(k)) {
+                        ("uv", Node::Array(_), Some(g)) => {
+                            let rule = Rule::Uv {
+                                periodic_u: on_sphere,
+                            };
+                            self.leaf(stage, &at, k, v, Some(g), Some(rule))
+                        }
+                        _ => self.tree(stage, &at, k, v, theirs.get(k)),
+                    }
                 }
             }
             (Node::Array(items), Some(Value::Array(theirs))) if !is_vector(theirs) => {
@@ -546,17 +719,26 @@ impl Walk {
                     self.tree(stage, &format!("{path}[{i}]"), key, item, theirs.get(i));
                 }
             }
-            _ => self.leaf(stage, path, key, yours, glint),
+            _ => self.leaf(stage, path, key, yours, glint, None),
         }
     }
 
-    /// One value compared as a whole.
-    fn leaf(&mut self, stage: Stage, path: &str, key: &str, yours: &Node, glint: Option<&Value>) {
+    /// One value compared as a whole, by `rule` if given, else by what its
+    /// key and Glint's value are.
+    fn leaf(
+        &mut self,
+        stage: Stage,
+        path: &str,
+        key: &str,
+        yours: &Node,
+        glint: Option<&Value>,
+        rule: Option<Rule>,
+    ) {
         let result = &mut self.stages[stage as usize];
         result.compared += 1;
         let yours = yours.to_value();
         let verdict = match glint {
-            Some(g) => agree(key, &yours, g),
+            Some(g) => agree(key, &yours, g, rule),
             None => Err((Tolerance::Exact, None)),
         };
         if let Err((tolerance, gap)) = verdict {
@@ -572,6 +754,25 @@ impl Walk {
     }
 }
 
+/// An object's entries in [`PIPELINE_ORDER`], the keys that describe
+/// Glint's own work ([`SKIPPED`]) left out; keys not listed last, in the
+/// document's order.
+fn in_pipeline_order(entries: &[(String, Node)]) -> Vec<(&str, &Node)> {
+    let mut keys: Vec<(&str, &Node)> = entries
+        .iter()
+        .filter(|(k, _)| !SKIPPED.contains(&k.as_str()))
+        .map(|(k, v)| (k.as_str(), v))
+        .collect();
+    let place = |k: &str| {
+        PIPELINE_ORDER
+            .iter()
+            .position(|p| *p == k)
+            .unwrap_or(PIPELINE_ORDER.len())
+    };
+    keys.sort_by_key(|(k, _)| place(k));
+    keys
+}
+
 /// An array of numbers (or of nulls, Glint's non-finite numbers): a vector.
 fn is_vector(items: &[Value]) -> bool {
     !items.is_empty() && items.iter().all(|v| v.is_number() || v.is_null())
@@ -579,16 +780,21 @@ fn is_vector(items: &[Value]) -> bool {
 
 type Verdict = Result<Tolerance, (Tolerance, Option<(f64, f64)>)>;
 
-/// Whether `yours` agrees with Glint's `glint` under `key`, and by which
-/// tolerance; on a failure, how far apart they are where that is a number.
-fn agree(key: &str, yours: &Value, glint: &Value) -> Verdict {
+/// Whether `yours` agrees with Glint's `glint` under `key` (by `rule` if
+/// given), and by which tolerance; on a failure, how far apart they are
+/// where that is a number.
+fn agree(key: &str, yours: &Value, glint: &Value, rule: Option<Rule>) -> Verdict {
     match (yours, glint) {
-        (Value::Array(a), Value::Array(g)) if is_vector(g) => vector(key, a, g),
+        (Value::Array(a), Value::Array(g)) if is_vector(g) => vector(key, a, g, rule),
         (Value::Number(a), Value::Number(g)) => number(key, a, g),
         _ if same(yours, glint) => Ok(Tolerance::Exact),
         _ => Err((Tolerance::Exact, None)),
     }
 }
+
+/// The 8-bit value's tolerance: the radiance is the student's own, and
+/// one within tolerance may round either way.
+const SRGB8_CODES: f64 = 1.0;
 
 /// A number: integers exactly (Glint writes ids and counts as integers),
 /// floats relatively.
@@ -597,26 +803,22 @@ fn number(key: &str, yours: &Number, glint: &Number) -> Verdict {
         yours.as_f64().unwrap_or(f64::NAN),
         glint.as_f64().unwrap_or(0.0),
     );
-    if !glint.is_f64() {
-        let tolerance = if key == "srgb8" {
-            Tolerance::WithinOne
-        } else {
-            Tolerance::Exact
-        };
-        let allowed = if key == "srgb8" { 1.0 } else { 0.0 };
-        return within(tolerance, (a - g).abs(), allowed);
+    match (glint.is_f64(), key) {
+        (false, "srgb8") => within(
+            Tolerance::WithinOne,
+            Rule::Codes { codes: SRGB8_CODES },
+            &[g],
+            &[a],
+        ),
+        (false, _) => within(Tolerance::Exact, Rule::Codes { codes: 0.0 }, &[g], &[a]),
+        (true, _) => within(Tolerance::Relative, Rule::Relative, &[g], &[a]),
     }
-    within(
-        Tolerance::Relative,
-        (a - g).abs(),
-        RELATIVE * g.abs() + FLOOR,
-    )
 }
 
 /// A vector: a unit direction by angle, integers exactly (or within 1 for
-/// the 8-bit value), anything else component by component relative to its
-/// largest component.
-fn vector(key: &str, yours: &[Value], glint: &[Value]) -> Verdict {
+/// the 8-bit value), a uv by `rule` (a sphere's `u` modulo 1), anything
+/// else component by component relative to its largest component.
+fn vector(key: &str, yours: &[Value], glint: &[Value], rule: Option<Rule>) -> Verdict {
     let numbers = |v: &[Value]| v.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>();
     let (Some(a), Some(g)) = (numbers(yours), numbers(glint)) else {
         // A null (a number that is not finite) must be matched exactly.
@@ -632,56 +834,33 @@ fn vector(key: &str, yours: &[Value], glint: &[Value]) -> Verdict {
         .iter()
         .all(|v| !v.as_number().is_some_and(Number::is_f64))
     {
-        let gap = a
-            .iter()
-            .zip(&g)
-            .map(|(x, y)| (x - y).abs())
-            .fold(0.0, f64::max);
         return match key {
-            "srgb8" => within(Tolerance::WithinOne, gap, 1.0),
-            _ => within(Tolerance::Exact, gap, 0.0),
+            "srgb8" => within(
+                Tolerance::WithinOne,
+                Rule::Codes { codes: SRGB8_CODES },
+                &g,
+                &a,
+            ),
+            _ => within(Tolerance::Exact, Rule::Codes { codes: 0.0 }, &g, &a),
         };
     }
-    if DIRECTIONS.contains(&key) {
-        if let Some(angle) = angle_between(&a, &g) {
-            return within(Tolerance::Angular, angle, ANGLE);
-        }
+    if DIRECTIONS.contains(&key) && rules::angle_between(&a, &g).is_some() {
+        return within(Tolerance::Angular, Rule::Direction, &g, &a);
     }
-    let largest = g.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let gap = a
-        .iter()
-        .zip(&g)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
-    within(Tolerance::Vector, gap, RELATIVE * largest + FLOOR)
+    match rule {
+        Some(rule @ Rule::Uv { periodic_u: true }) => within(Tolerance::PeriodicU, rule, &g, &a),
+        _ => within(Tolerance::Vector, Rule::Vector, &g, &a),
+    }
 }
 
-/// The angle between two vectors; `None` if either has no length.
-fn angle_between(a: &[f64], b: &[f64]) -> Option<f64> {
-    let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
-    let length = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let (la, lb) = (length(a), length(b));
-    if la == 0.0 || lb == 0.0 {
-        return None;
-    }
-    // The cross product's length keeps small angles accurate, where acos
-    // of a dot product near 1 loses them.
-    let cross = match (a, b) {
-        ([ax, ay, az], [bx, by, bz]) => {
-            let c = [ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx];
-            length(&c)
-        }
-        _ => ((la * lb).powi(2) - dot * dot).max(0.0).sqrt(),
-    };
-    Some(cross.atan2(dot))
-}
-
-fn within(tolerance: Tolerance, gap: f64, allowed: f64) -> Verdict {
-    if gap <= allowed {
+/// Glint's `g` against `a` under `rule`, reported as `tolerance`.
+fn within(tolerance: Tolerance, rule: Rule, g: &[f64], a: &[f64]) -> Verdict {
+    let gap = rules::measure(rule, g, a);
+    if gap.agrees() {
         Ok(tolerance)
     } else {
         // NaN (a student's value that is no number) never agrees.
-        Err((tolerance, Some((gap, allowed))))
+        Err((tolerance, Some((gap.apart, gap.allowed))))
     }
 }
 
@@ -692,14 +871,15 @@ mod tests {
     fn glint() -> Value {
         json!({
             "schema": "glint-explain/1", "pixel": [3, 4], "resolution": [8, 8],
-            "spp": 1, "seed": 0,
+            "spp": 1, "sampler": "grid", "light_samples": 1, "light_sampler": "grid",
+            "environment_samples": 0, "seed": 0,
             "samples": [{
                 "sample": 0,
                 "camera": {"raster": [3.5, 4.5], "direction": [0.0, 0.6, -0.8]},
                 "ray": {
                     "depth": 0,
-                    "intersect": {"tests": [{"object": 0}], "hit": {"object": 2, "t": 10.0, "uv": [0.5, 0.25]}},
-                    "texture": {"kd": [0.5, 0.5, 0.5]},
+                    "intersect": {"tests": [{"object": 0}], "hit": {"kind": "sphere", "object": 2, "t": 10.0, "uv": [0.9, 0.25]}},
+                    "texture": {"diffuse": {"report_level": 2.0, "texels": [{"level": 2, "x": 1, "y": 1, "value": [0.5, 0.5, 0.5], "weight": 1.0}], "value": [0.5, 0.5, 0.5]}, "kd": [0.5, 0.5, 0.5]},
                     "light": {"lights": [{"samples": [{"shadow": "unoccluded", "specular": [1.7e-30, 0.0, 0.0]}]}]},
                     "radiance": {"value": [0.3, 0.3, 0.3]}
                 },
@@ -714,13 +894,13 @@ mod tests {
     }
 
     #[test]
-    fn glints_own_document_agrees_and_keys_keep_the_files_order() {
+    fn glints_own_document_agrees_and_a_json_object_keeps_the_files_order() {
         let doc = glint().to_string();
         let c = against(&doc).unwrap();
         assert!(c.agrees(), "{}", c.text("x"));
         // Every stage was compared, the BVH's tests skipped.
         let compared: Vec<usize> = c.stages.iter().map(|s| s.compared).collect();
-        assert_eq!(compared, [2, 4, 1, 4, 2]);
+        assert_eq!(compared, [2, 5, 8, 4, 2]);
         let node = Node::parse(r#"{"b": 1, "a": 2}"#).unwrap();
         let Node::Object(entries) = node else {
             panic!()
@@ -729,9 +909,10 @@ mod tests {
     }
 
     #[test]
-    fn the_first_difference_is_in_pipeline_order_and_in_the_files_order_within_a_stage() {
+    fn the_first_difference_is_in_pipeline_order_whatever_the_files_order() {
         // The film and the uv both differ, and the film comes first in the
-        // file: the intersection is reported.
+        // file: the intersection is reported; within it, the object before
+        // the uv though the file lists the uv first.
         let c = against(
             r#"{"schema": "glint-explain/1", "pixel": [3, 4],
                 "film": {"radiance": [0.9, 0.3, 0.3]},
@@ -740,10 +921,64 @@ mod tests {
         .unwrap();
         let first = c.first().unwrap();
         assert_eq!(first.stage, Stage::Intersect);
-        assert_eq!(first.path, "samples[0].ray.intersect.hit.uv");
-        assert_eq!(first.tolerance, Tolerance::Vector);
+        assert_eq!(first.path, "samples[0].ray.intersect.hit.object");
+        assert_eq!(first.tolerance, Tolerance::Exact);
         assert_eq!(c.stages[Stage::Intersect as usize].differences.len(), 2);
         assert_eq!(c.stages[Stage::Film as usize].differences.len(), 1);
+        // A lookup's level is compared before the value it decides.
+        let c = against(
+            r#"{"schema": "glint-explain/1", "pixel": [3, 4], "samples": [{"sample": 0, "ray":
+                {"texture": {"diffuse": {"value": [0.4, 0.5, 0.5], "report_level": 2.9}}}}]}"#,
+        )
+        .unwrap();
+        assert_eq!(
+            c.first().unwrap().path,
+            "samples[0].ray.texture.diffuse.report_level"
+        );
+    }
+
+    #[test]
+    fn a_spheres_u_is_compared_modulo_1_as_grade_stages_compares_it() {
+        let c = against(
+            r#"{"schema": "glint-explain/1", "pixel": [3, 4], "samples": [{"sample": 0, "ray":
+                {"intersect": {"hit": {"uv": [-0.1, 0.25]}}}}]}"#,
+        )
+        .unwrap();
+        assert!(c.agrees(), "{}", c.text("x"));
+        let c = against(
+            r#"{"schema": "glint-explain/1", "pixel": [3, 4], "samples": [{"sample": 0, "ray":
+                {"intersect": {"hit": {"uv": [0.8, 0.25]}}}}]}"#,
+        )
+        .unwrap();
+        assert_eq!(c.first().unwrap().tolerance, Tolerance::PeriodicU);
+    }
+
+    #[test]
+    fn other_settings_are_named_before_any_number() {
+        let err = against(
+            r#"{"schema": "glint-explain/1", "pixel": [3, 4], "light_samples": 16, "light_sampler": "stratified",
+                "samples": [{"sample": 0, "camera": {"raster": [9.0, 9.0]}}]}"#,
+        )
+        .unwrap_err();
+        assert!(
+            err.starts_with("the document records light_samples 16, light_sampler \"stratified\", but this command explains light_samples 1, light_sampler \"grid\""),
+            "{err}"
+        );
+        assert!(
+            err.contains("pass --light-samples 16 --light-sampler stratified"),
+            "{err}"
+        );
+        // A document that records no settings but lists 2 light samples
+        // where the command takes 1.
+        let err = against(
+            r#"{"schema": "glint-explain/1", "pixel": [3, 4], "samples": [{"sample": 0, "ray":
+                {"light": {"lights": [{"samples": [{"shadow": "unoccluded"}, {"shadow": "unoccluded"}]}]}}}]}"#,
+        )
+        .unwrap_err();
+        assert!(
+            err.starts_with("samples[0] takes 2 samples of light 0 where this command takes 1 (--light-samples 1, --light-sampler grid)"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -23,6 +23,7 @@
 
 pub mod against;
 mod json;
+pub mod rules;
 mod text;
 
 #[cfg(doctest)]
@@ -138,6 +139,10 @@ pub fn explain(
         "pixel": [x, y],
         "resolution": [scene.camera.resolution().x, scene.camera.resolution().y],
         "spp": explained.spp,
+        "sampler": settings.pixel_pattern.name(),
+        "light_samples": settings.light_samples,
+        "light_sampler": settings.light_pattern.name(),
+        "environment_samples": settings.environment_samples,
         "seed": settings.seed,
         "samples": samples,
         "film": {

@@ -7,16 +7,10 @@ use super::probe;
 use super::table::{Case, Check, Field, Value};
 use super::{vectors, Stage, StageVectors};
 use crate::{GradeError, GradeScene};
-use glint_explain::against::{ANGLE, FLOOR, RELATIVE};
+use glint_explain::rules::{self, Rule};
 use glint_integrator::trace::SampleSelection;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-
-/// [`Check::Level`]'s tolerance, in levels.
-pub const LEVEL: f64 = 3e-3;
-
-/// How far from 1 the length of an answered direction may be.
-pub const UNIT: f64 = 1e-3;
 
 /// One expected field an answer does not match.
 #[derive(Clone, Debug, PartialEq)]
@@ -254,62 +248,25 @@ fn same(expected: &Value, answered: &Answer) -> bool {
     }
 }
 
-/// How far apart `a` is from `e` under `check`, what it allows, and a note
-/// where the figure is not the difference itself.
+/// How far apart `a` is from `e` under `check` ([`glint_explain::rules`],
+/// the rules `glint explain --against` compares by), what it allows, and a
+/// note where the figure is not the difference itself.
 fn measure(
     check: Check,
     e: &[f64],
     a: &[f64],
     periodic_u: bool,
 ) -> (f64, f64, Option<&'static str>) {
-    let largest = e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let relative = RELATIVE * largest + FLOOR;
-    let componentwise = |wrap_u: bool| {
-        e.iter()
-            .zip(a)
-            .enumerate()
-            .map(|(i, (e, a))| {
-                let d = a - e;
-                if wrap_u && i == 0 {
-                    (d - d.round()).abs()
-                } else {
-                    d.abs()
-                }
-            })
-            .fold(0.0f64, |m, d| {
-                if d.is_nan() || m.is_nan() {
-                    f64::NAN
-                } else {
-                    m.max(d)
-                }
-            })
+    let rule = match check {
+        Check::Relative => Rule::Relative,
+        Check::Vector => Rule::Vector,
+        Check::Uv => Rule::Uv { periodic_u },
+        Check::Level => Rule::Level,
+        Check::Direction => Rule::Direction,
+        Check::Exact | Check::Info => return (0.0, 0.0, None),
     };
-    match check {
-        Check::Relative | Check::Vector => (componentwise(false), relative, None),
-        Check::Uv => (componentwise(periodic_u), relative, None),
-        Check::Level => (componentwise(false), LEVEL, None),
-        Check::Direction => {
-            let length = a.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if (length - 1.0).abs() > UNIT {
-                return ((length - 1.0).abs(), UNIT, Some("not of unit length"));
-            }
-            (angle(e, a), ANGLE, Some("radians"))
-        }
-        Check::Exact | Check::Info => (0.0, 0.0, None),
-    }
-}
-
-/// The angle between two 3-vectors, `atan2(|e × a|, e·a)` (accurate at
-/// small angles, where `acos` is not).
-fn angle(e: &[f64], a: &[f64]) -> f64 {
-    let cross = [
-        e[1] * a[2] - e[2] * a[1],
-        e[2] * a[0] - e[0] * a[2],
-        e[0] * a[1] - e[1] * a[0],
-    ];
-    let sine = cross.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let cosine: f64 = e.iter().zip(a).map(|(x, y)| x * y).sum();
-    sine.atan2(cosine)
+    let gap = rules::measure(rule, e, a);
+    (gap.apart, gap.allowed, gap.note)
 }
 
 #[cfg(test)]

@@ -26,6 +26,8 @@ use super::table::{Case, Check, Field, Kind, Layout, Value, RGB, XYZ};
 use super::Context;
 use crate::GradeError;
 use glam::Vec3;
+use glint_explain::rules::SHADOW_EPSILON;
+use glint_geometry::bvh::Bounds3;
 use glint_geometry::{spawn_ray_to, Hit, Ray, RayTarget};
 use glint_integrator::trace::{Event, Shadow, Skip};
 use glint_integrator::{Scene, ShadingModel, SurfaceKind};
@@ -351,11 +353,62 @@ fn light_inputs(case: &mut Case, j: usize, light: &Light) {
 /// where a correct program in other arithmetic could decide otherwise
 /// ([`MARGIN`]).
 fn steady(scene: &Scene, s: &Shading) -> bool {
+    let size = scene_size(scene);
     s.lights.iter().all(|(j, samples, _)| {
-        samples
-            .iter()
-            .all(|sample| sample_steady(scene, s, &scene.lights[*j], sample))
+        samples.iter().all(|sample| {
+            sample_steady(scene, s, &scene.lights[*j], sample)
+                && fixed_offsets_agree(scene, s, sample, size)
+        })
     })
+}
+
+/// The scene's size for its shadow-ray offsets: the longest side of the
+/// box around its finite shapes (1 if it has none).
+pub fn scene_size(scene: &Scene) -> f32 {
+    let bounds = scene
+        .shapes
+        .shapes()
+        .iter()
+        .filter_map(|shape| shape.bounds())
+        .fold(Bounds3::EMPTY, Bounds3::union);
+    let side = (bounds.max - bounds.min).max_element();
+    if side.is_finite() && side > 0.0 {
+        side
+    } else {
+        1.0
+    }
+}
+
+/// Whether a shadow ray with a fixed offset gets the sample's verdict at
+/// both ends of the offsets the docs allow ([`SHADOW_EPSILON`] of the
+/// scene's `size`), following `docs/scene-format.md`'s rule literally:
+/// start at `o = x + ε·ng` (`ng` on the light's side), aim at the sample
+/// `p` from `o`, and count a blocker at `0 < t < |p − o| − ε`.
+fn fixed_offsets_agree(scene: &Scene, s: &Shading, sample: &Sample, size: f32) -> bool {
+    let blocked = match sample.shadow {
+        Shadow::Blocked { .. } => true,
+        Shadow::Unoccluded => false,
+        _ => return true,
+    };
+    SHADOW_EPSILON.iter().all(|&fraction| {
+        let epsilon = fraction as f32 * size;
+        fixed_offset_blocked(scene, s.hit.point, s.ng, sample.position, epsilon) == blocked
+    })
+}
+
+/// The docs' fixed-offset shadow ray from `x` (geometric normal `ng`) to
+/// `p`: whether anything lies on it.
+pub fn fixed_offset_blocked(scene: &Scene, x: Vec3, ng: Vec3, p: Vec3, epsilon: f32) -> bool {
+    let side = if ng.dot(p - x) >= 0.0 { ng } else { -ng };
+    let origin = x + epsilon * side;
+    let towards = p - origin;
+    let length = towards.length();
+    if length <= epsilon {
+        return false;
+    }
+    scene
+        .shapes
+        .any_hit(&Ray::new(origin, towards), 1.0 - epsilon / length)
 }
 
 fn sample_steady(scene: &Scene, s: &Shading, light: &Light, sample: &Sample) -> bool {

@@ -2,11 +2,11 @@
 //! first failing case with `glint explain`'s text) and JSON (schema
 //! [`CHECK_SCHEMA`]).
 
-use super::check::{CaseFailure, Difference, StageCheck, StagesCheck, LEVEL};
+use super::check::{CaseFailure, Difference, StageCheck, StagesCheck};
 use super::files::{explain_command, Ordered};
 use super::table::{Case, Check, Value, RGB, XYZ};
 use super::CHECK_SCHEMA;
-use glint_explain::against::{ANGLE, FLOOR, RELATIVE};
+use glint_explain::rules::{ANGLE, FLOOR, LEVEL, RELATIVE, UNIT};
 use serde_json::Value as Json;
 use std::fmt::Write;
 
@@ -293,7 +293,10 @@ fn difference_json(d: &Difference) -> Ordered {
             tolerance.push(("relative", value(RELATIVE)));
             tolerance.push(("floor", value(FLOOR)));
         }
-        Check::Direction => tolerance.push(("radians", value(ANGLE))),
+        Check::Direction => {
+            tolerance.push(("radians", value(ANGLE)));
+            tolerance.push(("unit_length", value(UNIT)));
+        }
         Check::Level => tolerance.push(("levels", value(LEVEL))),
         Check::Exact | Check::Info => {}
     }

@@ -109,20 +109,23 @@ pub enum Check {
 }
 
 impl Check {
-    /// The tolerance in words, for reports and the files' headers.
-    pub fn describe(self) -> &'static str {
+    /// The tolerance in words, for reports and the files' headers, from
+    /// the constants of [`glint_explain::rules`].
+    pub fn describe(self) -> String {
+        use glint_explain::rules::{ANGLE, FLOOR, LEVEL, RELATIVE, UNIT};
+        let vector = format!(
+            "each component within {RELATIVE:e} × (Glint's largest |component|) + {FLOOR:e}"
+        );
         match self {
-            Check::Relative => "within 1e-3 × |Glint's| + 1e-6",
-            Check::Vector => {
-                "each component within 1e-3 × (Glint's largest |component|) + 1e-6"
+            Check::Relative => format!("within {RELATIVE:e} × |Glint's| + {FLOOR:e}"),
+            Check::Vector => vector,
+            Check::Direction => {
+                format!("at most {ANGLE:e} radians from Glint's, and of length 1 within {UNIT:e}")
             }
-            Check::Direction => "at most 1e-3 radians from Glint's, and of length 1 within 1e-3",
-            Check::Uv => {
-                "each component within 1e-3 × (Glint's largest |component|) + 1e-6; u modulo 1 on spheres"
-            }
-            Check::Level => "within 0.003 levels",
-            Check::Exact => "equal",
-            Check::Info => "not checked",
+            Check::Uv => format!("{vector}; u modulo 1 on spheres"),
+            Check::Level => format!("within {LEVEL} levels"),
+            Check::Exact => "equal".into(),
+            Check::Info => "not checked".into(),
         }
     }
 

@@ -307,6 +307,100 @@ fn a_wrong_sign_of_the_spheres_u_fails_the_intersection_stage() {
     assert!(out.ends_with("1 stage fails: intersection\n"), "{out}");
 }
 
+/// `text` (a stage's CSV) with `edit` applied to each row's cells, by
+/// column name.
+fn edited(text: &str, edit: impl Fn(&mut std::collections::HashMap<String, String>)) -> String {
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let mut out = vec![header.join(",")];
+    for line in lines {
+        let mut row: std::collections::HashMap<String, String> = header
+            .iter()
+            .cloned()
+            .zip(line.split(',').map(String::from))
+            .collect();
+        edit(&mut row);
+        out.push(
+            header
+                .iter()
+                .map(|h| row[h].clone())
+                .collect::<Vec<_>>()
+                .join(","),
+        );
+    }
+    out.join("\n") + "\n"
+}
+
+#[test]
+fn a_failing_case_shows_the_steps_of_glints_expected_value() {
+    // The textured spheres: image textures read at the report's level. A
+    // level from the natural log, and a light that blocks its own shadow rays.
+    let dir = tempfile::tempdir().unwrap();
+    let spheres = scene("textured-spheres");
+    let o = glint(&["grade", "--stages", &spheres, "--write", "v"], dir.path());
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let read = |name: &str| std::fs::read_to_string(dir.path().join("v").join(name)).unwrap();
+    std::fs::create_dir(dir.path().join("a")).unwrap();
+    let texture = edited(&read("texture.csv"), |row| {
+        if let Ok(level) = row["level"].parse::<f64>() {
+            row.insert("level".into(), (level * 2f64.ln()).to_string());
+        }
+    });
+    std::fs::write(dir.path().join("a/texture.csv"), texture).unwrap();
+    let lighting = edited(&read("lighting.csv"), |row| {
+        if row["s00_verdict"] == "visible" {
+            row.insert("s00_verdict".into(), "blocked".into());
+            row.insert("s00_blocker".into(), "10".into());
+        }
+    });
+    std::fs::write(dir.path().join("a/lighting.csv"), lighting).unwrap();
+    let o = glint(
+        &["grade", "--stages", &spheres, "--answers", "a"],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let out = stdout(&o);
+    // The texture's steps: the report's level, the two pyramid levels with
+    // their sizes and weights, eight texels, and their sum, Glint's value.
+    let texture = &out[out.find("texture: ").unwrap()..out.find("lighting: ").unwrap()];
+    let steps = &texture[texture
+        .find("how Glint's expected values were found:")
+        .unwrap()..texture.find("Glint's steps: ").unwrap()];
+    assert!(steps.contains("level = log2(L/W) = log2("), "{texture}");
+    assert!(
+        steps.contains("the report's level, not the render's below"),
+        "{texture}"
+    );
+    let reads = steps
+        .lines()
+        .find(|l| l.trim_start().starts_with("reads level"))
+        .unwrap();
+    assert!(
+        reads.contains(" × ") && reads.contains(" weight "),
+        "{reads}"
+    );
+    assert_eq!(steps.matches(" texel (").count(), 8, "{texture}");
+    let sum = steps
+        .lines()
+        .find(|l| l.contains("value = Σ weight × texel = ("))
+        .unwrap();
+    let glints = texture
+        .lines()
+        .find(|l| l.trim_start().starts_with("value ["))
+        .map(|l| l.to_owned());
+    assert!(
+        glints.is_none(),
+        "the value is right, only the level is wrong: {texture}"
+    );
+    assert!(sum.ends_with(')'), "{sum}");
+    // The lighting's: the student's blocker named.
+    let lighting = &out[out.find("lighting: ").unwrap()..];
+    assert!(
+        lighting.contains("s00: Glint's visible, yours blocked by object 10 ("),
+        "{lighting}"
+    );
+}
+
 #[test]
 fn unreadable_answers_are_bad_input() {
     let dir = answers(&["film.csv"], |_, text| {

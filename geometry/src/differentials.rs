@@ -90,12 +90,17 @@ pub fn reflect_differential(
 
 impl RayDifferential {
     /// The angle (radians) between a ray of direction `d` and the wider of its two
-    /// offset rays: the angular footprint an environment lookup filters over.
+    /// offset rays: the angular footprint an environment lookup filters over,
+    /// `max(∠(d, rx), ∠(d, ry))`. Each angle is `2·atan2(|a − b|, |a + b|)` of
+    /// the unit directions (Kahan), accurate to a few float steps at any
+    /// angle, where `acos(a·b)` of a dot product rounded near 1 moves in steps
+    /// of 2⁻²⁴ of `1 − cos`: about 5% apart at a pixel's footprint.
     pub fn angular_width(&self, d: Vec3) -> f32 {
         let angle = |o: Vec3| {
-            let cos = d.normalize().dot(o.normalize());
-            if cos.is_finite() {
-                cos.clamp(-1.0, 1.0).acos()
+            let (a, b) = (d.normalize(), o.normalize());
+            let angle = 2.0 * (a - b).length().atan2((a + b).length());
+            if angle.is_finite() {
+                angle
             } else {
                 0.0
             }
@@ -157,6 +162,32 @@ impl Hit {
 mod tests {
     use crate::{Plane, Ray, RayDifferential, Shape};
     use glam::{Vec2, Vec3};
+
+    #[test]
+    fn the_angular_width_is_accurate_at_a_pixels_footprint() {
+        // Angles of a pixel's size and below, between directions off every
+        // axis: within a few float steps (3e-7 rad) of the angle computed in
+        // 64 bits, where acos of a 32-bit dot product near 1 is off by up to
+        // 1e-4 rad.
+        for (k, angle) in [2.2e-3f64, 1e-3, 3e-4, 0.5].into_iter().enumerate() {
+            let d = glam::DVec3::new(0.3, -0.8 + 0.1 * k as f64, 0.52).normalize();
+            let side = d.cross(glam::DVec3::Y).normalize();
+            let o = d * angle.cos() + side * angle.sin();
+            let diff = RayDifferential {
+                rx_origin: Vec3::ZERO,
+                rx_direction: o.as_vec3() * 3.0,
+                ry_origin: Vec3::ZERO,
+                ry_direction: d.as_vec3(),
+            };
+            let width = f64::from(diff.angular_width(d.as_vec3() * 0.5));
+            // The exact angle between the 32-bit directions given.
+            let exact = d.as_vec3().as_dvec3().angle_between(o.as_vec3().as_dvec3());
+            assert!(
+                (width - exact).abs() < 3e-7,
+                "{angle}: {width} against {exact}"
+            );
+        }
+    }
 
     fn ground_hit_from(height: f32, tilt: f32) -> (crate::Hit, RayDifferential) {
         let plane = Shape::from(Plane::new(Vec3::ZERO, Vec3::Y, false).unwrap());

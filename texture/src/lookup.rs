@@ -91,39 +91,6 @@ fn explain_image(t: &ImageTexture, tc: &TexCoord, out: &mut LookupExplained) {
     let image = t.image.image();
     out.glint_level = Some(t.mip_level(tc));
     let reduced = reduce_st(st, t.wrap);
-    let mut bilinear = |level: usize, weight: f32| {
-        let image = match level {
-            0 => image,
-            _ => &t.image.pyramid().levels()[level],
-        };
-        let p = reduced * image.size() - 0.5;
-        let p0 = p.floor();
-        let f = p - p0;
-        for (dx, dy, w) in [
-            (0, 0, (1.0 - f.x) * (1.0 - f.y)),
-            (1, 0, f.x * (1.0 - f.y)),
-            (0, 1, (1.0 - f.x) * f.y),
-            (1, 1, f.x * f.y),
-        ] {
-            let (x, y) = (p0.x as i64 + dx, p0.y as i64 + dy);
-            out.texels.push(TexelRead {
-                level,
-                x,
-                y,
-                weight: weight * w,
-                value: image.texel_wrapped(x, y, t.wrap),
-            });
-        }
-    };
-    let mut trilinear = |level: f32| {
-        let last = t.image.pyramid().levels().len() - 1;
-        let lower = (level as usize).min(last);
-        let frac = level - lower as f32;
-        bilinear(lower, 1.0 - frac);
-        if frac > 0.0 {
-            bilinear((lower + 1).min(last), frac);
-        }
-    };
     match t.filter {
         TextureFilter::Nearest => {
             let p = (reduced * image.size()).floor();
@@ -136,17 +103,19 @@ fn explain_image(t: &ImageTexture, tc: &TexCoord, out: &mut LookupExplained) {
                 value: image.texel_wrapped(x, y, t.wrap),
             });
         }
-        TextureFilter::Bilinear => bilinear(0, 1.0),
-        TextureFilter::Trilinear => trilinear(out.glint_level.unwrap_or(0.0)),
+        TextureFilter::Bilinear => bilinear_texels(t, reduced, 0, 1.0, &mut out.texels),
+        TextureFilter::Trilinear => {
+            trilinear_texels(t, reduced, out.glint_level.unwrap_or(0.0), &mut out.texels)
+        }
         TextureFilter::Ewa => match t
             .image
             .pyramid()
             .ewa_explained(st, dst0, dst1, t.wrap)
             .reads
         {
-            EwaRead::Texels(texels) => {
+            EwaRead::Texels(read) => {
                 let levels = t.image.pyramid().levels();
-                out.texels.extend(texels.iter().map(|e| TexelRead {
+                out.texels.extend(read.iter().map(|e| TexelRead {
                     level: e.level,
                     x: e.x,
                     y: e.y,
@@ -156,7 +125,7 @@ fn explain_image(t: &ImageTexture, tc: &TexCoord, out: &mut LookupExplained) {
             }
             EwaRead::Fallback(EwaFallback::Bilinear) => {
                 out.kind = "ewa (zero footprint: bilinear)".into();
-                bilinear(0, 1.0);
+                bilinear_texels(t, reduced, 0, 1.0, &mut out.texels);
             }
             EwaRead::Fallback(EwaFallback::LastLevel) => {
                 out.kind = "ewa (at the last level: its one texel)".into();
@@ -171,9 +140,69 @@ fn explain_image(t: &ImageTexture, tc: &TexCoord, out: &mut LookupExplained) {
             }
             EwaRead::Fallback(EwaFallback::Trilinear { width }) => {
                 out.kind = "ewa (ellipse too large: trilinear)".into();
-                trilinear(t.image.pyramid().level_for_width(width));
+                let level = t.image.pyramid().level_for_width(width);
+                trilinear_texels(t, reduced, level, &mut out.texels);
             }
         },
+    }
+}
+
+impl ImageTexture {
+    /// The texels a trilinear lookup at `st` and the given continuous
+    /// `level` reads, with their weights: [`crate::MipMap::trilinear_at_level`]'s
+    /// (the level clamped to the pyramid the same way), for a level chosen
+    /// elsewhere, as the course report's `log2(L/W)`.
+    pub fn texels_at_level(&self, st: Vec2, level: f32) -> Vec<TexelRead> {
+        let mut texels = Vec::new();
+        trilinear_texels(self, reduce_st(st, self.wrap), level, &mut texels);
+        texels
+    }
+}
+
+/// The four texels of a bilinear lookup at `reduced` in `level`, weighted by
+/// `weight` times their bilinear weights.
+fn bilinear_texels(
+    t: &ImageTexture,
+    reduced: Vec2,
+    level: usize,
+    weight: f32,
+    out: &mut Vec<TexelRead>,
+) {
+    let image = &t.image.pyramid().levels()[level];
+    let p = reduced * image.size() - 0.5;
+    let p0 = p.floor();
+    let f = p - p0;
+    for (dx, dy, w) in [
+        (0, 0, (1.0 - f.x) * (1.0 - f.y)),
+        (1, 0, f.x * (1.0 - f.y)),
+        (0, 1, (1.0 - f.x) * f.y),
+        (1, 1, f.x * f.y),
+    ] {
+        let (x, y) = (p0.x as i64 + dx, p0.y as i64 + dy);
+        out.push(TexelRead {
+            level,
+            x,
+            y,
+            weight: weight * w,
+            value: image.texel_wrapped(x, y, t.wrap),
+        });
+    }
+}
+
+/// The texels of a trilinear lookup at `level`, clamped to `[0, last]`
+/// (NaN reads level 0) as [`crate::MipMap::trilinear_at_level`] clamps it.
+fn trilinear_texels(t: &ImageTexture, reduced: Vec2, level: f32, out: &mut Vec<TexelRead>) {
+    let last = t.image.pyramid().levels().len() - 1;
+    let level = if level >= 0.0 {
+        level.min(last as f32)
+    } else {
+        0.0
+    };
+    let lower = level as usize;
+    let frac = level - lower as f32;
+    bilinear_texels(t, reduced, lower, 1.0 - frac, out);
+    if frac > 0.0 {
+        bilinear_texels(t, reduced, lower + 1, frac, out);
     }
 }
 
@@ -181,6 +210,41 @@ fn explain_image(t: &ImageTexture, tc: &TexCoord, out: &mut LookupExplained) {
 mod tests {
     use super::*;
     use crate::{Checkerboard, Image, TextureImage, WrapMode};
+
+    #[test]
+    fn the_texels_at_a_level_make_the_trilinear_value_there() {
+        // An odd-sized pyramid (37 × 25: its levels round down), levels
+        // between, on, below and past its ends.
+        let image = TextureImage::new(Image::from_fn(37, 25, |x, y| {
+            Vec3::new(x as f32, y as f32, ((x * 7 + y * 3) % 5) as f32)
+        }));
+        let texture = ImageTexture::new(image.clone(), WrapMode::Repeat, TextureFilter::Trilinear);
+        let st = Vec2::new(0.61, 0.27);
+        for level in [3.7643, 2.0, -1.5, 40.0, f32::NAN] {
+            let texels = texture.texels_at_level(st, level);
+            let sum = texels
+                .iter()
+                .fold(Vec3::ZERO, |acc, t| acc + t.weight * t.value);
+            let want = image
+                .pyramid()
+                .trilinear_at_level(st, level, WrapMode::Repeat);
+            assert!(
+                (sum - want).abs().max_element() < 1e-4,
+                "level {level}: {sum} against {want}"
+            );
+            let weights: f32 = texels.iter().map(|t| t.weight).sum();
+            assert!(
+                (weights - 1.0).abs() < 1e-5,
+                "level {level}: weights {weights}"
+            );
+        }
+        let levels: Vec<usize> = texture
+            .texels_at_level(st, 3.7643)
+            .iter()
+            .map(|t| t.level)
+            .collect();
+        assert_eq!(levels, [3, 3, 3, 3, 4, 4, 4, 4]);
+    }
 
     #[test]
     fn the_weighted_texels_make_the_filtered_value() {

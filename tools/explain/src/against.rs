@@ -18,7 +18,7 @@
 //! 1; unit directions within [`ANGLE`] radians; integers, booleans, strings
 //! (kinds, shadow verdicts) and nulls exactly; the 8-bit sRGB value within 1.
 
-use crate::rules::{self, Rule, ANGLE, FLOOR, RELATIVE, UNIT};
+use crate::rules::{self, Rule, ANGLE, FLOOR, LEVEL, RELATIVE, UNIT};
 use crate::Stage;
 use serde::de::{self, Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde_json::{json, Number, Value};
@@ -40,6 +40,9 @@ const DIRECTIONS: [&str; 10] = [
     "geometric_normal",
     "shading_normal",
 ];
+/// Keys whose value is a MIP level, a logarithm: compared within
+/// `LEVEL` levels, as `glint grade --stages` compares its `level`.
+const LEVELS: [&str; 2] = ["glint_level", "report_level"];
 /// The document's own keys besides `samples` and `film`.
 const HEADER: [&str; 9] = [
     "schema",
@@ -225,6 +228,10 @@ pub enum Tolerance {
     Vector,
     /// A sphere's uv: as `Vector`, its `u` modulo 1.
     PeriodicU,
+    /// A MIP level, a logarithm: within `LEVEL` levels.
+    Levels,
+    /// A texel's weight, a share of 1: within `RELATIVE` of 1.
+    Share,
     /// A unit direction: at most `ANGLE` radians apart, of length 1 within
     /// `UNIT`.
     Angular,
@@ -242,6 +249,8 @@ impl Tolerance {
             Tolerance::Relative => "relative",
             Tolerance::Vector => "relative to the largest component",
             Tolerance::PeriodicU => "relative to the largest component, u modulo 1",
+            Tolerance::Levels => "levels",
+            Tolerance::Share => "relative to the whole",
             Tolerance::Angular => "angular",
             Tolerance::Exact => "exact",
             Tolerance::WithinOne => "within 1",
@@ -259,6 +268,8 @@ impl Tolerance {
                 "each component within {RELATIVE:e}·(Glint's largest |component|) + {FLOOR:e}, u modulo 1 (a sphere's seam)"
             ),
             Tolerance::Angular => format!("at most {ANGLE:e} rad apart, of length 1 within {UNIT:e}"),
+            Tolerance::Levels => format!("within {LEVEL} levels"),
+            Tolerance::Share => format!("within {RELATIVE:e}·1 + {FLOOR:e} (a share of 1)"),
             Tolerance::Exact => "equal".to_owned(),
             Tolerance::WithinOne => "each component within 1".to_owned(),
         }
@@ -435,7 +446,7 @@ fn difference_json(d: &Difference) -> Value {
 fn tolerance_json(tolerance: Tolerance) -> Value {
     let mut out = json!({ "kind": tolerance.name() });
     match tolerance {
-        Tolerance::Relative | Tolerance::Vector | Tolerance::PeriodicU => {
+        Tolerance::Relative | Tolerance::Vector | Tolerance::PeriodicU | Tolerance::Share => {
             out["relative"] = json!(RELATIVE);
             out["floor"] = json!(FLOOR);
         }
@@ -444,6 +455,7 @@ fn tolerance_json(tolerance: Tolerance) -> Value {
             out["unit_length"] = json!(UNIT);
         }
         Tolerance::WithinOne => out["codes"] = json!(SRGB8_CODES),
+        Tolerance::Levels => out["levels"] = json!(LEVEL),
         Tolerance::Exact => {}
     }
     out
@@ -804,6 +816,8 @@ fn number(key: &str, yours: &Number, glint: &Number) -> Verdict {
         glint.as_f64().unwrap_or(0.0),
     );
     match (glint.is_f64(), key) {
+        (true, _) if LEVELS.contains(&key) => within(Tolerance::Levels, Rule::Level, &[g], &[a]),
+        (true, "weight") => within(Tolerance::Share, Rule::Share, &[g], &[a]),
         (false, "srgb8") => within(
             Tolerance::WithinOne,
             Rule::Codes { codes: SRGB8_CODES },
@@ -935,6 +949,19 @@ mod tests {
             c.first().unwrap().path,
             "samples[0].ray.texture.diffuse.report_level"
         );
+    }
+
+    #[test]
+    fn a_level_is_compared_in_levels_as_grade_stages_compares_it() {
+        let doc = |level: f64| {
+            format!(
+                r#"{{"schema": "glint-explain/1", "pixel": [3, 4], "samples": [{{"sample": 0, "ray":
+                    {{"texture": {{"diffuse": {{"report_level": {level}}}}}}}}}]}}"#
+            )
+        };
+        assert!(against(&doc(2.0029)).unwrap().agrees());
+        let c = against(&doc(2.0031)).unwrap();
+        assert_eq!(c.first().unwrap().tolerance, Tolerance::Levels);
     }
 
     #[test]

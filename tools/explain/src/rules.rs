@@ -12,7 +12,8 @@
 //!   its seam.
 //! - A unit direction at most [`ANGLE`] radians from Glint's, of length 1
 //!   within [`UNIT`].
-//! - A MIP level within [`LEVEL`] levels.
+//! - A MIP level within [`LEVEL`] levels; a texel's weight, a share of 1,
+//!   within [`RELATIVE`] of 1.
 //! - An 8-bit value exactly where the stage gives its input
 //!   (`grade --stages`), within 1 where the radiance is the student's own
 //!   (`explain --against`).
@@ -54,6 +55,10 @@ pub enum Rule {
     Direction,
     /// A MIP level: within `LEVEL`.
     Level,
+    /// A share of a whole of 1 (a texel's weight in a lookup): within
+    /// `RELATIVE` of the whole, plus `FLOOR`, as a component of a vector
+    /// whose largest part is the whole.
+    Share,
     /// Whole numbers within `codes` of each other (0: equal).
     Codes { codes: f64 },
 }
@@ -88,6 +93,7 @@ pub fn measure(rule: Rule, glint: &[f64], yours: &[f64]) -> Gap {
         Rule::Relative | Rule::Vector => gap(largest_difference(glint, yours, false), relative),
         Rule::Uv { periodic_u } => gap(largest_difference(glint, yours, periodic_u), relative),
         Rule::Level => gap(largest_difference(glint, yours, false), LEVEL),
+        Rule::Share => gap(largest_difference(glint, yours, false), RELATIVE + FLOOR),
         Rule::Codes { codes } => gap(largest_difference(glint, yours, false), codes),
         Rule::Direction => {
             let length = yours.iter().map(|x| x * x).sum::<f64>().sqrt();

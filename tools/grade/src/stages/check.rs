@@ -34,6 +34,11 @@ pub struct CaseFailure {
     pub inputs: Vec<String>,
     /// Its fields that differ, in layout order.
     pub differences: Vec<Difference>,
+    /// The steps that decided the expected values where the stage's own
+    /// computation differs from the render's or the numbers alone do not
+    /// say it: the texture lookup at the report's level; each shadow verdict
+    /// that differs, both blockers named.
+    pub steps: Vec<String>,
     /// `glint explain`'s text of the case's pixel and sample, this stage
     /// only (none for the film's chosen values).
     pub explanation: Option<String>,
@@ -169,6 +174,7 @@ pub fn score(scene: &GradeScene, v: &StageVectors, answers: &Answers) -> StageCh
         } else if check.first_failure.is_none() {
             check.first_failure = Some(CaseFailure {
                 explanation: explain(scene, v.stage, case),
+                steps: steps(scene, v.stage, case, row),
                 case: case.clone(),
                 inputs: v.layout.inputs.clone(),
                 differences,
@@ -176,6 +182,21 @@ pub fn score(scene: &GradeScene, v: &StageVectors, answers: &Answers) -> StageCh
         }
     }
     check
+}
+
+/// [`CaseFailure::steps`] of `case`, answered by `row`.
+fn steps(
+    scene: &GradeScene,
+    stage: Stage,
+    case: &Case,
+    row: &std::collections::BTreeMap<String, Answer>,
+) -> Vec<String> {
+    let d = &scene.description;
+    match stage {
+        Stage::Texture => super::texture::expected_steps(&d.scene, case),
+        Stage::Lighting => super::lighting::verdict_steps(&d.object_names, case, row),
+        _ => Vec::new(),
+    }
 }
 
 /// `glint explain`'s text of `case`'s pixel and sample, `stage` only.

@@ -20,7 +20,9 @@
 //!   diffuse + specular) / (its sample count)`, the point's local radiance
 //!   (before any mirror reflection; no environment light).
 
+use super::answers::Answer;
 use super::probe::{collect, Plan, Probe, LIGHT_GRID};
+use super::report::number;
 use super::survey::camera_ray;
 use super::table::{Case, Check, Field, Kind, Layout, Value, RGB, XYZ};
 use super::Context;
@@ -32,6 +34,7 @@ use glint_geometry::{spawn_ray_to, Hit, Ray, RayTarget};
 use glint_integrator::trace::{Event, Shadow, Skip};
 use glint_integrator::{Scene, ShadingModel, SurfaceKind};
 use glint_lighting::{Light, SpecularLobe};
+use std::collections::BTreeMap;
 
 /// How near (relative) a sample may come to a decision boundary: the light's
 /// plane, the surface's horizon, `n·l = 0`, or an edge of a shadow (its
@@ -360,6 +363,72 @@ fn steady(scene: &Scene, s: &Shading) -> bool {
                 && fixed_offsets_agree(scene, s, sample, size)
         })
     })
+}
+
+/// For a failing case's report: each light sample whose verdict the
+/// student's `answered` row gives otherwise than Glint, with both blockers
+/// named (`names`: the scene's object names), and the shadow ray Glint
+/// traced.
+pub fn verdict_steps(
+    names: &[String],
+    case: &Case,
+    answered: &BTreeMap<String, Answer>,
+) -> Vec<String> {
+    let name = |object: f64| {
+        let name = names.get(object as usize).map_or("?", String::as_str);
+        format!("object {object} ({name})")
+    };
+    let verdict = |v: Option<&str>, blocker: Option<f64>| match (v, blocker) {
+        (Some("blocked"), Some(b)) => format!("blocked by {}", name(b)),
+        (Some(v), _) => v.to_owned(),
+        (None, _) => "(none)".to_owned(),
+    };
+    let mut lines = Vec::new();
+    let samples = case
+        .values
+        .keys()
+        .filter_map(|k| k.strip_suffix("_verdict"))
+        .map(str::to_owned)
+        .collect::<Vec<_>>();
+    for sample in samples {
+        let column = |suffix: &str| format!("{sample}_{suffix}");
+        let glints = match case.get(&column("verdict")) {
+            Value::Text(v) => v.as_str(),
+            _ => continue,
+        };
+        let yours = match answered.get(&column("verdict")) {
+            Some(Answer::Text(v)) => Some(v.as_str()),
+            _ => None,
+        };
+        if yours == Some(glints) {
+            continue;
+        }
+        let your_blocker = match answered.get(&column("blocker")) {
+            Some(Answer::Number(b)) => Some(*b),
+            _ => None,
+        };
+        let point = |prefix: &str| {
+            let at = |c: &str| {
+                case.get(&format!("{prefix}_{c}"))
+                    .number()
+                    .unwrap_or(f64::NAN)
+            };
+            format!(
+                "({}, {}, {})",
+                number(at("x")),
+                number(at("y")),
+                number(at("z"))
+            )
+        };
+        lines.push(format!(
+            "{sample}: Glint's {}, yours {}; the shadow ray from the point {} to the sample {}, offsets as scene-format.md step 9 says",
+            verdict(Some(glints), case.get(&column("blocker")).number()),
+            verdict(yours, your_blocker),
+            point("point"),
+            point(&sample),
+        ));
+    }
+    lines
 }
 
 /// The scene's size for its shadow-ray offsets: the longest side of the

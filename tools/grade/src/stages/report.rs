@@ -103,6 +103,12 @@ fn failure_text(out: &mut String, scene: &str, s: &StageCheck, f: &CaseFailure) 
     for d in &f.differences {
         let _ = writeln!(out, "  {}", difference_text(d));
     }
+    if !f.steps.is_empty() {
+        let _ = writeln!(out, "  how Glint's expected values were found:");
+        for line in &f.steps {
+            let _ = writeln!(out, "    {line}");
+        }
+    }
     if let (Some(from), Some(explanation)) = (&f.case.from, &f.explanation) {
         let _ = writeln!(
             out,
@@ -278,6 +284,7 @@ fn failure_json(scene: &str, s: &StageCheck, f: &CaseFailure) -> Ordered {
         ("from", from),
         ("inputs", Ordered::Object(inputs)),
         ("differences", Ordered::Array(differences)),
+        ("steps", value(f.steps.clone())),
         ("explanation", value(f.explanation.clone())),
     ])
 }

@@ -16,9 +16,9 @@ use super::table::{Case, Check, Field, Kind, Layout, Value};
 use super::Context;
 use crate::GradeError;
 use glam::Vec2;
-use glint_integrator::{pixel_height_on_surface, report_level, uv_unit_length, SurfaceKind};
+use glint_integrator::{pixel_height_on_surface, report_level, uv_unit_length, Scene, SurfaceKind};
 use glint_lighting::PhongMaterial;
-use glint_texture::{Checkerboard, TexCoord, Texture};
+use glint_texture::{Checkerboard, ImageTexture, TexCoord, Texture};
 
 /// How near (in checks, relative to the coordinate's size) a uv may come to
 /// a check's edge: nearer, a correct program in other arithmetic may read the
@@ -148,6 +148,120 @@ fn case(cx: &Context, p: &Probe) -> Option<Case> {
         _ => true,
     });
     finite.then_some(case)
+}
+
+/// The steps that decided `case`'s expected value, for a failing case's
+/// report: the lookup the report asks for at the report's level, not the
+/// render's (whose level `glint explain` prints). For an image: uv through
+/// the material's transform, the level `log2(L/W)` and its parts, the two
+/// pyramid levels read with their sizes and weights, each texel with its
+/// weight, and their sum; for a checkerboard, the check.
+pub fn expected_steps(scene: &Scene, case: &Case) -> Vec<String> {
+    let number = |column: &str| case.get(column).number();
+    let (Some(object), Some(u), Some(v)) = (number("object"), number("u"), number("v")) else {
+        return Vec::new();
+    };
+    let SurfaceKind::Material(m) = scene.surface_of_primitive(object as u32, 0) else {
+        return Vec::new();
+    };
+    let texture = match case.get("texture") {
+        Value::Text(t) if t == "specular" => m.specular.as_ref(),
+        _ => Some(&m.diffuse),
+    };
+    let uv = m
+        .uv_transform
+        .apply(&TexCoord::point(Vec2::new(u as f32, v as f32)))
+        .uv;
+    let mut lines = vec![format!(
+        "uv' = uv·scale + offset = ({}, {})",
+        show(uv.x),
+        show(uv.y)
+    )];
+    match texture {
+        Some(Texture::Image(image)) => {
+            let Some(level) = number("level") else {
+                return Vec::new();
+            };
+            lines.extend(image_steps(image, uv, level as f32, case));
+        }
+        Some(Texture::Checkerboard(c)) => {
+            let q = (uv * c.checks as f32).floor();
+            let which = (q.x as i64 + q.y as i64).rem_euclid(2) as usize;
+            lines.push(format!(
+                "check (⌊u'·{n}⌋ + ⌊v'·{n}⌋) mod 2 = ({} + {}) mod 2 = {which}: color {}",
+                q.x,
+                q.y,
+                show3(c.colors[which]),
+                n = c.checks
+            ));
+        }
+        _ => return Vec::new(),
+    }
+    lines
+}
+
+/// An image lookup's steps at the report's `level`.
+fn image_steps(image: &ImageTexture, uv: Vec2, level: f32, case: &Case) -> Vec<String> {
+    let st = Vec2::new(uv.x, 1.0 - uv.y);
+    let levels = image.image.pyramid().levels();
+    let size = |i: usize| format!("{} × {}", levels[i].width(), levels[i].height());
+    let texels = image.texels_at_level(st, level);
+    let cell = |c: &str| case.get(c).number().map_or("?".into(), |x| show(x as f32));
+    let mut lines = vec![
+        format!("st = (u', 1 − v') = ({}, {})", show(st.x), show(st.y)),
+        format!(
+            "level = log2(L/W) = log2({} / {}) = {} (L = 2·t·tan(fov/2)/(r·|N·D|), W = jacobian/m, m = {}); the report's level, not the render's below",
+            cell("l"),
+            cell("w"),
+            show(level),
+            cell("m"),
+        ),
+    ];
+    let mut read: Vec<(usize, f32)> = Vec::new();
+    for t in &texels {
+        match read.iter_mut().find(|(l, _)| *l == t.level) {
+            Some((_, w)) => *w += t.weight,
+            None => read.push((t.level, t.weight)),
+        }
+    }
+    let parts: Vec<String> = read
+        .iter()
+        .map(|(l, w)| format!("level {l} ({}) weight {}", size(*l), show(*w)))
+        .collect();
+    let clamped = match level {
+        l if l < 0.0 || l.is_nan() => " (clamped to level 0)",
+        l if l > (levels.len() - 1) as f32 => " (clamped to the last level)",
+        _ => "",
+    };
+    lines.push(format!(
+        "reads {} of the {}-level pyramid from {}{clamped}",
+        parts.join(" and "),
+        levels.len(),
+        size(0)
+    ));
+    for t in &texels {
+        lines.push(format!(
+            "  level {} texel ({}, {}) {} × weight {}",
+            t.level,
+            t.x,
+            t.y,
+            show3(t.value),
+            show(t.weight)
+        ));
+    }
+    let value = texels
+        .iter()
+        .fold(glam::Vec3::ZERO, |acc, t| acc + t.weight * t.value);
+    lines.push(format!("value = Σ weight × texel = {}", show3(value)));
+    lines
+}
+
+fn show(x: f32) -> String {
+    super::report::number(f64::from(x))
+}
+
+fn show3(v: glam::Vec3) -> String {
+    format!("({}, {}, {})", show(v.x), show(v.y), show(v.z))
 }
 
 /// Whether `uv` lies within [`CHECK_EDGE`] of a check's edge.

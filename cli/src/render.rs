@@ -8,6 +8,7 @@ use glam::UVec2;
 use glint_camera::{Film, ImageFormat, PartialFilm, Placement, Tile};
 use glint_integrator::{
     Aov, AreaSampling, Crop, EnvironmentSampling, RenderControl, RenderSettings, SamplePattern,
+    TextureLevel,
 };
 use glint_scene::SceneDescription;
 use glint_texture::TextureFilter;
@@ -153,6 +154,14 @@ pub(crate) struct SceneArgs {
     /// the footprint), ewa (elliptically weighted average, anisotropic)
     #[arg(long, value_name = "FILTER", value_parser = named(&TextureFilter::NAMES, TextureFilter::from_name))]
     texture_filter: Option<TextureFilter>,
+
+    /// The MIP level image textures are read at: footprint (Glint's, from the
+    /// ray differentials) or report (the course report's log2(L/W) at each
+    /// camera ray's hit, read trilinearly, as a ray tracer that follows the
+    /// report reads it)
+    /// [default: footprint]
+    #[arg(long, value_name = "LEVEL", value_parser = named(&TextureLevel::NAMES, TextureLevel::from_name))]
+    texture_level: Option<TextureLevel>,
 }
 
 pub(crate) fn parse_resolution(text: &str) -> Result<UVec2, String> {
@@ -510,8 +519,8 @@ fn fingerprint(
         ..settings.clone()
     };
     let settings = format!(
-        "{pixels_depend_on:?} {resolution} {:?}",
-        args.scene.texture_filter
+        "{pixels_depend_on:?} {resolution} {:?} {:?}",
+        args.scene.texture_filter, args.scene.texture_level
     );
     add(&mut hasher, settings.as_bytes());
     Ok(format!("blake3 {}", hasher.finalize().to_hex()))
@@ -634,6 +643,18 @@ impl SceneArgs {
         description.timings.assets += start.elapsed();
         if let Some(filter) = self.texture_filter {
             scene.override_texture_filter(filter);
+        }
+        if let Some(level) = self.texture_level {
+            if level == TextureLevel::Report
+                && self
+                    .texture_filter
+                    .is_some_and(|f| f != TextureFilter::Trilinear)
+            {
+                return Err(Failure::Input(
+                    "--texture-level report reads the report's level trilinearly: leave out --texture-filter, or give trilinear".into(),
+                ));
+            }
+            scene.set_texture_level(level);
         }
         if let Some(resolution) = self.resolution {
             scene.camera = scene

@@ -90,7 +90,7 @@ impl Aov {
             Aov::Normal => hit.shading_normal,
             Aov::Depth => Vec3::splat(hit.t * ray.direction.length()),
             Aov::MipLevel => Vec3::splat(material.map_or(0.0, |m| {
-                m.diffuse_mip_level(&texture_footprint(m, &hit, diff))
+                m.diffuse_mip_level(&texture_footprint(scene, m, (&hit, 0), ray, diff))
             })),
             Aov::ReportMipLevel => Vec3::splat(material.map_or(0.0, |m| {
                 report_level(&scene.camera, ray, &hit, m, &m.diffuse).map_or(0.0, |r| r.level)
@@ -100,7 +100,10 @@ impl Aov {
             }
             Aov::Object => Vec3::splat((hit.shape + 1) as f32),
             Aov::Albedo => match surface {
-                SurfaceKind::Material(m) => m.reflectances(&texture_footprint(m, &hit, diff)).0,
+                SurfaceKind::Material(m) => {
+                    m.reflectances(&texture_footprint(scene, m, (&hit, 0), ray, diff))
+                        .0
+                }
                 SurfaceKind::Emitter(Light::Area(a)) => a.color,
                 SurfaceKind::Emitter(Light::Point(p)) => p.color,
                 SurfaceKind::Emitter(Light::Sphere(s)) => s.color,

@@ -261,7 +261,7 @@ impl DirectIntegrator {
             }
             FirstHits::Several => {
                 let hits = (rays, wave.diffs, closest);
-                ShadedLanes::one_by_one(scene, hits, local, radiance, ctx)
+                ShadedLanes::one_by_one(scene, hits, (local, wave.depth), radiance, ctx)
             }
         };
         shaded.depth = wave.depth;
@@ -1122,11 +1122,14 @@ impl<'a> ShadedLanes<'a> {
     fn one_by_one<T: Tracer>(
         scene: &'a Scene,
         hits: (&RayLanes, Option<&[RayDifferential; LANES]>, &ClosestLanes),
-        hit_lanes: u32,
+        (hit_lanes, depth): (u32, u32),
         radiance: &mut Vec3Lanes,
         ctx: &mut SampleContext<T>,
     ) -> Self {
-        let mut shaded = Self::default();
+        let mut shaded = Self {
+            depth,
+            ..Self::default()
+        };
         shaded.set_one_by_one(scene, hits, hit_lanes, radiance, ctx);
         shaded
     }
@@ -1163,7 +1166,7 @@ impl<'a> ShadedLanes<'a> {
                     };
                     ctx.counters.footprints += 1;
                     let diff = diffs.map_or_else(|| RayDifferential::none(&ray), |d| d[k]);
-                    let tc = texture_footprint(material, &hit, &diff);
+                    let tc = texture_footprint(scene, material, (&hit, self.depth), &ray, &diff);
                     if ctx.detailed {
                         ctx.textures.record(material, &tc);
                     }

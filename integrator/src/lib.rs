@@ -60,7 +60,7 @@ pub use render::{
 };
 pub use report_level::{pixel_height_on_surface, report_level, uv_unit_length, ReportLevel};
 pub use sampling::SamplePattern;
-pub use scene::{Scene, SceneBuilder, SceneError, Surface, SurfaceKind};
+pub use scene::{Scene, SceneBuilder, SceneError, Surface, SurfaceKind, TextureLevel};
 pub use settings::{Crop, RenderSettings, SampleCount, SettingsError, MAX_SAMPLES, MAX_THREADS};
 
 #[cfg(doctest)]

@@ -123,7 +123,7 @@ impl DirectIntegrator {
         if at.material.uses_footprint() {
             ctx.counters.footprints += 1;
         }
-        let tc = texture_footprint(at.material, at.hit, at.diff);
+        let tc = texture_footprint(scene, at.material, (at.hit, depth), at.ray, at.diff);
         if ctx.detailed {
             ctx.textures.record(at.material, &tc);
         }

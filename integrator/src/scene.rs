@@ -46,6 +46,39 @@ pub struct Scene {
     /// How the lights' `color` and the materials are read: the course's Phong
     /// model, or radiometric units ([`ShadingModel`]).
     pub shading: ShadingModel,
+    /// Which MIP level image textures are read at ([`TextureLevel`]).
+    pub texture_level: TextureLevel,
+}
+
+/// Which MIP level image textures are read at.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TextureLevel {
+    /// Glint's: from the pixel's footprint, carried by the ray
+    /// differentials to each hit, as the texture's filter reads it.
+    #[default]
+    Footprint,
+    /// The course report's `log2(L/W)` at a camera ray's hit, the pixel's
+    /// height at the hit's distance over a texel's width
+    /// ([`crate::report_level()`]), read trilinearly: what a ray tracer that
+    /// follows the report computes. A mirror's reflection rays, for which the
+    /// report has no formula, keep the footprint.
+    Report,
+}
+
+impl TextureLevel {
+    pub const NAMES: [&'static str; 2] = ["footprint", "report"];
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "footprint" => Some(Self::Footprint),
+            "report" => Some(Self::Report),
+            _ => None,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
 }
 
 impl Scene {
@@ -85,6 +118,15 @@ impl Scene {
                 let m = self.mesh_materials[k as usize][primitive as usize];
                 SurfaceKind::Material(&self.materials[m as usize])
             }
+        }
+    }
+
+    /// Reads image textures at `level` (the command line's
+    /// `--texture-level`); at the report's level, trilinearly.
+    pub fn set_texture_level(&mut self, level: TextureLevel) {
+        self.texture_level = level;
+        if level == TextureLevel::Report {
+            self.override_texture_filter(TextureFilter::Trilinear);
         }
     }
 
@@ -263,6 +305,7 @@ impl SceneBuilder {
             environment: self.environment,
             mesh_materials: self.mesh_materials,
             shading: self.shading,
+            texture_level: TextureLevel::Footprint,
         })
     }
 }

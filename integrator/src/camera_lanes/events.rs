@@ -99,7 +99,7 @@ impl Wave<'_> {
             let SurfaceKind::Material(material) = scene.surface_of(&hit) else {
                 return None;
             };
-            let tc = texture_footprint(material, &hit, &diff);
+            let tc = texture_footprint(scene, material, (&hit, shaded.depth), &ray, &diff);
             Some(TracedSurface { hit, ray, tc })
         });
         let phong = &shaded.phong;

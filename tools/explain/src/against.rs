@@ -44,8 +44,9 @@ const DIRECTIONS: [&str; 10] = [
 /// `LEVEL` levels, as `glint grade --stages` compares its `level`.
 const LEVELS: [&str; 2] = ["glint_level", "report_level"];
 /// The document's own keys besides `samples` and `film`.
-const HEADER: [&str; 9] = [
+const HEADER: [&str; 10] = [
     "schema",
+    "texture_level",
     "pixel",
     "resolution",
     "spp",
@@ -58,7 +59,8 @@ const HEADER: [&str; 9] = [
 /// The settings a document records, checked before any number: with
 /// other sample counts or patterns every later number differs for that
 /// reason alone.
-const SETTINGS: [&str; 7] = [
+const SETTINGS: [&str; 8] = [
+    "texture_level",
     "pixel",
     "resolution",
     "spp",
@@ -306,6 +308,9 @@ pub struct StageComparison {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Comparison {
     pub pixel: (u64, u64),
+    /// The MIP level Glint's textures were read at: `footprint` (the
+    /// render's) or `report` (`--texture-level report`).
+    pub texture_level: String,
     /// The one stage compared (`--stage`), if only one was.
     pub only: Option<Stage>,
     /// Every stage, in pipeline order.
@@ -327,8 +332,12 @@ impl Comparison {
     /// The report as text, naming the student's file `file`: a line per
     /// stage, and the first difference under its stage.
     pub fn text(&self, file: &str) -> String {
+        let level = match self.texture_level.as_str() {
+            "report" => "textures at the report's level log2(L/W) (--texture-level report)",
+            _ => "textures at the render's level (--texture-level report for the report's)",
+        };
         let mut lines = vec![format!(
-            "{file} against Glint, pixel ({}, {}), stage by stage in pipeline order:",
+            "{file} against Glint, pixel ({}, {}), {level}, stage by stage in pipeline order:",
             self.pixel.0, self.pixel.1
         )];
         let first = self.first();
@@ -390,6 +399,7 @@ impl Comparison {
         json!({
             "schema": "glint-explain-against/1",
             "pixel": [self.pixel.0, self.pixel.1],
+            "texture_level": self.texture_level,
             "agrees": self.agrees(),
             "stages": stages,
             "first_difference": self.first().map(difference_json),
@@ -498,6 +508,10 @@ pub fn compare(student: &Node, glint: &Value, only: Option<Stage>) -> Result<Com
     }
     let pixel = &glint["pixel"];
     Ok(Comparison {
+        texture_level: glint["texture_level"]
+            .as_str()
+            .unwrap_or("footprint")
+            .to_owned(),
         only,
         pixel: (
             pixel[0].as_u64().unwrap_or(0),

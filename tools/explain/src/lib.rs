@@ -143,6 +143,7 @@ pub fn explain(
         "light_samples": settings.light_samples,
         "light_sampler": settings.light_pattern.name(),
         "environment_samples": settings.environment_samples,
+        "texture_level": scene.texture_level.name(),
         "seed": settings.seed,
         "samples": samples,
         "film": {

@@ -240,6 +240,34 @@ fn a_texture_case_on_an_image_reads_the_reports_level() {
             .pyramid()
             .trilinear_at_level(st, level, image.wrap);
         assert_eq!(rgb(c, "value"), want, "{}", c.id);
+        // A render at the report's level reads the same value at the case's
+        // camera sample: the stage and `glint explain --texture-level
+        // report` agree.
+        let mut at_report = d.scene.clone();
+        at_report.set_texture_level(glint_integrator::TextureLevel::Report);
+        let from = c.from.as_ref().unwrap();
+        let settings = probe::settings(&d.settings, from.spp);
+        let selection = SampleSelection::One(from.sample.into());
+        let [x, y] = from.pixel;
+        let explained = glint_explain::explain(&at_report, &settings, x, y, selection).unwrap();
+        let lookup = &explained.document["samples"][0]["ray"]["texture"]["diffuse"];
+        let rendered: Vec<f64> = (0..3)
+            .map(|i| lookup["value"][i].as_f64().unwrap())
+            .collect();
+        for (got, want) in rendered.iter().zip(want.to_array()) {
+            // The document's 5 significant digits.
+            assert!(
+                (got - f64::from(want)).abs() <= 1e-4 * f64::from(want).abs() + 1e-9,
+                "{}: {rendered:?} against {want}",
+                c.id
+            );
+        }
+        let level = lookup["glint_level"].as_f64().unwrap();
+        assert!(
+            (level - f64::from(float(c, "level"))).abs() < 1e-3,
+            "{}: level {level}",
+            c.id
+        );
     }
 }
 

@@ -332,6 +332,43 @@ fn edited(text: &str, edit: impl Fn(&mut std::collections::HashMap<String, Strin
 }
 
 #[test]
+fn a_scene_without_meshes_needs_no_shading_normal_columns() {
+    // Set 1 has no meshes: its shading normals are its geometric normals.
+    let dir = answers(&["intersection.csv"], |_, text| {
+        let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+        let keep: Vec<usize> = (0..header.len())
+            .filter(|&i| !header[i].starts_with("shading_normal_"))
+            .collect();
+        assert!(keep.len() + 3 == header.len(), "{header:?}");
+        text.lines()
+            .map(|line| {
+                let cells: Vec<&str> = line.split(',').collect();
+                keep.iter().map(|&i| cells[i]).collect::<Vec<_>>().join(",")
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+            + "\n"
+    });
+    let o = check(dir.path(), &[]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    // Given, they are checked.
+    let dir = answers(&["intersection.csv"], |_, text| {
+        edited(&text, |row| {
+            if row["hit"] == "true" {
+                row.insert("shading_normal_y".into(), "0.6".into());
+            }
+        })
+    });
+    let o = check(dir.path(), &[]);
+    assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains("shading_normal [shading_normal_x"),
+        "{}",
+        stdout(&o)
+    );
+}
+
+#[test]
 fn a_failing_case_shows_the_steps_of_glints_expected_value() {
     // The textured spheres: image textures read at the report's level. A
     // level from the natural log, and a light that blocks its own shadow rays.

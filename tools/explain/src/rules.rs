@@ -37,7 +37,7 @@ pub const LEVEL: f64 = 3e-3;
 /// The fixed shadow-ray offsets a ray tracer may use, as fractions of the
 /// scene's size (the longest side of the box around its finite shapes):
 /// from `1e-5` (above the rounding error of a hit point in 32-bit floats)
-/// to `1e-4`. For the Cornell box, 20 units across: 2e-4 to 2e-3.
+/// to `1e-4`. For the Cornell box, 23 units across: 2.3e-4 to 2.3e-3.
 pub const SHADOW_EPSILON: [f64; 2] = [1e-5, 1e-4];
 
 /// How a value is compared.

@@ -463,7 +463,7 @@ fn lighting(out: &mut String, ray: &Value, indent: &str) {
     }
     if !light.is_null() {
         if !light["ambient"].is_null() {
-            writeln!(out, "{sub}ambient {}", f(&light["ambient"])).unwrap();
+            writeln!(out, "{sub}ambient·kd {}", f(&light["ambient"])).unwrap();
         }
         for l in light["lights"].as_array().into_iter().flatten() {
             writeln!(out, "{sub}light {} ({})", l["light"], f(&l["kind"])).unwrap();

@@ -98,12 +98,21 @@ pub fn read(
 }
 
 /// The columns an answer must have: every expected one but those shown
-/// only (an object's name).
+/// only (an object's name) and those of optional fields.
 fn required(layout: &Layout) -> Vec<(&str, Kind)> {
+    checked(layout, false)
+}
+
+/// The columns of the optional fields, read where an answer gives them.
+fn optional(layout: &Layout) -> Vec<(&str, Kind)> {
+    checked(layout, true)
+}
+
+fn checked(layout: &Layout, optional: bool) -> Vec<(&str, Kind)> {
     layout
         .expected
         .iter()
-        .filter(|f| f.check != super::Check::Info)
+        .filter(|f| f.check != super::Check::Info && f.optional == optional)
         .flat_map(|f| f.columns.iter().map(move |c| (c.as_str(), f.kind)))
         .collect()
 }
@@ -167,7 +176,7 @@ fn csv_columns<'a>(
             shorten(&header.iter().collect::<Vec<_>>().join(","))
         )
     })?;
-    let columns = required(layout)
+    let mut columns: Vec<Column> = required(layout)
         .into_iter()
         .map(|(name, kind)| match position(name) {
             Some(at) => Ok((name, kind, at)),
@@ -177,6 +186,11 @@ fn csv_columns<'a>(
             )),
         })
         .collect::<Result<_, _>>()?;
+    columns.extend(
+        optional(layout)
+            .into_iter()
+            .filter_map(|(name, kind)| Some((name, kind, position(name)?))),
+    );
     Ok((id_at, columns))
 }
 
@@ -315,6 +329,17 @@ fn json_cells(cells: &Json, layout: &Layout) -> Result<BTreeMap<String, Answer>,
             )
         })?;
         answers.insert(name.to_owned(), answer);
+    }
+    for (name, kind) in optional(layout) {
+        if let Some(value) = cells.get(name) {
+            let answer = parse_json(value, kind).map_err(|expected| {
+                format!(
+                    "{name}: expected {expected}, got {}",
+                    shorten(&value.to_string())
+                )
+            })?;
+            answers.insert(name.to_owned(), answer);
+        }
     }
     Ok(answers)
 }

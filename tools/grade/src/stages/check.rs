@@ -160,6 +160,7 @@ pub fn score(scene: &GradeScene, v: &StageVectors, answers: &Answers) -> StageCh
             .layout
             .expected
             .iter()
+            .filter(|f| !f.optional || f.columns.iter().any(|c| row.contains_key(c)))
             .filter_map(|f| {
                 let answered: Vec<Answer> = f
                     .columns

@@ -7,6 +7,7 @@ use super::table::{Case, Check, Field, Kind, Layout, Value};
 use super::Context;
 use crate::GradeError;
 use glint_geometry::{Hit, Ray};
+use glint_integrator::Scene;
 
 /// How far (radians) a ray is turned to test that its answer is not on a
 /// knife's edge: about a hundredth of a pixel of a 512-pixel, 45° image.
@@ -21,7 +22,14 @@ const UV_STEADY: f32 = 3e-4;
 /// spheres and boxes, the front of flat shapes) and the `shading_normal`
 /// (the same but on meshes with interpolated normals), `u`, `v`, the
 /// `object` index and its `name` (shown, not checked).
-pub fn layout() -> Layout {
+/// The shading normal may be left out of the answers of a scene without
+/// meshes, where it is the geometric normal.
+pub fn layout(scene: &Scene) -> Layout {
+    let has_meshes = scene
+        .surfaces
+        .iter()
+        .any(|s| matches!(s, glint_integrator::Surface::Mesh(_)));
+    let shading_normal = Field::xyz("shading_normal", Check::Direction);
     let inputs = ["origin", "direction"]
         .iter()
         .flat_map(|n| super::table::XYZ.map(|s| format!("{n}_{s}")))
@@ -33,7 +41,10 @@ pub fn layout() -> Layout {
             Field::scalar("t", Kind::Float, Check::Relative),
             Field::xyz("point", Check::Vector),
             Field::xyz("geometric_normal", Check::Direction),
-            Field::xyz("shading_normal", Check::Direction),
+            match has_meshes {
+                true => shading_normal,
+                false => shading_normal.optional(),
+            },
             Field::uv(),
             Field::scalar("object", Kind::Int, Check::Exact),
             Field::scalar("name", Kind::Text, Check::Info),

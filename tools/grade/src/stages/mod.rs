@@ -102,7 +102,7 @@ impl Stage {
     pub fn layout(self, scene: &Scene) -> Layout {
         match self {
             Stage::Camera => camera::layout(),
-            Stage::Intersection => intersection::layout(),
+            Stage::Intersection => intersection::layout(scene),
             Stage::Texture => texture::layout(),
             Stage::Lighting => lighting::layout(scene),
             Stage::Film => film::layout(),

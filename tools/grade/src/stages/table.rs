@@ -150,6 +150,9 @@ pub struct Field {
     pub columns: Vec<String>,
     pub kind: Kind,
     pub check: Check,
+    /// An answer may leave its columns out (a scene without meshes, whose
+    /// shading normals are its geometric normals); given, they are checked.
+    pub optional: bool,
 }
 
 impl Field {
@@ -160,6 +163,7 @@ impl Field {
             columns: vec![name.to_owned()],
             kind,
             check,
+            optional: false,
         }
     }
 
@@ -181,6 +185,14 @@ impl Field {
         }
     }
 
+    /// This field, which an answer may leave out.
+    pub fn optional(self) -> Field {
+        Field {
+            optional: true,
+            ..self
+        }
+    }
+
     /// The two columns `u` and `v`.
     pub fn uv() -> Field {
         Field {
@@ -188,6 +200,7 @@ impl Field {
             columns: vec!["u".to_owned(), "v".to_owned()],
             kind: Kind::Float,
             check: Check::Uv,
+            optional: false,
         }
     }
 
@@ -197,6 +210,7 @@ impl Field {
             columns: suffixes.iter().map(|s| format!("{name}_{s}")).collect(),
             kind: Kind::Float,
             check,
+            optional: false,
         }
     }
 }

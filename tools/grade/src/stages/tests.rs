@@ -272,6 +272,14 @@ fn a_texture_case_on_an_image_reads_the_reports_level() {
 }
 
 #[test]
+fn the_cornell_box_is_23_units_across() {
+    // Its walls run from −7 to 13 along x and y; docs/scene-format.md and
+    // tools/explain/tests/docs_rules.rs state the offsets for this size.
+    let (s, _) = set1();
+    assert_eq!(lighting::scene_size(&s.description.scene), 23.0);
+}
+
+#[test]
 fn a_checkerboard_case_is_the_check_under_the_point() {
     let (s, _) = set1();
     for c in &stage(Stage::Texture).cases {

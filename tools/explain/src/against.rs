@@ -43,19 +43,11 @@ const DIRECTIONS: [&str; 10] = [
 /// Keys whose value is a MIP level, a logarithm: compared within
 /// `LEVEL` levels, as `glint grade --stages` compares its `level`.
 const LEVELS: [&str; 2] = ["glint_level", "report_level"];
-/// The document's own keys besides `samples` and `film`.
-const HEADER: [&str; 10] = [
-    "schema",
-    "texture_level",
-    "pixel",
-    "resolution",
-    "spp",
-    "sampler",
-    "light_samples",
-    "light_sampler",
-    "environment_samples",
-    "seed",
-];
+/// The document's own keys besides `samples` and `film`: its schema, its
+/// [`SETTINGS`] and its seed.
+fn is_header(key: &str) -> bool {
+    key == "schema" || key == "seed" || SETTINGS.contains(&key)
+}
 /// The settings a document records, checked before any number: with
 /// other sample counts or patterns every later number differs for that
 /// reason alone.
@@ -495,13 +487,13 @@ pub fn compare(student: &Node, glint: &Value, only: Option<Stage>) -> Result<Com
     };
     for (key, value) in entries {
         match key.as_str() {
-            k if HEADER.contains(&k) => {}
+            k if is_header(k) => {}
             "samples" => walk.samples(value, &glint["samples"])?,
             "film" => walk.tree(Stage::Film, "film", "film", value, glint.get("film")),
             other => {
                 return Err(format!(
-                    "unknown key \"{other}\" at the top of the document (a glint-explain/1 document holds {}, samples and film)",
-                    HEADER.join(", ")
+                    "unknown key \"{other}\" at the top of the document (a glint-explain/1 document holds schema, {}, seed, samples and film)",
+                    SETTINGS.join(", ")
                 ))
             }
         }

@@ -318,10 +318,19 @@ fn read_json(
 /// One JSON object's answers to the layout's required keys.
 fn json_cells(cells: &Json, layout: &Layout) -> Result<BTreeMap<String, Answer>, String> {
     let mut answers = BTreeMap::new();
-    for (name, kind) in required(layout) {
-        let value = cells
-            .get(name)
-            .ok_or_else(|| format!("no key \"{name}\""))?;
+    let given = required(layout)
+        .into_iter()
+        .map(|(name, kind)| {
+            let value = cells
+                .get(name)
+                .ok_or_else(|| format!("no key \"{name}\""))?;
+            Ok((name, kind, value))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let optional = optional(layout)
+        .into_iter()
+        .filter_map(|(name, kind)| Some((name, kind, cells.get(name)?)));
+    for (name, kind, value) in given.into_iter().chain(optional) {
         let answer = parse_json(value, kind).map_err(|expected| {
             format!(
                 "{name}: expected {expected}, got {}",
@@ -329,17 +338,6 @@ fn json_cells(cells: &Json, layout: &Layout) -> Result<BTreeMap<String, Answer>,
             )
         })?;
         answers.insert(name.to_owned(), answer);
-    }
-    for (name, kind) in optional(layout) {
-        if let Some(value) = cells.get(name) {
-            let answer = parse_json(value, kind).map_err(|expected| {
-                format!(
-                    "{name}: expected {expected}, got {}",
-                    shorten(&value.to_string())
-                )
-            })?;
-            answers.insert(name.to_owned(), answer);
-        }
     }
     Ok(answers)
 }

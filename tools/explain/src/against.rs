@@ -303,6 +303,10 @@ pub struct Comparison {
     /// The MIP level Glint's textures were read at: `footprint` (the
     /// render's) or `report` (`--texture-level report`).
     pub texture_level: String,
+    /// The camera samples the student's document follows, and those the
+    /// film averages.
+    pub samples_followed: usize,
+    pub samples_averaged: u64,
     /// The one stage compared (`--stage`), if only one was.
     pub only: Option<Stage>,
     /// Every stage, in pipeline order.
@@ -338,6 +342,14 @@ impl Comparison {
             if let Some(d) = first.filter(|d| d.stage == s.stage) {
                 lines.extend(difference_text(d));
             }
+        }
+        if first.is_some_and(|d| d.stage == Stage::Film)
+            && (self.samples_followed as u64) < self.samples_averaged
+        {
+            lines.push(format!(
+                "  the samples followed agree, but the film averages all {} of the pixel's: pass --all-samples (and write every sample) to find the one that parts",
+                self.samples_averaged
+            ));
         }
         lines.push(match first {
             None => "your document agrees with Glint's everywhere it gives a value".to_owned(),
@@ -472,6 +484,8 @@ pub fn compare(student: &Node, glint: &Value, only: Option<Stage>) -> Result<Com
     check_header(student, glint)?;
     check_light_sample_counts(student, glint)?;
     let mut walk = Walk {
+        on_sphere: false,
+        report_level: glint["texture_level"].as_str() == Some("report"),
         only,
         stages: Stage::ALL
             .iter()
@@ -504,6 +518,11 @@ pub fn compare(student: &Node, glint: &Value, only: Option<Stage>) -> Result<Com
             .as_str()
             .unwrap_or("footprint")
             .to_owned(),
+        samples_followed: match student.get("samples") {
+            Some(Node::Array(samples)) => samples.len(),
+            _ => 0,
+        },
+        samples_averaged: glint["film"]["samples_averaged"].as_u64().unwrap_or(1),
         only,
         pixel: (
             pixel[0].as_u64().unwrap_or(0),
@@ -643,6 +662,12 @@ fn same(a: &Value, b: &Value) -> bool {
 struct Walk {
     only: Option<Stage>,
     stages: Vec<StageComparison>,
+    /// Whether the ray being walked hit a sphere, whose u (the hit's, its
+    /// texture lookup's) is compared modulo 1.
+    on_sphere: bool,
+    /// Whether Glint read its textures at the report's level
+    /// (`--texture-level report`), where the level decides the footprint.
+    report_level: bool,
 }
 
 impl Walk {
@@ -696,9 +721,11 @@ impl Walk {
         let (Node::Object(entries), Some(glint @ Value::Object(_))) = (yours, glint) else {
             return self.tree(Stage::Intersect, path, "ray", yours, glint);
         };
-        for (key, value) in entries {
+        let kind = glint.pointer("/intersect/hit/kind").and_then(Value::as_str);
+        let outer = std::mem::replace(&mut self.on_sphere, kind == Some("sphere"));
+        for (key, value) in in_pipeline_order(entries, self.report_level) {
             let at = format!("{path}.{key}");
-            match key.as_str() {
+            match key {
                 "reflection" if glint.get(key).is_some() => self.ray(&at, value, glint.get(key)),
                 "reflection" | "depth" | "intersect" | "object" | "triangle" => {
                     self.tree(Stage::Intersect, &at, key, value, glint.get(key))
@@ -707,6 +734,7 @@ impl Walk {
                 _ => self.tree(Stage::Light, &at, key, value, glint.get(key)),
             }
         }
+        self.on_sphere = outer;
     }
 
     /// Any value of `stage` under `key`: objects key by key in pipeline
@@ -718,8 +746,9 @@ impl Walk {
         }
         match (yours, glint) {
             (Node::Object(entries), Some(Value::Object(theirs))) => {
-                let on_sphere = theirs.get("kind").and_then(Value::as_str) == Some("sphere");
-                for (k, v) in in_pipeline_order(entries) {
+                let on_sphere =
+                    self.on_sphere || theirs.get("kind").and_then(Value::as_str) == Some("sphere");
+                for (k, v) in in_pipeline_order(entries, self.report_level) {
                     let at = format!("{path}.{k}");
                     match (k, v, theirs.get(k)) {
                         ("uv", Node::Array(_), Some(g)) => {
@@ -774,22 +803,42 @@ impl Walk {
 
 /// An object's entries in [`PIPELINE_ORDER`], the keys that describe
 /// Glint's own work ([`SKIPPED`]) left out; keys not listed last, in the
-/// document's order.
-fn in_pipeline_order(entries: &[(String, Node)]) -> Vec<(&str, &Node)> {
+/// document's order. At the report's level (`report_level`) the level is
+/// computed first and decides the footprint: the lookups and their
+/// `report_*` keys come before the footprint and the derivatives.
+fn in_pipeline_order(entries: &[(String, Node)], report_level: bool) -> Vec<(&str, &Node)> {
     let mut keys: Vec<(&str, &Node)> = entries
         .iter()
         .filter(|(k, _)| !SKIPPED.contains(&k.as_str()))
         .map(|(k, v)| (k.as_str(), v))
         .collect();
-    let place = |k: &str| {
+    let position = |k: &str| {
         PIPELINE_ORDER
             .iter()
             .position(|p| *p == k)
             .unwrap_or(PIPELINE_ORDER.len())
     };
+    // A texture stage's object: its lookups before its footprint.
+    let texture = keys.iter().any(|(k, _)| *k == "footprint");
+    let first = |k: &str| LEVEL_KEYS.contains(&k) || (texture && LOOKUPS.contains(&k));
+    let place = |k: &str| match report_level && first(k) {
+        true => (position("footprint"), 0),
+        false => (position(k), 1),
+    };
     keys.sort_by_key(|(k, _)| place(k));
     keys
 }
+
+/// The keys of a lookup's level, which at the report's level decides the
+/// lookup's footprint and derivatives, and the lookups that hold them.
+const LEVEL_KEYS: [&str; 5] = [
+    "report_l",
+    "report_w",
+    "report_m",
+    "report_level",
+    "glint_level",
+];
+const LOOKUPS: [&str; 2] = ["diffuse", "specular"];
 
 /// An array of numbers (or of nulls, Glint's non-finite numbers): a vector.
 fn is_vector(items: &[Value]) -> bool {
@@ -984,6 +1033,47 @@ mod tests {
         )
         .unwrap();
         assert_eq!(c.first().unwrap().tolerance, Tolerance::PeriodicU);
+    }
+
+    #[test]
+    fn a_lookups_uv_on_a_sphere_wraps_and_at_the_reports_level_the_level_comes_first() {
+        let mut g = glint();
+        g["samples"][0]["ray"]["texture"]["footprint"] =
+            json!({"uv": [0.9, 0.25], "duvdx": [0.01, 0.0]});
+        let doc = r#"{"schema": "glint-explain/1", "pixel": [3, 4], "samples": [{"sample": 0, "ray":
+            {"texture": {"footprint": {"uv": [-0.1, 0.25], "duvdx": [0.02, 0.0]},
+                         "diffuse": {"report_level": 2.9}}}}]}"#;
+        let c = compare(&Node::parse(doc).unwrap(), &g, None).unwrap();
+        assert_eq!(
+            c.first().unwrap().path,
+            "samples[0].ray.texture.footprint.duvdx"
+        );
+        assert_eq!(
+            c.stages[Stage::Texture as usize].differences.len(),
+            2,
+            "the uv agrees"
+        );
+        g["texture_level"] = json!("report");
+        let c = compare(&Node::parse(doc).unwrap(), &g, None).unwrap();
+        assert_eq!(
+            c.first().unwrap().path,
+            "samples[0].ray.texture.diffuse.report_level"
+        );
+        assert!(c.text("x").contains("textures at the report's level"));
+    }
+
+    #[test]
+    fn a_film_that_differs_behind_agreeing_samples_asks_for_all_of_them() {
+        let mut g = glint();
+        g["film"]["samples_averaged"] = json!(4);
+        let doc = r#"{"schema": "glint-explain/1", "pixel": [3, 4],
+            "samples": [{"sample": 0, "camera": {"raster": [3.5, 4.5]}}],
+            "film": {"radiance": [0.2, 0.3, 0.3]}}"#;
+        let c = compare(&Node::parse(doc).unwrap(), &g, None).unwrap();
+        assert_eq!(c.first().unwrap().stage, Stage::Film);
+        assert!(c
+            .text("x")
+            .contains("the film averages all 4 of the pixel's: pass --all-samples"));
     }
 
     #[test]

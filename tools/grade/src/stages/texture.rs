@@ -75,8 +75,42 @@ pub fn cases(cx: &Context, n: usize) -> Result<Vec<Case>, GradeError> {
             0.15,
             s.awkward(|p| textured(p) && s.near_seam(p)).into_iter(),
         ),
+        Plan::new(
+            "a pyramid level halved from an odd size",
+            0.1,
+            s.awkward(|p| textured(p) && reads_an_odd_halving(cx.scene, p))
+                .into_iter(),
+        ),
     ];
     collect(cx.scene, cx.settings, n, plans, |p| case(cx, p))
+}
+
+/// Whether pixel `p`'s centre reads, at the report's level, a pyramid level
+/// made from a level of odd width or height (37 × 25 from 75 × 50): where
+/// a pyramid built with the sizes rounded the other way parts from Glint's.
+fn reads_an_odd_halving(scene: &Scene, [x, y]: [u32; 2]) -> bool {
+    let ray = super::survey::camera_ray(scene, x as f32 + 0.5, y as f32 + 0.5);
+    let Some(hit) = scene.shapes.closest_hit(&ray, f32::INFINITY) else {
+        return false;
+    };
+    let SurfaceKind::Material(m) = scene.surface_of(&hit) else {
+        return false;
+    };
+    let Some((_, texture @ Texture::Image(image))) = varying(m) else {
+        return false;
+    };
+    let Some(report) = report_level(&scene.camera, &ray, &hit, m, texture) else {
+        return false;
+    };
+    let levels = image.image.pyramid().levels();
+    let odd = |k: usize| {
+        k >= 1
+            && k < levels.len()
+            && (levels[k - 1].width() % 2 == 1 || levels[k - 1].height() % 2 == 1)
+    };
+    let level = report.level.clamp(0.0, (levels.len() - 1) as f32);
+    let lower = level as usize;
+    odd(lower) || (level > lower as f32 && odd(lower + 1))
 }
 
 /// The texture a case reads: the diffuse one if it varies, else the specular.

@@ -35,6 +35,35 @@ INF = float("inf")
 
 
 # ----------------------------------------------------------------------------
+# Deliberate mistakes (--mistake NAME): ten classic student slips, each a small
+# branch marked "MISTAKE name" where it is made, so that tools/student/mistakes.py
+# can see how `glint grade --stages` and `glint explain --against` name them.
+# With no --mistake (MISTAKE is None) no branch is taken and nothing changes.
+# ----------------------------------------------------------------------------
+
+MISTAKES = {
+    "up-flipped": "the camera's up vector flipped (up = forward x right): the image upside down",
+    "sphere-u-unwrapped": "sphere u = atan2(-z, x)/2pi left in [-0.5, 0.5) instead of wrapped into [0, 1)",
+    "mip-natural-log": "the report's MIP level with the natural log, ln(L/W), instead of log2(L/W)",
+    "odd-level-rounded-up": "pyramid levels of odd size rounded up, ceil(side/2) (75x50 -> 38x25), not floor",
+    "light-sum-not-divided": "an area light's sum of samples not divided by their number N",
+    "light-blocks-itself": "the shadow ray aimed along l from the offset start (the old recipe): the light's "
+                           "own surface blocks it where the light is seen at a slant",
+    "no-shadow-offset": "shadow rays start exactly at x, blockers at t > 0 (shadow acne)",
+    "blinn": "the Phong lobe with the half vector, max(0, n.h)^s, instead of max(0, r.v)^s",
+    "view-sign": "the view vector's sign flipped in the specular term (r.(-v))",
+    "gamma-22": "8-bit film values with c^(1/2.2) instead of the sRGB curve",
+}
+MISTAKE = None
+
+
+def mistake(name):
+    """True where the mistake `name` is switched on (--mistake name)."""
+    assert name in MISTAKES, name
+    return MISTAKE == name
+
+
+# ----------------------------------------------------------------------------
 # Vectors (plain tuples)
 # ----------------------------------------------------------------------------
 
@@ -261,6 +290,10 @@ def _box_weights(n):
     """texture-filtering.md: level k+1 has side max(1, floor(n/2)); each new texel
     averages the old level over its own footprint, fractional weights at its edges."""
     m = max(1, n // 2)
+    if mistake("odd-level-rounded-up"):
+        # MISTAKE odd-level-rounded-up: an odd side rounded up, ceil(n/2), with
+        # the same area-weighted box (75 -> 38 instead of 37)
+        m = max(1, (n + 1) // 2)
     ratio = n / m
     out = []
     for j in range(m):
@@ -498,7 +531,8 @@ class Sphere:
     def uv_of_normal(self, n):
         # scene-format.md, sphere uv
         phi = math.atan2(-n[2], n[0])
-        if phi < 0:
+        if phi < 0 and not mistake("sphere-u-unwrapped"):
+            # (MISTAKE sphere-u-unwrapped skips this wrap: u stays in [-0.5, 0.5))
             phi += 2 * math.pi
         theta = math.acos(max(-1.0, min(1.0, n[1])))
         return (phi / (2 * math.pi), 1 - theta / math.pi)
@@ -720,6 +754,9 @@ class Camera:
         self.forward = normalize(sub(look, self.eye))
         self.right = normalize(cross(self.forward, up))
         self.up = cross(self.right, self.forward)
+        if mistake("up-flipped"):
+            # MISTAKE up-flipped: the basis's up the wrong way round (forward x right)
+            self.up = neg(self.up)
         self.width, self.height = width, height
         self.half_h = self.f * math.tan(math.radians(self.fov) / 2)
 
@@ -972,7 +1009,11 @@ def phong_terms(kd, ks, shininess, lobe, n, v, l):
     r = sub(mul(n, 2 * ndl), l)
     if ndl <= 0:
         return ndl, r, ZERO, ZERO
-    if lobe == "blinn-phong":
+    if mistake("view-sign"):
+        # MISTAKE view-sign: the view vector's sign flipped in the specular term
+        v = neg(v)
+    if lobe == "blinn-phong" or mistake("blinn"):
+        # (MISTAKE blinn: the half vector's lobe for a Phong material too)
         h = normalize(add(l, v))
         base = max(0.0, dot(n, h))
     else:
@@ -991,6 +1032,15 @@ def shadow_test(scene, x, ng, p, eps):
     to = sub(p, o)
     dist = length(to)
     d = mul(to, 1 / dist)
+    if mistake("light-blocks-itself"):
+        # MISTAKE light-blocks-itself: aimed along the shading's l (from x) out of
+        # the offset start, which meets the light's own plane short of the end
+        d = normalize(sub(p, x))
+    if mistake("no-shadow-offset"):
+        # MISTAKE no-shadow-offset: the ray starts exactly at x (any t > 0 blocks),
+        # still stopping eps short of the light
+        o, d = x, normalize(sub(p, x))
+        dist = length(sub(p, x))
     best_t, best = dist - eps, None
     for obj in scene.objects:
         t = obj.shape.intersect_t(o, d, best_t)
@@ -1047,6 +1097,14 @@ def sample_light(scene, light, p, x, n, ng, v, kd, ks, mat_shininess, lobe, eps)
 # Ray differentials and texture lookups (texture-filtering.md, pbrt-v4 10.1)
 # ----------------------------------------------------------------------------
 
+def report_level_of(L, W):
+    """The report's MIP level, log2(L/W) (checking-your-ray-tracer.md)."""
+    if mistake("mip-natural-log"):
+        # MISTAKE mip-natural-log: the natural log instead of log2
+        return math.log(L / W)
+    return math.log2(L / W)
+
+
 def footprint_at(hit, rd):
     """Intersect the offset rays with the tangent plane; least squares for duv."""
     if rd is None:
@@ -1100,7 +1158,7 @@ def lookup(tex, uv_m, duvdx_m, duvdy_m, report, at_report_level=False):
         L, Wj = report
         m = max(img.width, img.height)
         W = Wj / m
-        out["report_level"] = math.log2(L / W)
+        out["report_level"] = report_level_of(L, W)
         out["report_l"], out["report_w"], out["report_m"] = L, W, m
     else:
         out["report_level"] = None
@@ -1222,6 +1280,10 @@ class Tracer:
                     s["running_average"] = mul(acc, 1 / (k + 1))
                     samples.append(s)
                 total = cmul(light.color, mul(acc, 1 / len(pts)))
+                if mistake("light-sum-not-divided"):
+                    # MISTAKE light-sum-not-divided: the sum, not the mean (the
+                    # running averages above are left as they should be)
+                    total = cmul(light.color, acc)
                 lights.append({"light": light.index, "kind": light.kind, "samples": samples, "total": total})
                 local = add(local, total)
             rec["light"] = {"ambient": ambient, "lights": lights, "environment": None}
@@ -1274,7 +1336,7 @@ class Tracer:
             if img_tex is not None:
                 L, Wj = report
                 m = max(img_tex.image.width, img_tex.image.height)
-                level = math.log2(L / (Wj / m)) if L > 0 and Wj > 0 else float("nan")
+                level = report_level_of(L, Wj / m) if L > 0 and Wj > 0 else float("nan")
                 if math.isfinite(level):
                     w = 2.0 ** level / m
                     duvdx, duvdy = (w / su, 0.0), (0.0, w / sv)
@@ -1348,6 +1410,9 @@ def srgb8(c):
     if not (c == c):
         c = 0.0
     c = min(1.0, max(0.0, c))
+    if mistake("gamma-22"):
+        # MISTAKE gamma-22: a plain power curve instead of the sRGB curve
+        return int(math.floor(255 * c ** (1 / 2.2) + 0.5))
     e = 12.92 * c if c <= 0.0031308 else 1.055 * c ** (1 / 2.4) - 0.055
     return int(math.floor(255 * e + 0.5))
 
@@ -1494,7 +1559,7 @@ def stage_texture(scene, cases):
             continue
         m = max(tex.image.width, tex.image.height)
         W = J / m
-        level = math.log2(L / W)
+        level = report_level_of(L, W)
         val = trilinear_at_level(tex.pyramid, um, 1 - vm, level, tex.wrap)
         rows.append([c["id"], L, J, W, level, *val])
     return header, rows
@@ -1554,6 +1619,10 @@ def stage_lighting(scene, cases, eps):
         total = ambient_term
         for j, (kind, col, nrm) in lights.items():
             if counts[j]:
+                if mistake("light-sum-not-divided"):
+                    # MISTAKE light-sum-not-divided: the sum of the samples, not divided by N
+                    total = add(total, cmul(col, sums[j]))
+                    continue
                 total = add(total, cmul(col, mul(sums[j], 1 / counts[j])))
         hdr += ["total_r", "total_g", "total_b"]
         out += list(total)
@@ -1598,6 +1667,12 @@ def epsilon_of(scene, args):
     return eps
 
 
+def add_mistake_option(p):
+    p.add_argument("--mistake", choices=sorted(MISTAKES), default=None, metavar="NAME",
+                   help="make one classic student mistake on purpose (for tools/student/mistakes.py): "
+                        + "; ".join(f"{k}: {v}" for k, v in MISTAKES.items()))
+
+
 def add_epsilon_options(p):
     p.add_argument("--epsilon-fraction", type=float, default=1e-4, metavar="F",
                    help="shadow and mirror ray offset as a fraction of the scene's size (scene-format.md step 9: "
@@ -1614,6 +1689,7 @@ def main(argv=None):
     a.add_argument("vectors")
     a.add_argument("answers")
     add_epsilon_options(a)
+    add_mistake_option(a)
     e = sub_.add_parser("explain", help="write a glint-explain/1 document for one pixel")
     e.add_argument("scene")
     e.add_argument("--pixel", required=True)
@@ -1630,8 +1706,11 @@ def main(argv=None):
     g.add_argument("--sample", type=int, default=0)
     g.add_argument("--all-samples", action="store_true")
     add_epsilon_options(e)
+    add_mistake_option(e)
     e.add_argument("-o", "--output", default="-")
     args = ap.parse_args(argv)
+    global MISTAKE
+    MISTAKE = args.mistake
     try:
         if args.command == "stages":
             cmd_stages(args)

@@ -259,7 +259,7 @@ impl Tolerance {
                 "each component within {RELATIVE:e}·(Glint's largest |component|) + {FLOOR:e}"
             ),
             Tolerance::PeriodicU => format!(
-                "each component within {RELATIVE:e}·(Glint's largest |component|) + {FLOOR:e}, u modulo 1 (a sphere's seam)"
+                "each component within {RELATIVE:e}·(Glint's largest |component|) + {FLOOR:e}, u modulo its period on a sphere (1 for the hit's uv, |uv_scale.u| for the lookup's)"
             ),
             Tolerance::Angular => format!("at most {ANGLE:e} rad apart, of length 1 within {UNIT:e}"),
             Tolerance::Levels => format!("within {LEVEL} levels"),
@@ -485,6 +485,7 @@ pub fn compare(student: &Node, glint: &Value, only: Option<Stage>) -> Result<Com
     check_light_sample_counts(student, glint)?;
     let mut walk = Walk {
         on_sphere: false,
+        lookup_period: None,
         report_level: glint["texture_level"].as_str() == Some("report"),
         only,
         stages: Stage::ALL
@@ -665,6 +666,9 @@ struct Walk {
     /// Whether the ray being walked hit a sphere, whose u (the hit's, its
     /// texture lookup's) is compared modulo 1.
     on_sphere: bool,
+    /// On a sphere, the period of the lookup coordinates' u made from it
+    /// (`u·s_u + o_u`: `|s_u|`), while its texture stage is walked.
+    lookup_period: Option<f64>,
     /// Whether Glint read its textures at the report's level
     /// (`--texture-level report`), where the level decides the footprint.
     report_level: bool,
@@ -748,18 +752,27 @@ impl Walk {
             (Node::Object(entries), Some(Value::Object(theirs))) => {
                 let on_sphere =
                     self.on_sphere || theirs.get("kind").and_then(Value::as_str) == Some("sphere");
+                let scale_u = theirs.get("uv_scale").and_then(|s| s[0].as_f64());
+                let outer = self.lookup_period;
+                if let (true, Some(s)) = (on_sphere, scale_u) {
+                    self.lookup_period = Some(s.abs());
+                }
                 for (k, v) in in_pipeline_order(entries, self.report_level) {
                     let at = format!("{path}.{k}");
-                    match (k, v, theirs.get(k)) {
-                        ("uv", Node::Array(_), Some(g)) => {
-                            let rule = Rule::Uv {
-                                periodic_u: on_sphere,
-                            };
+                    let u_period = match k {
+                        "uv" => on_sphere.then_some(1.0),
+                        "material_uv" | "st" => self.lookup_period,
+                        _ => None,
+                    };
+                    match (v, theirs.get(k)) {
+                        (Node::Array(_), Some(g)) if u_period.is_some() || k == "uv" => {
+                            let rule = Rule::Uv { u_period };
                             self.leaf(stage, &at, k, v, Some(g), Some(rule))
                         }
                         _ => self.tree(stage, &at, k, v, theirs.get(k)),
                     }
                 }
+                self.lookup_period = outer;
             }
             (Node::Array(items), Some(Value::Array(theirs))) if !is_vector(theirs) => {
                 for (i, item) in items.iter().enumerate() {
@@ -917,7 +930,7 @@ fn vector(key: &str, yours: &[Value], glint: &[Value], rule: Option<Rule>) -> Ve
         return within(Tolerance::Angular, Rule::Direction, &g, &a);
     }
     match rule {
-        Some(rule @ Rule::Uv { periodic_u: true }) => within(Tolerance::PeriodicU, rule, &g, &a),
+        Some(rule @ Rule::Uv { u_period: Some(_) }) => within(Tolerance::PeriodicU, rule, &g, &a),
         _ => within(Tolerance::Vector, Rule::Vector, &g, &a),
     }
 }

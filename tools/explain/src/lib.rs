@@ -365,6 +365,7 @@ fn ray_event(
                     camera_hit.and_then(|(r, h)| report_level(&scene.camera, r, h, m, t))
                 };
                 let tc = m.uv_transform.apply(tc);
+                texture["uv_scale"] = json!(v2(m.uv_transform.scale));
                 texture["material_uv"] = json!(v2(tc.uv));
                 texture["diffuse"] = json::lookup(&m.diffuse.explain(&tc), report(&m.diffuse));
                 texture["specular"] = match &m.specular {

@@ -48,8 +48,10 @@ pub enum Rule {
     /// A vector: each component within `RELATIVE` times Glint's largest
     /// component, plus `FLOOR`.
     Vector,
-    /// A uv: as a vector, `u` modulo 1 where it wraps around (spheres).
-    Uv { periodic_u: bool },
+    /// A uv: as a vector, `u` modulo its period where it wraps around (1 for
+    /// a sphere's; `|s_u|` for the lookup coordinates `u·s_u + o_u` made
+    /// from it).
+    Uv { u_period: Option<f64> },
     /// A unit direction: at most `ANGLE` radians apart, of length 1 within
     /// `UNIT`.
     Direction,
@@ -90,11 +92,11 @@ pub fn measure(rule: Rule, glint: &[f64], yours: &[f64]) -> Gap {
         note: None,
     };
     match rule {
-        Rule::Relative | Rule::Vector => gap(largest_difference(glint, yours, false), relative),
-        Rule::Uv { periodic_u } => gap(largest_difference(glint, yours, periodic_u), relative),
-        Rule::Level => gap(largest_difference(glint, yours, false), LEVEL),
-        Rule::Share => gap(largest_difference(glint, yours, false), RELATIVE + FLOOR),
-        Rule::Codes { codes } => gap(largest_difference(glint, yours, false), codes),
+        Rule::Relative | Rule::Vector => gap(largest_difference(glint, yours, None), relative),
+        Rule::Uv { u_period } => gap(largest_difference(glint, yours, u_period), relative),
+        Rule::Level => gap(largest_difference(glint, yours, None), LEVEL),
+        Rule::Share => gap(largest_difference(glint, yours, None), RELATIVE + FLOOR),
+        Rule::Codes { codes } => gap(largest_difference(glint, yours, None), codes),
         Rule::Direction => {
             let length = yours.iter().map(|x| x * x).sum::<f64>().sqrt();
             if (length - 1.0).abs() > UNIT {
@@ -113,9 +115,9 @@ pub fn measure(rule: Rule, glint: &[f64], yours: &[f64]) -> Gap {
     }
 }
 
-/// The largest component difference, the first component modulo 1 if
-/// `wrap_first`; NaN if any is (or the lengths differ).
-fn largest_difference(glint: &[f64], yours: &[f64], wrap_first: bool) -> f64 {
+/// The largest component difference, the first component modulo
+/// `first_period` if given; NaN if any is (or the lengths differ).
+fn largest_difference(glint: &[f64], yours: &[f64], first_period: Option<f64>) -> f64 {
     if glint.len() != yours.len() {
         return f64::NAN;
     }
@@ -125,9 +127,9 @@ fn largest_difference(glint: &[f64], yours: &[f64], wrap_first: bool) -> f64 {
         .enumerate()
         .map(|(i, (g, y))| {
             let d = y - g;
-            match wrap_first && i == 0 {
-                true => (d - d.round()).abs(),
-                false => d.abs(),
+            match first_period.filter(|p| i == 0 && *p > 0.0) {
+                Some(p) => (d - p * (d / p).round()).abs(),
+                None => d.abs(),
             }
         })
         .fold(0.0f64, |m, d| {
@@ -164,20 +166,21 @@ mod tests {
 
     #[test]
     fn a_spheres_u_agrees_across_its_seam_and_nothing_else_wraps() {
-        let seam = measure(
-            Rule::Uv { periodic_u: true },
-            &[0.9999, 0.5],
-            &[0.0001, 0.5],
-        );
+        let sphere = Rule::Uv {
+            u_period: Some(1.0),
+        };
+        let seam = measure(sphere, &[0.9999, 0.5], &[0.0001, 0.5]);
         assert!(seam.agrees(), "{seam:?}");
-        let unwrapped = measure(Rule::Uv { periodic_u: true }, &[0.836, 0.5], &[-0.164, 0.5]);
+        let unwrapped = measure(sphere, &[0.836, 0.5], &[-0.164, 0.5]);
         assert!(unwrapped.agrees(), "{unwrapped:?}");
-        assert!(!measure(
-            Rule::Uv { periodic_u: false },
-            &[0.836, 0.5],
-            &[-0.164, 0.5]
-        )
-        .agrees());
+        // A lookup's coordinates u·4 + o repeat every 4.
+        let scaled = Rule::Uv {
+            u_period: Some(4.0),
+        };
+        assert!(measure(scaled, &[3.344, 0.5], &[-0.656, 0.5]).agrees());
+        assert!(!measure(scaled, &[3.344, 0.5], &[2.344, 0.5]).agrees());
+        let plain = Rule::Uv { u_period: None };
+        assert!(!measure(plain, &[0.836, 0.5], &[-0.164, 0.5]).agrees());
         assert!(!measure(Rule::Vector, &[0.9999, 0.5], &[0.0001, 0.5]).agrees());
     }
 

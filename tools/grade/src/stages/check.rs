@@ -282,7 +282,9 @@ fn measure(
     let rule = match check {
         Check::Relative => Rule::Relative,
         Check::Vector => Rule::Vector,
-        Check::Uv => Rule::Uv { periodic_u },
+        Check::Uv => Rule::Uv {
+            u_period: periodic_u.then_some(1.0),
+        },
         Check::Level => Rule::Level,
         Check::Direction => Rule::Direction,
         Check::Exact | Check::Info => return (0.0, 0.0, None),

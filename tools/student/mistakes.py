@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Do Glint's two checking tools name the same mistake the same way?
 
-For each of the ten classic student mistakes that `tracer.py --mistake NAME`
+For each of the fourteen classic student mistakes that `tracer.py --mistake NAME`
 can make, on a scene where it shows:
 
   1. `glint grade --stages S --write V` (once per scene), the tracer's
@@ -66,6 +66,10 @@ MISTAKES = [
     ("blinn", "cornell-set1"),
     ("view-sign", "cornell-set1"),
     ("gamma-22", "cornell-set1"),
+    ("no-ambient", "cornell-set1"),  # ambient = 0.1
+    ("light-centre", "cornell-set1"),  # one area light, 4 x 4 grid samples
+    ("pixel-corner", "cornell-set1"),
+    ("fov-not-halved", "cornell-set1"),
 ]
 TEXTURE_SCENES = {"textured-spheres"}  # explained with --texture-level report
 
@@ -82,6 +86,8 @@ CORRESPONDENCES = [
     (r"direction", r"camera\.direction", "exact", ""),
     (r"direction", r"camera\.film_point", "judged", "direction = normalize(film point)"),
     (r"direction", r"camera\.ndc", "judged", "the direction is built from ndc"),
+    (r"direction", r"camera\.raster", "judged",
+     "the direction is built from the raster position (an input of the stage)"),
     (r"direction", r"camera\.differentials\..*", "judged", "the differentials are offsets of the direction"),
     # intersection
     (r"hit", r"intersect\.hit", "exact", ""),
@@ -112,6 +118,8 @@ CORRESPONDENCES = [
     (r"s\d+_specular", r"light\.lights\[k\]\.samples\[k\]\.specular", "exact", ""),
     (r"s\d+_(verdict|blocker)", r"light\.lights\[k\]\.samples\[k\]\.(value|running_average)", "judged",
      "what a blocked sample adds (0) follows from its verdict"),
+    (r"s\d+_(verdict|blocker|diffuse|specular)", r"light\.lights\[k\]\.samples\[k\]\.(position|l|n_dot_l|reflection)",
+     "judged", "the sample's position is an input of the stage; its l, terms and verdict follow from it"),
     (r"total", r"light\.lights\[k\]\.total", "exact", "a light's term of the total"),
     (r"total", r"radiance\.(local|value)|radiance", "exact", "the point's local radiance"),
     # film

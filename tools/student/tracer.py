@@ -35,7 +35,7 @@ INF = float("inf")
 
 
 # ----------------------------------------------------------------------------
-# Deliberate mistakes (--mistake NAME): ten classic student slips, each a small
+# Deliberate mistakes (--mistake NAME): fourteen classic student slips, each a small
 # branch marked "MISTAKE name" where it is made, so that tools/student/mistakes.py
 # can see how `glint grade --stages` and `glint explain --against` name them.
 # With no --mistake (MISTAKE is None) no branch is taken and nothing changes.
@@ -53,6 +53,10 @@ MISTAKES = {
     "blinn": "the Phong lobe with the half vector, max(0, n.h)^s, instead of max(0, r.v)^s",
     "view-sign": "the view vector's sign flipped in the specular term (r.(-v))",
     "gamma-22": "8-bit film values with c^(1/2.2) instead of the sRGB curve",
+    "no-ambient": "the ambient term (ambient * kd) left out of the local radiance",
+    "light-centre": "every area-light sample placed at the light's centre instead of its grid cell's centre",
+    "pixel-corner": "camera samples through the grid cells' corners, (i mod k)/k, not their centres (+1/2 left out)",
+    "fov-not-halved": "the film's half height f*tan(fov) instead of f*tan(fov/2)",
 }
 MISTAKE = None
 
@@ -759,6 +763,10 @@ class Camera:
             self.up = neg(self.up)
         self.width, self.height = width, height
         self.half_h = self.f * math.tan(math.radians(self.fov) / 2)
+        if mistake("fov-not-halved"):
+            # MISTAKE fov-not-halved: the whole vertical fov, not half of it, in
+            # the film's half height (both commands build rays with this camera)
+            self.half_h = self.f * math.tan(math.radians(self.fov))
 
     def film_point(self, x, y, width=None, height=None):
         width = width or self.width
@@ -1066,6 +1074,9 @@ def light_sample_points(light, n):
     k = int(round(math.sqrt(n)))
     if k * k != n:
         raise SystemExit("--light-sampler grid needs a perfect square of light samples")
+    if mistake("light-centre"):
+        # MISTAKE light-centre: all n samples at the light's centre (still n of them)
+        return [light.center] * n
     return [light.point_at(((i % k) + 0.5) / k, ((i // k) + 0.5) / k) for i in range(n)]
 
 
@@ -1267,6 +1278,9 @@ class Tracer:
             rec["texture"] = tex
             rec["shading"] = {"n": n, "ng": ng, "v": v}
             ambient = cmul(sc.ambient, kd)  # step 6
+            if mistake("no-ambient"):
+                # MISTAKE no-ambient: the ambient term left out (recorded as 0)
+                ambient = ZERO
             lights = []
             local = ambient
             for light in sc.lights:  # step 7: point lights, then area lights
@@ -1451,6 +1465,9 @@ def cmd_explain(args):
     for i in range(spp):
         x = X + ((i % k) + 0.5) / k  # step 1, grid
         y = Y + ((i // k) + 0.5) / k
+        if mistake("pixel-corner"):
+            # MISTAKE pixel-corner: the cell's corner, (i mod k)/k, without the + 1/2
+            x, y = X + (i % k) / k, Y + (i // k) / k
         ndc, fp = cam.film_point(x, y)
         d = normalize(fp)
         camrec = {"raster": (x, y), "ndc": ndc, "film_point": fp, "origin": cam.eye, "direction": d}
@@ -1514,10 +1531,31 @@ def write_answers(answers, stage, header, rows):
             w.writerow(["" if v is None else (repr(v) if isinstance(v, float) else v) for v in r])
 
 
+def cell_corner(r):
+    """For MISTAKE pixel-corner: a case's raster coordinate is a grid cell's centre,
+    X + (j + 1/2)/k (grading-stages.md, where the cases come from); its cell's
+    corner X + j/k is r less half a cell, 1/(2k), the largest power of 2 whose odd
+    multiple the fraction r - X is."""
+    f = r - math.floor(r)
+    h = 0.5
+    while h > 2 ** -20:
+        q = f / h
+        if q == int(q) and int(q) % 2 == 1:
+            return r - h
+        h /= 2
+    return r
+
+
 def stage_camera(scene, cases):
     rows = []
     for c in cases:
-        o, d = scene.camera.ray(float(c["x"]), float(c["y"]), int(c["width"]), int(c["height"]))
+        x, y = float(c["x"]), float(c["y"])
+        if mistake("pixel-corner"):
+            # MISTAKE pixel-corner: the student's camera shoots each grid sample
+            # through its cell's corner, so it answers the case's raster position
+            # (a cell centre) with that cell's corner, the + 1/2 left out
+            x, y = cell_corner(x), cell_corner(y)
+        o, d = scene.camera.ray(x, y, int(c["width"]), int(c["height"]))
         rows.append([c["id"], *o, *d])
     return ["id", "origin_x", "origin_y", "origin_z", "direction_x", "direction_y", "direction_z"], rows
 
@@ -1596,6 +1634,9 @@ def stage_lighting(scene, cases, eps):
             k += 1
         width = 2 if len(samples) <= 100 else 3
         ambient_term = cmul(amb, kd)
+        if mistake("no-ambient"):
+            # MISTAKE no-ambient: the ambient term left out (answered as 0)
+            ambient_term = ZERO
         out = [c["id"], *ambient_term]
         hdr = ["id", "ambient_term_r", "ambient_term_g", "ambient_term_b"]
         sums = {j: ZERO for j in lights}
@@ -1603,6 +1644,12 @@ def stage_lighting(scene, cases, eps):
         for k, (j, p) in enumerate(samples):
             kind, col, nrm = lights[j]
             counts[j] += 1
+            if mistake("light-centre") and kind == "area":
+                # MISTAKE light-centre: the student's own sample points, all at the
+                # light's centre, instead of the given sNN_x/y/z (light J is the
+                # scene's J-th light: point lights, then area lights, as step 7)
+                assert scene.lights[j].kind == "area", (j, scene.lights[j].kind)
+                p = scene.lights[j].center
 
             class _L:
                 pass

@@ -192,12 +192,7 @@ fn bilinear_texels(
 /// The texels of a trilinear lookup at `level`, clamped to `[0, last]`
 /// (NaN reads level 0) as [`crate::MipMap::trilinear_at_level`] clamps it.
 fn trilinear_texels(t: &ImageTexture, reduced: Vec2, level: f32, out: &mut Vec<TexelRead>) {
-    let last = t.image.pyramid().levels().len() - 1;
-    let level = if level >= 0.0 {
-        level.min(last as f32)
-    } else {
-        0.0
-    };
+    let level = t.image.pyramid().clamp_level(level);
     let lower = level as usize;
     let frac = level - lower as f32;
     bilinear_texels(t, reduced, lower, 1.0 - frac, out);

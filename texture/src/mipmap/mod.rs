@@ -49,7 +49,13 @@ impl MipMap {
     /// for power-of-two square images; `max(w0, h0)` also covers the other sizes.
     #[inline]
     pub fn level_for_width(&self, width: f32) -> f32 {
-        let level = (width * self.max_side()).log2();
+        self.clamp_level((width * self.max_side()).log2())
+    }
+
+    /// A continuous `level` clamped to the pyramid, `[0, level_count − 1]`;
+    /// NaN gives 0.
+    #[inline]
+    pub fn clamp_level(&self, level: f32) -> f32 {
         if level >= 0.0 {
             level.min(self.last_level() as f32)
         } else {

@@ -26,11 +26,7 @@ impl MipMap {
     /// --stages`).
     #[inline]
     pub fn trilinear_at_level(&self, st: Vec2, level: f32, wrap: WrapMode) -> Vec3 {
-        let level = if level >= 0.0 {
-            level.min(self.last_level() as f32)
-        } else {
-            0.0 // also NaN
-        };
+        let level = self.clamp_level(level);
         let st = reduce_st(st, wrap);
         let lower = level as usize; // level is finite and ≥ 0
         let frac = level - lower as f32;

@@ -108,7 +108,7 @@ fn reads_an_odd_halving(scene: &Scene, [x, y]: [u32; 2]) -> bool {
             && k < levels.len()
             && (levels[k - 1].width() % 2 == 1 || levels[k - 1].height() % 2 == 1)
     };
-    let level = report.level.clamp(0.0, (levels.len() - 1) as f32);
+    let level = image.image.pyramid().clamp_level(report.level);
     let lower = level as usize;
     odd(lower) || (level > lower as f32 && odd(lower + 1))
 }

@@ -230,14 +230,7 @@ fn glint_farm_grade_scripts_give_the_single_report_by_hand_and_through_gnu_paral
     );
     assert_input_error(&too_many, "--parts 8: the class has 7 submissions");
 
-    if std::process::Command::new("parallel")
-        .arg("--version")
-        .output()
-        .is_err()
-    {
-        eprintln!(
-            "skipped the GNU parallel run: parallel is not installed (apt-get install parallel)"
-        );
+    if !common::real_part(common::program_missing("parallel", "parallel")) {
         return;
     }
     let parallel = farm("parallel", "parallel");

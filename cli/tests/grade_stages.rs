@@ -504,11 +504,7 @@ fn python_example() -> String {
 
 #[test]
 fn the_python_example_in_the_docs_answers_the_camera_stage() {
-    let python = std::process::Command::new("python3")
-        .arg("--version")
-        .output();
-    if !python.is_ok_and(|o| o.status.success()) {
-        eprintln!("skipped: no python3");
+    if !common::real_part(common::program_missing("python3", "python3")) {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

@@ -40,20 +40,9 @@ fn tracer() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tools/student/tracer.py")
 }
 
-/// Whether `python3` runs; under `CI=true` it must.
+/// Whether `python3` runs ([`common::real_part`]).
 fn python_runs() -> bool {
-    let runs = Command::new("python3")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !runs {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "python3 is needed to run the student's tracer (apt-get install python3)"
-        );
-        eprintln!("skipped: no python3 to run tools/student/tracer.py");
-    }
-    runs
+    common::real_part(common::program_missing("python3", "python3"))
 }
 
 /// Runs the tracer with `args` in `dir`; it prints nothing when it succeeds.

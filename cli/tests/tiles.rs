@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{assert_input_error, glint, scene, stderr, stdout};
+use common::{assert_input_error, glint, program_missing, real_part, scene, stderr, stdout};
 use std::path::Path;
 use std::process::Command;
 
@@ -237,8 +237,7 @@ fn farm_scripts_render_the_tiles_and_assemble_the_single_render() {
 
 #[test]
 fn farm_runs_on_gnu_parallel_where_installed() {
-    if Command::new("parallel").arg("--version").output().is_err() {
-        eprintln!("skipped: GNU parallel is not installed (apt-get install parallel); see docs/testing.md");
+    if !real_part(program_missing("parallel", "parallel")) {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -511,15 +510,14 @@ fn start_sshd(dir: &Path) -> Result<(Sshd, String), String> {
 
 #[test]
 fn farm_runs_on_gnu_parallel_over_ssh_to_this_machine() {
-    if Command::new("parallel").arg("--version").output().is_err() {
-        eprintln!("skipped: GNU parallel is not installed (apt-get install parallel); see docs/testing.md");
+    if !real_part(program_missing("parallel", "parallel")) {
         return;
     }
     let keys = tempfile::tempdir().unwrap();
     let (_server, login) = match start_sshd(keys.path()) {
         Ok(started) => started,
         Err(why) => {
-            eprintln!("skipped: {why}; see docs/testing.md");
+            assert!(!real_part(Some(why)));
             return;
         }
     };

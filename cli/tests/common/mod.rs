@@ -174,3 +174,29 @@ pub fn assert_same_folders(a: &Path, b: &Path) {
         );
     }
 }
+
+/// Whether a test may use a real part it needs (a program from a Debian
+/// package, a daemon): `missing` says why it cannot, or is `None`. Where the
+/// part is missing, the test says so and skips that part; under `CI=true`,
+/// where `.ci/run` has installed every part, a missing one fails the test.
+pub fn real_part(missing: Option<String>) -> bool {
+    let Some(why) = missing else {
+        return true;
+    };
+    assert!(
+        std::env::var("CI").as_deref() != Ok("true"),
+        "{why} (CI=true: .ci/run installs every part the tests need)"
+    );
+    eprintln!("skipped: {why}");
+    false
+}
+
+/// Why a program cannot be run with `--version`, if it cannot, with the
+/// Debian package that has it.
+pub fn program_missing(program: &str, package: &str) -> Option<String> {
+    let runs = Command::new(program)
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    (!runs).then(|| format!("no {program} (apt-get install {package})"))
+}

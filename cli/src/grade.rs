@@ -273,13 +273,15 @@ fn grade_or_merge(args: &GradeArgs) -> Result<(), Failure> {
         parts::write_part(staging.dir.path(), &file).map_err(failure)?;
         staging.finish()?;
         // A part's verdicts are the merge's to report.
-        crate::output::say(&glint_grade::report::table(&grades.report_rows()));
+        crate::output::say(&glint_grade::report::table(&glint_grade::report::rows(
+            &grades,
+        )));
         return Ok(());
     }
     if let Some(path) = &args.heatmap {
         write_heatmap(path, &grades)?;
     }
-    let rows = grades.report_rows();
+    let rows = glint_grade::report::rows(&grades);
     if let Some(staging) = staging {
         glint_grade::html::write_report(staging.dir.path(), &rows).map_err(failure)?;
         staging.finish()?;
@@ -323,8 +325,10 @@ fn references_only(
             "--references-only renders into the reference cache, and there is none here; give --cache DIR".into(),
         ));
     };
-    let (mine, sets) =
-        class::render_references(entries, scenes, base, options, bar, part).map_err(failure)?;
+    let (mine, sets) = class::render_references(entries, scenes, base, options, bar, &|set| {
+        part.is_none_or(|p| p.has(set))
+    })
+    .map_err(failure)?;
     bar.finish();
     let which = match part {
         Some(part) => format!("{mine} of the {sets} reference sets (part {part})"),

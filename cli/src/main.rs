@@ -24,8 +24,6 @@ mod diff;
 mod explain;
 mod export;
 mod farm;
-mod farm_class;
-mod farm_sweep;
 mod grade;
 mod grade_stages;
 mod interrupt;

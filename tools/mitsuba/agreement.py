@@ -270,7 +270,7 @@ def render_worker(argv: list[str]) -> int:
 
     if variant.startswith("llvm_") and "DRJIT_LIBLLVM_PATH" not in os.environ:
         sys.path.insert(0, str(Path(__file__).parent))
-        from compare import newest_libllvm  # the same lookup as compare.py
+        from harness import newest_libllvm  # the same lookup as compare.py
 
         found = newest_libllvm()
         if found:

@@ -32,8 +32,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
-import compare
-from compare import REPO, Failure
+import harness
+from harness import REPO, Failure
 
 PROG = "compare.py --equal-error"
 
@@ -211,7 +211,7 @@ class MitsubaScenes:
     """The exported scene with each configuration's sampler and sample counts, loaded
     once per configuration and kept, so that the timed rounds only render."""
 
-    def __init__(self, ms: compare.Mitsuba, xml: Path):
+    def __init__(self, ms: harness.Mitsuba, xml: Path):
         self.ms = ms
         self.xml = xml
         self.loaded = {}
@@ -318,7 +318,7 @@ def fmt_e(x: float) -> str:
 # One scene
 
 
-def run_scene(args, scene: Scene, glint: Glint, ms: compare.Mitsuba, out_dir: Path) -> dict:
+def run_scene(args, scene: Scene, glint: Glint, ms: harness.Mitsuba, out_dir: Path) -> dict:
     mi, dr = ms.mi, ms.dr
     work = out_dir / scene.name
     work.mkdir(parents=True, exist_ok=True)
@@ -713,17 +713,17 @@ def main(argv) -> int:
         raise Failure(f"no Glint binary at {glint_bin}; build it with `cargo build --release -p glint-cli`", 2)
     out_dir = Path(args.out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
-    ms = compare.Mitsuba(args.variant)
+    ms = harness.Mitsuba(args.variant)
     glint = Glint(glint_bin)
     machine = {
-        "cpu": compare.machine_cpu(),
+        "cpu": harness.machine_cpu(),
         "cores": os.cpu_count(),
         "mitsuba": ms.version,
         "drjit": ms.drjit_version,
         "variant": ms.variant,
         "mitsuba_threads": ms.threads,
         "llvm": ms.llvm_version,
-        "glint": compare.glint_version(glint_bin),
+        "glint": harness.glint_version(glint_bin),
     }
     log(f"machine: {machine['cpu']}, {machine['cores']} cores; Mitsuba {ms.version} {ms.variant} ({ms.threads} threads)")
     t0 = time.perf_counter()

@@ -285,14 +285,6 @@ impl ClassGrades {
     pub fn all_passed(&self) -> bool {
         self.rows.iter().all(Row::passed)
     }
-
-    /// The rows as the report shows them.
-    pub fn report_rows(&self) -> Vec<crate::report::ReportRow> {
-        self.rows
-            .iter()
-            .map(crate::report::ReportRow::new)
-            .collect()
-    }
 }
 
 /// Submissions judged against the same references: one scene, resolution
@@ -364,23 +356,24 @@ pub fn grade_class(
 
 /// Renders the references `entries` need into the cache (or finds them
 /// there), and grades nothing: the first step of a class graded in parts,
-/// whose parts then read them from the cache. With `part`, only the part's
-/// reference sets (I, I + N, … in order of first use). Returns how many sets
-/// were rendered or found, and how many the class has.
+/// whose parts then read them from the cache. Only the reference sets
+/// `wanted` takes (by their index in order of first use: a part's are I, I +
+/// N, …). Returns how many sets were rendered or found, and how many the
+/// class has.
 pub fn render_references(
     entries: &[Entry],
     scenes: &Scenes,
     base: &Path,
     options: &ClassOptions,
     progress: &dyn Progress,
-    part: Option<crate::parts::Part>,
+    wanted: &dyn Fn(usize) -> bool,
 ) -> Result<(usize, usize), GradeError> {
     let (entries, loaded, probes) = probe(entries, scenes, base)?;
     let (keys, row_groups) = reference_keys(&entries, &probes);
     let mut groups = Vec::new();
     let mut mine = vec![None; keys.len()];
     for (i, key) in keys.iter().enumerate() {
-        if part.is_none_or(|p| p.has(i)) {
+        if wanted(i) {
             mine[i] = Some(groups.len());
             groups.push(reference_group(key, &loaded, options, progress)?);
         }

@@ -114,8 +114,7 @@ pub fn class_fingerprint(entries: &[Entry], options: &str) -> String {
 /// The part file of `part` of a class (`submissions` in all) graded as
 /// `grades`, whose rows are the part's submissions in order.
 pub fn part_file(class: String, part: Part, submissions: usize, grades: &ClassGrades) -> PartFile {
-    let rows = grades
-        .report_rows()
+    let rows = crate::report::rows(grades)
         .into_iter()
         .enumerate()
         .map(|(k, row)| PartRow {

@@ -4,7 +4,7 @@
 //! made from those alone, so a class graded in parts ([`crate::parts`]) gives
 //! the report a single run gives.
 
-use crate::class::{Outcome, Row};
+use crate::class::{ClassGrades, Outcome, Row};
 use crate::{ChannelFinding, ImageGrade, RegionFinding};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
@@ -129,6 +129,11 @@ pub struct ReportRow {
     /// The reference set it is judged against, where its scene and
     /// resolution could be read: the report's `images/reference-G.png`.
     pub reference: Option<usize>,
+}
+
+/// The rows of a class's grades as the report shows them.
+pub fn rows(grades: &ClassGrades) -> Vec<ReportRow> {
+    grades.rows.iter().map(ReportRow::new).collect()
 }
 
 impl ReportRow {

@@ -22,10 +22,10 @@
 
 use super::answers::Answer;
 use super::probe::{collect, Plan, Probe, LIGHT_GRID};
-use super::report::number;
 use super::survey::camera_ray;
 use super::table::{Case, Check, Field, Kind, Layout, Value, RGB, XYZ};
 use super::Context;
+use crate::text::number;
 use crate::GradeError;
 use glam::Vec3;
 use glint_explain::rules::SHADOW_EPSILON;

@@ -291,7 +291,7 @@ fn image_steps(image: &ImageTexture, uv: Vec2, level: f32, case: &Case) -> Vec<S
 }
 
 fn show(x: f32) -> String {
-    super::report::number(f64::from(x))
+    crate::text::number(f64::from(x))
 }
 
 fn show3(v: glam::Vec3) -> String {

@@ -3,7 +3,7 @@
 //! same reference file, then `merge-bench.sh`, which fits and plots from the
 //! tasks' JSON (`glint bench --merge`).
 
-use crate::farm::{check_managed, or_default, parse_command, quote, quote_str, Farm};
+use super::script::{check_managed, or_default, parse_command, quote, quote_str, Farm};
 use crate::{Command, Failure};
 use clap::Args;
 use std::path::{Path, PathBuf};

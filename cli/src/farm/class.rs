@@ -5,7 +5,7 @@
 //! reads them from there; then `merge-grades.sh` merges the parts into the
 //! report a single run writes (`glint grade --merge`).
 
-use crate::farm::{
+use super::script::{
     check_managed, file_stem, or_default, parse_command, quote, quote_str, Farm, FirstStep,
 };
 use crate::{Command, Failure};

@@ -9,13 +9,23 @@
 //! a time limit's SIGTERM, GNU parallel's `--resume-failed`). A tile rendered
 //! again gives the same bytes. `assemble.sh` then puts the tiles together
 //! (`glint assemble`), which refuses an incomplete set and names the tiles
-//! to render again. A bench sweep (`farm_sweep.rs`) and a class's grading
-//! (`farm_class.rs`) fill the same [`Farm`] with scripts of their own.
+//! to render again. A render in tiles ([`tiles`]), a bench sweep ([`sweep`])
+//! and a class's grading ([`class`]) each fill one [`Farm`]
+//! ([`script`]): its task and merge scripts; this module writes it for an
+//! engine and submits it.
 //! docs/cluster.md walks through both engines.
 
-use crate::render::RenderArgs;
-use crate::{Cli, Command, Failure};
-use clap::{Args, Parser, Subcommand};
+mod class;
+mod script;
+mod sweep;
+mod tiles;
+
+pub(crate) use script::misplaced_option;
+use script::{quote, Farm, FirstStep};
+use tiles::{FarmRender, Plan};
+
+use crate::Failure;
+use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -52,34 +62,11 @@ enum Job {
     Render(FarmRender),
     /// A glint bench sweep: one task per strategy and budget against one
     /// reference file, then glint bench --merge (the fits and the plot)
-    Bench(crate::farm_sweep::FarmBench),
+    Bench(sweep::FarmBench),
     /// A class's grading: its references rendered into a shared cache, then
     /// one task per part of the submissions (glint grade --part I/N), then
     /// glint grade --merge (the report)
-    Grade(crate::farm_class::FarmGrade),
-}
-
-#[derive(Args)]
-struct FarmRender {
-    /// The scene file
-    scene: PathBuf,
-
-    /// How many tiles (tasks): tile I renders rows I, I+N, I+2N, ...
-    #[arg(long, value_name = "N")]
-    tiles: u32,
-
-    /// The assembled image [default: SCENE-NAME.png in the current directory]
-    #[arg(short, long, value_name = "OUT")]
-    output: Option<PathBuf>,
-
-    /// Where the scripts, tiles (tiles/) and logs (logs/) go [default:
-    /// SCENE-NAME.farm in the current directory]
-    #[arg(long, value_name = "DIR")]
-    dir: Option<PathBuf>,
-
-    /// Options for every tile's glint render (after --, e.g. -- --spp 256)
-    #[arg(last = true, value_name = "RENDER-OPTIONS")]
-    render_options: Vec<String>,
+    Grade(class::FarmGrade),
 }
 
 #[derive(Args)]
@@ -127,17 +114,6 @@ struct ParallelOptions {
     run: bool,
 }
 
-/// Options `glint farm` sets for every tile itself.
-const MANAGED: [&str; 7] = [
-    "-o",
-    "--output",
-    "--tile",
-    "--crop",
-    "--resume",
-    "--threads",
-    "--stats-json",
-];
-
 pub(crate) fn farm(args: &FarmArgs) -> Result<(), Failure> {
     match &args.engine {
         Engine::Slurm { options, job } => slurm(options, &job_of(job)?),
@@ -149,42 +125,9 @@ pub(crate) fn farm(args: &FarmArgs) -> Result<(), Failure> {
 fn job_of(job: &Job) -> Result<Farm, Failure> {
     match job {
         Job::Render(render) => Ok(Plan::new(render)?.farm()),
-        Job::Bench(bench) => Ok(crate::farm_sweep::Sweep::new(bench)?.farm()),
-        Job::Grade(grade) => Ok(crate::farm_class::ClassPlan::new(grade)?.farm()),
+        Job::Bench(bench) => Ok(sweep::Sweep::new(bench)?.farm()),
+        Job::Grade(grade) => Ok(class::ClassPlan::new(grade)?.farm()),
     }
-}
-
-/// What the engines run: the first step if there is one, then tasks
-/// `0..tasks`, each `TASK_SCRIPT I`, then the merge script once all have
-/// succeeded.
-pub(crate) struct Farm {
-    /// A step the tasks wait for.
-    pub(crate) first: Option<FirstStep>,
-    /// Names the jobs, the logs and the Slurm scripts (`render.sbatch`,
-    /// `assemble.sbatch`).
-    pub(crate) kind: &'static str,
-    pub(crate) merge_kind: &'static str,
-    pub(crate) task_script: &'static str,
-    pub(crate) merge_script: &'static str,
-    pub(crate) scene: PathBuf,
-    pub(crate) dir: PathBuf,
-    pub(crate) tasks: u32,
-    /// Said when the job is written: "5 tiles of SCENE".
-    pub(crate) what: String,
-    /// The folders to make.
-    pub(crate) folders: Vec<PathBuf>,
-    /// The text of `task_script` and of `merge_script`.
-    pub(crate) task_text: String,
-    pub(crate) merge_text: String,
-}
-
-/// Tasks that the tasks wait for: `KIND.sbatch`, an array of `tasks`
-/// tasks, each `SCRIPT I`.
-pub(crate) struct FirstStep {
-    pub(crate) kind: &'static str,
-    pub(crate) script: &'static str,
-    pub(crate) tasks: u32,
-    pub(crate) text: String,
 }
 
 /// Writes the job array and the merge job, and submits them or says how.
@@ -251,133 +194,6 @@ fn parallel(options: &ParallelOptions, farm: &Farm) -> Result<(), Failure> {
         quote(&script)
     ));
     Ok(())
-}
-
-/// A render in tiles, checked, with every path absolute.
-struct Plan {
-    glint: PathBuf,
-    scene: PathBuf,
-    tiles: u32,
-    output: PathBuf,
-    dir: PathBuf,
-    render_options: Vec<String>,
-}
-
-impl Plan {
-    /// Checks everything before any file is written: the render options (as
-    /// `glint render` parses them), the scene (loaded), the tile count
-    /// against the image's rows, and the paths.
-    fn new(args: &FarmRender) -> Result<Plan, Failure> {
-        if args.tiles == 0 {
-            return Err(Failure::Input(
-                "--tiles: expected at least 1 tile, got 0".into(),
-            ));
-        }
-        check_managed("render", &args.render_options, &MANAGED)?;
-        let stem = file_stem(&args.scene, "render");
-        let dir = or_default(&args.dir, format!("{stem}.farm"));
-        let output = or_default(&args.output, format!("{stem}.png"));
-        glint_camera::ImageFormat::from_path(&output).map_err(|e| Failure::Input(e.to_string()))?;
-        let output_folder = output.parent().filter(|p| !p.as_os_str().is_empty());
-        glint_camera::check_output_folder(output_folder.unwrap_or(Path::new(".")))
-            .map_err(|e| Failure::Input(format!("-o {}: its folder {e}", output.display())))?;
-        glint_camera::check_output_folder(&dir)
-            .map_err(|e| Failure::Input(format!("--dir {}: {e}", dir.display())))?;
-        let render = parse_render(&args.scene, &dir, &args.render_options)?;
-        let image = crate::render::image_size(&render)?;
-        if args.tiles > image.y {
-            return Err(Failure::Input(format!(
-                "--tiles {}: the image has {} rows, one per tile at most; use at most {} tiles",
-                args.tiles, image.y, image.y
-            )));
-        }
-        let absolute = |path: &Path| std::path::absolute(path).unwrap_or_else(|_| path.to_owned());
-        let glint = std::env::current_exe()
-            .map_err(|e| Failure::Other(format!("cannot find the glint executable: {e}")))?;
-        Ok(Plan {
-            glint,
-            scene: absolute(&args.scene),
-            tiles: args.tiles,
-            output: absolute(&output),
-            dir: absolute(&dir),
-            render_options: args.render_options.clone(),
-        })
-    }
-
-    /// The job: a task per tile (`render-tile.sh`), then `assemble.sh`.
-    fn farm(&self) -> Farm {
-        let folders = [self.dir.clone(), self.tiles_dir(), self.dir.join("logs")];
-        let output_folder = self.output.parent().map(Path::to_owned);
-        Farm {
-            first: None,
-            kind: "render",
-            merge_kind: "assemble",
-            task_script: "render-tile.sh",
-            merge_script: "assemble.sh",
-            scene: self.scene.clone(),
-            dir: self.dir.clone(),
-            tasks: self.tiles,
-            what: format!("{} tiles of {}", self.tiles, self.scene.display()),
-            folders: folders.into_iter().chain(output_folder).collect(),
-            task_text: self.render_tile(),
-            merge_text: self.assemble(),
-        }
-    }
-
-    fn tiles_dir(&self) -> PathBuf {
-        self.dir.join("tiles")
-    }
-
-    /// `render-tile.sh I`: tile I, continued where a stopped run left it, on
-    /// as many threads as Slurm gave the task CPUs, else one (GNU parallel
-    /// runs one job per core).
-    fn render_tile(&self) -> String {
-        let options: Vec<String> = self.render_options.iter().map(|o| quote_str(o)).collect();
-        format!(
-            r#"#!/bin/bash
-# Renders tile I of {tiles} of {scene} (written by glint farm).
-# Usage: render-tile.sh I
-set -euo pipefail
-tile="$1"
-out={tiles_dir}/tile-"$tile".exr
-resume=()
-# A run stopped earlier (SIGTERM at a time limit, a requeue) left the tile's
-# finished pixels here: continue it. The result is the same bytes.
-if [ -e {tiles_dir}/tile-"$tile".partial.exr ]; then resume=(--resume); fi
-threads="${{SLURM_CPUS_PER_TASK:-1}}"
-exec {glint} render {scene} --tile "$tile/{tiles}" -o "$out" --threads "$threads" "${{resume[@]}}"{options}
-"#,
-            tiles = self.tiles,
-            scene = quote(&self.scene),
-            tiles_dir = quote(&self.tiles_dir()),
-            glint = quote(&self.glint),
-            options = options.iter().map(|o| format!(" {o}")).collect::<String>(),
-        )
-    }
-
-    /// `assemble.sh`: the tiles there are, put together; `glint assemble`
-    /// names any missing.
-    fn assemble(&self) -> String {
-        format!(
-            r#"#!/bin/bash
-# Puts the {tiles} tiles of {scene} together (written by glint farm).
-set -euo pipefail
-files=()
-for tile in $(seq 0 {last}); do
-  f={tiles_dir}/tile-"$tile".exr
-  if [ -e "$f" ]; then files+=("$f"); fi
-done
-if [ ${{#files[@]}} -eq 0 ]; then echo "no tiles in "{tiles_dir} >&2; exit 2; fi
-exec {glint} assemble "${{files[@]}}" -o {output}
-"#,
-            tiles = self.tiles,
-            last = self.tiles - 1,
-            scene = quote(&self.scene),
-            tiles_dir = quote(&self.tiles_dir()),
-            glint = quote(&self.glint),
-            output = quote(&self.output),
-        )
-    }
 }
 
 impl Farm {
@@ -547,119 +363,6 @@ set -uo pipefail
     }
 }
 
-/// `path`'s file name without its extension, or `fallback`.
-pub(crate) fn file_stem(path: &Path, fallback: &str) -> String {
-    path.file_stem()
-        .map_or(fallback.into(), |s| s.to_string_lossy().into_owned())
-}
-
-/// A path flag's value, or its default (a name in the current directory).
-pub(crate) fn or_default(given: &Option<PathBuf>, default: String) -> PathBuf {
-    given.clone().unwrap_or_else(|| PathBuf::from(default))
-}
-
-/// The tiles' `glint render` command line as `glint render` parses it: the
-/// options' errors are caught here, before any job exists.
-fn parse_render(scene: &Path, dir: &Path, options: &[String]) -> Result<RenderArgs, Failure> {
-    let tile = dir.join("tiles").join("tile-0.exr");
-    let fixed = [
-        scene.as_os_str().to_owned(),
-        "-o".into(),
-        tile.into_os_string(),
-        "--tile".into(),
-        "0/1".into(),
-    ];
-    match parse_command("render", &fixed, options)? {
-        Command::Render(args) => Ok(args),
-        _ => unreachable!("parsed as glint render"),
-    }
-}
-
-/// `glint COMMAND FIXED... OPTIONS...` as glint parses it; a usage error
-/// is bad input in the options after `--`.
-/// For `glint farm ENGINE JOB … --flag value …` where `--flag` is not the
-/// farm's but the job's command's own (`glint render --resolution`), what to
-/// say: that the job's options go after `--`, with the command corrected.
-pub(crate) fn misplaced_option(args: &[String], flag: &str) -> Option<String> {
-    let farm = args.iter().position(|a| a == "farm")?;
-    let (job_at, job) = args
-        .iter()
-        .enumerate()
-        .skip(farm + 2)
-        .find(|(_, a)| ["render", "bench", "grade"].contains(&a.as_str()))?;
-    let name = flag.split('=').next().unwrap_or(flag);
-    let command = <crate::Cli as clap::CommandFactory>::command();
-    let takes_value = command
-        .find_subcommand(job)?
-        .get_arguments()
-        .find(|a| a.get_long().is_some_and(|l| format!("--{l}") == name))?
-        .get_action()
-        .takes_values();
-    let joined = format!("{name}=");
-    let at = args
-        .iter()
-        .skip(job_at)
-        .position(|a| a == name || a.starts_with(&joined))?
-        + job_at;
-    let end = args.iter().position(|a| a == "--").unwrap_or(args.len());
-    if at > end {
-        return None;
-    }
-    let with_value = takes_value && args[at] == name && at + 1 < end;
-    let moved: Vec<&String> = args[at..=at + with_value as usize].iter().collect();
-    let mut fixed: Vec<&String> = args[..end]
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| !(at..=at + with_value as usize).contains(i))
-        .map(|(_, a)| a)
-        .collect();
-    let dashes = "--".to_string();
-    fixed.push(&dashes);
-    fixed.extend(moved);
-    fixed.extend(args.iter().skip(end + 1));
-    let shown: Vec<String> = fixed.iter().map(|a| quote_str(a)).collect();
-    Some(format!(
-        "{name} is an option of glint {job}, not of glint farm: the options of every task's glint {job} go after --; try: glint {}",
-        shown.join(" ")
-    ))
-}
-
-pub(crate) fn parse_command(
-    command: &str,
-    fixed: &[std::ffi::OsString],
-    options: &[String],
-) -> Result<Command, Failure> {
-    let mut words: Vec<std::ffi::OsString> = vec!["glint".into(), command.into()];
-    words.extend(fixed.iter().cloned());
-    words.extend(options.iter().map(Into::into));
-    let parsed = Cli::try_parse_from(words).map_err(|e| {
-        let rendered = e.render().to_string();
-        let first = rendered.lines().next().unwrap_or("invalid options");
-        Failure::Input(format!(
-            "{command} options after --: {}",
-            first.strip_prefix("error: ").unwrap_or(first)
-        ))
-    })?;
-    Ok(parsed.command)
-}
-
-/// Refuses an option among `options` that the farm sets for each task
-/// (`managed`).
-pub(crate) fn check_managed(
-    command: &str,
-    options: &[String],
-    managed: &[&str],
-) -> Result<(), Failure> {
-    let name = |o: &String| o.split('=').next().unwrap_or(o).to_owned();
-    match options.iter().find(|o| managed.contains(&name(o).as_str())) {
-        Some(option) => Err(Failure::Input(format!(
-            "{command} options after --: {option} is set by glint farm for each task (managed: {})",
-            managed.join(", ")
-        ))),
-        None => Ok(()),
-    }
-}
-
 fn write_script(path: &Path, text: &str) -> Result<(), Failure> {
     crate::output::write_text(path, text)?;
     #[cfg(unix)]
@@ -737,23 +440,6 @@ fn run_parallel(script: &Path) -> Result<(), Failure> {
     }
 }
 
-/// `path` quoted for bash.
-pub(crate) fn quote(path: &Path) -> String {
-    quote_str(&path.to_string_lossy())
-}
-
-/// `text` as one bash word: as is where it is plainly safe, else in single quotes.
-pub(crate) fn quote_str(text: &str) -> String {
-    let plain = !text.is_empty()
-        && text
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || "/._-+=:,%@".contains(c));
-    match plain {
-        true => text.to_owned(),
-        false => format!("'{}'", text.replace('\'', r"'\''")),
-    }
-}
-
 /// A Slurm time limit: minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS.
 fn parse_slurm_time(text: &str) -> Result<String, String> {
     let (days, rest) = match text.split_once('-') {
@@ -815,15 +501,6 @@ fn parse_jobs(text: &str) -> Result<String, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn words_are_quoted_for_bash_only_where_needed() {
-        assert_eq!(quote_str("/a/b-c_d.toml"), "/a/b-c_d.toml");
-        assert_eq!(quote_str("a b"), "'a b'");
-        assert_eq!(quote_str("it's"), r"'it'\''s'");
-        assert_eq!(quote_str("$HOME"), "'$HOME'");
-        assert_eq!(quote_str(""), "''");
-    }
 
     #[test]
     fn slurm_values_are_checked() {

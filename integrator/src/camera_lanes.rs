@@ -42,13 +42,15 @@
 
 mod events;
 
-use crate::direct::{mirror_ray, PairAllocation, SampleContext, ShadingPoint, CULL_REACH};
+use crate::context::{LaneOccluders, SampleContext};
+use crate::direct::{mirror_ray, PairAllocation, CULL_REACH};
 use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::physical::{power_heuristic, DiffusePoints};
 use crate::sampling::{
     DimensionPair, LaneSamples, Pcg32Lanes, PointLanes, RunLanes, SamplePattern, SamplePoints,
     SobolSequence,
 };
+use crate::shading_point::ShadingPoint;
 use crate::texture_lookup::texture_footprint;
 use crate::trace::{Event, Tracer};
 use crate::{DirectIntegrator, Scene, ShadingCounters, SurfaceKind};
@@ -843,18 +845,6 @@ impl LanePoints<'_> {
             Self::Filled(points, _) => ctx.lane_points = points,
         }
     }
-}
-
-/// The last culling of shadow-ray occluders in the lanes: the shapes that
-/// may block rays to light `light` from any point of `object` within `reach`
-/// of `center`, kept for the chunks of the pixels around.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct LaneOccluders {
-    light: usize,
-    object: u32,
-    center: Vec3,
-    reach: f32,
-    occluders: Occluders,
 }
 
 /// The Sobol sequences of a chunk's runs of camera samples for one pair:

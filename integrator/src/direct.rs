@@ -1,18 +1,9 @@
-use crate::camera_lanes::LaneOccluders;
-use crate::counters::{ShadingCounters, TextureCounters};
-use crate::sampling::Pcg32;
-use crate::sampling::{
-    DimensionPair, PixelSample, PointLanes, SamplePattern, SamplePoints, SequenceCache, MAX_JOINT,
-};
+use crate::sampling::{DimensionPair, SamplePattern, MAX_JOINT};
 use crate::settings::RenderSettings;
-use crate::trace::{Event, Shadow, Tracer};
+use crate::trace::Shadow;
 use crate::Scene;
-use glam::{Vec2, Vec3};
 use glint_geometry::{reflect_differential, spawn_ray, Hit, Ray, RayDifferential};
-use glint_lighting::{
-    AreaSampling, EnvironmentLight, EnvironmentSampling, Light, PhongMaterial, ShadingModel,
-};
-use glint_texture::TexCoord;
+use glint_lighting::{AreaSampling, EnvironmentLight, EnvironmentSampling, Light, ShadingModel};
 
 /// How far from the point it was found for a culling serves, as a fraction of
 /// the point's distance to the light: a pixel's samples on one surface then
@@ -43,85 +34,6 @@ pub struct DirectIntegrator {
     pub area_sampling: AreaSampling,
     /// Physical shading: multiple importance sampling of glossy lobes.
     pub mis: bool,
-}
-
-/// Reusable per-thread state: the current camera sample and its random stream,
-/// buffers for sample positions, ray counters, and the [`Tracer`] that sees
-/// each step (`()`, which sees nothing at no cost, for renders).
-pub struct SampleContext<T: Tracer = ()> {
-    /// The camera sample being traced; names its points of the Sobol sequences.
-    pub sample: PixelSample,
-    /// Its PCG stream (for the patterns other than Sobol).
-    pub rng: Pcg32,
-    pub light_points: SamplePoints,
-    pub environment_points: SamplePoints,
-    /// What the integrator did so far.
-    pub counters: ShadingCounters,
-    /// Texture lookups by kind and level, counted when `detailed` is set.
-    pub textures: TextureCounters,
-    /// Whether to gather [`Self::textures`] (`--stats`).
-    pub detailed: bool,
-    /// Sees every step of the integrator ([`crate::trace`]).
-    pub tracer: T,
-    /// The last culling in the camera-sample lanes, for the next chunks near it.
-    pub(crate) lane_occluders: Option<LaneOccluders>,
-    /// The Sobol sequences of the pixel's pairs, hashed once for its samples.
-    pub(crate) sequences: SequenceCache,
-    /// Each lane's points, drawn up front, in the camera-sample lanes.
-    pub(crate) lane_points: Vec<Vec2>,
-    /// The camera-sample lanes' Sobol points, hashed up front.
-    pub(crate) sobol_lanes: Vec<PointLanes>,
-}
-
-impl SampleContext {
-    pub fn new(light_samples: u32, environment_samples: u32) -> Self {
-        Self::with_tracer(light_samples, environment_samples, ())
-    }
-}
-
-impl<T: Tracer> SampleContext<T> {
-    /// [`SampleContext::new`] with `tracer` seeing every step.
-    pub fn with_tracer(light_samples: u32, environment_samples: u32, tracer: T) -> Self {
-        Self {
-            sample: PixelSample::default(),
-            rng: PixelSample::default().rng(),
-            light_points: SamplePoints::new(light_samples as usize),
-            environment_points: SamplePoints::new(environment_samples as usize),
-            counters: ShadingCounters::default(),
-            textures: TextureCounters::default(),
-            detailed: false,
-            tracer,
-            lane_occluders: None,
-            sequences: SequenceCache::default(),
-            lane_points: Vec::new(),
-            sobol_lanes: Vec::new(),
-        }
-    }
-
-    /// Starts camera sample `sample` of pixel `pixel` (index `y · width + x`):
-    /// sets [`Self::sample`] and its stream [`Self::rng`].
-    pub fn begin_sample(&mut self, seed: u64, pixel: u64, sample: u64) {
-        self.sample = PixelSample {
-            seed,
-            pixel,
-            sample,
-        };
-        self.rng = self.sample.rng();
-    }
-
-    /// Fills `out` with this camera sample's points of `pair` in `pattern`, as
-    /// [`SamplePattern::fill`] does with [`PixelSample::sobol_points`]`(pair,
-    /// out.len())`.
-    #[inline]
-    pub(crate) fn fill_points(
-        &mut self,
-        pattern: SamplePattern,
-        pair: DimensionPair,
-        out: &mut SamplePoints,
-    ) {
-        let sobol = self.sample.sobol_points(pair, out.len() as u32);
-        pattern.fill_lanes(&mut self.rng, sobol, &mut self.sequences, out);
-    }
 }
 
 impl DirectIntegrator {
@@ -180,102 +92,6 @@ impl DirectIntegrator {
         }
         let own = DimensionPair::Environment { depth };
         pairs.take(own, self.environment_samples)
-    }
-}
-
-/// A surface point being shaded: the hit, its material and reflectances, the
-/// unit shading normal `n` (on the viewer's side), the geometric normal `ng` on the
-/// same side, and the direction `v` towards the viewer.
-pub(crate) struct ShadingPoint<'a> {
-    pub(crate) hit: &'a Hit,
-    pub(crate) material: &'a PhongMaterial,
-    pub(crate) kd: Vec3,
-    pub(crate) ks: Vec3,
-    pub(crate) n: Vec3,
-    pub(crate) ng: Vec3,
-    pub(crate) v: Vec3,
-    /// Whether `ks` is nonzero: without it the specular lobe is never evaluated.
-    pub(crate) has_specular: bool,
-}
-
-impl<'a> ShadingPoint<'a> {
-    /// The point `hit` of `material`, seen along `ray`, with its texture lookup `tc`.
-    pub(crate) fn new(hit: &'a Hit, material: &'a PhongMaterial, ray: &Ray, tc: &TexCoord) -> Self {
-        Self::with_reflectances(hit, material, ray, material.reflectances(tc))
-    }
-
-    /// [`Self::new`] with the reflectances `(kd, ks)` already looked up.
-    pub(crate) fn with_reflectances(
-        hit: &'a Hit,
-        material: &'a PhongMaterial,
-        ray: &Ray,
-        (kd, ks): (Vec3, Vec3),
-    ) -> Self {
-        let n = hit.facing_normal(ray.direction);
-        let ng = if hit.geometric_normal.dot(n) < 0.0 {
-            -hit.geometric_normal
-        } else {
-            hit.geometric_normal
-        };
-        Self {
-            hit,
-            material,
-            kd,
-            ks,
-            n,
-            ng,
-            v: -ray.direction.normalize(),
-            has_specular: ks != Vec3::ZERO,
-        }
-    }
-
-    /// Whether light from direction `l` can reach the surface at all: it must be
-    /// above the *geometric* surface. With interpolated shading normals a light can
-    /// be above the shading normal's horizon but below the triangle's; its shadow
-    /// ray would leave into the surface and be blocked by the neighbouring
-    /// triangles, leaving dark specks (the "shadow terminator" problem).
-    #[inline]
-    pub(crate) fn above_surface(&self, l: Vec3) -> bool {
-        self.ng.dot(l) > 0.0
-    }
-
-    /// [`Self::brdf_cos`], uncounted.
-    #[inline]
-    pub(crate) fn f_cos(&self, l: Vec3) -> Vec3 {
-        if self.has_specular {
-            self.material.brdf_cos(self.kd, self.ks, self.n, l, self.v)
-        } else {
-            self.material.brdf_cos_diffuse(self.kd, self.n, l)
-        }
-    }
-}
-
-impl ShadingPoint<'_> {
-    /// A light sample of the course's model at `position` (on the light), the
-    /// direction to it `l`, as a tracer shows it: its shadow ray's verdict,
-    /// what it adds (`value`), and the diffuse and specular parts recomputed
-    /// apart (their sum is the reflection the integrator used, to rounding).
-    pub(crate) fn light_sample_event(
-        &self,
-        (position, l): (Vec3, Vec3),
-        shadow: Shadow,
-        value: Vec3,
-    ) -> Event {
-        let n_dot_l = self.n.dot(l);
-        let specular = match self.has_specular {
-            true => (self.material).reflect(Vec3::ZERO, self.ks, self.n, l, self.v),
-            false => Vec3::ZERO,
-        };
-        Event::LightSample {
-            position,
-            l,
-            n_dot_l,
-            reflection: 2.0 * n_dot_l * self.n - l,
-            diffuse: self.material.reflect_diffuse(self.kd, self.n, l),
-            specular,
-            shadow,
-            value,
-        }
     }
 }
 

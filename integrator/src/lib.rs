@@ -35,6 +35,7 @@
 
 mod aov;
 mod camera_lanes;
+mod context;
 pub mod counters;
 mod direct;
 mod explain;
@@ -47,12 +48,14 @@ mod report_level;
 pub mod sampling;
 mod scene;
 mod settings;
+mod shading_point;
 mod texture_lookup;
 pub mod trace;
 
 pub use aov::Aov;
+pub use context::SampleContext;
 pub use counters::{LookupKind, ShadingCounters, Skips, TextureCounters};
-pub use direct::{DirectIntegrator, SampleContext};
+pub use direct::DirectIntegrator;
 pub use explain::{explain_pixel, ExplainError, PixelExplanation};
 pub use glint_lighting::{AreaSampling, EnvironmentSampling, ShadingModel};
 pub use render::{

@@ -24,7 +24,7 @@
 //! the sharp highlight of a large light, where light samples alone are noisy.
 //! On a purely diffuse material only the light is sampled (weight 1).
 
-use crate::direct::ShadingPoint;
+use crate::shading_point::ShadingPoint;
 use crate::trace::{Shadow, Skip};
 use crate::ShadingCounters;
 use glam::Vec3;

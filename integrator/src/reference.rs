@@ -5,7 +5,9 @@
 //! written the plain way, sample after sample, each light and environment
 //! sample through its own shadow ray, the course's report read line by line.
 
-use crate::direct::{mirror_ray, PairAllocation, SampleContext, ShadingPoint};
+use crate::context::SampleContext;
+use crate::direct::{mirror_ray, PairAllocation};
+use crate::shading_point::ShadingPoint;
 use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::physical::{power_heuristic, DiffusePoints};
 use crate::sampling::{DimensionPair, PointChunk, SamplePoints};

@@ -1,5 +1,5 @@
+use crate::context::SampleContext;
 use crate::counters::{ShadingCounters, TextureCounters};
-use crate::direct::SampleContext;
 use crate::sampling::{pixel_rng, LaneSamples, PixelSample, SobolPoints, PIXEL_STREAM};
 use crate::settings::{Crop, RenderSettings, SettingsError};
 use crate::trace::{Event, Tracer};

@@ -9,8 +9,9 @@
 //! it.
 
 use super::{ShadedLanes, Wave};
-use crate::direct::{blocker, ShadingPoint};
+use crate::direct::blocker;
 use crate::physical::power_heuristic;
+use crate::shading_point::ShadingPoint;
 use crate::texture_lookup::texture_footprint;
 use crate::trace::{Event, Shadow, Skip, Technique, TracedSurface, Tracer};
 use crate::{SampleContext, Scene, SurfaceKind};

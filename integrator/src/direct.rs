@@ -1,16 +1,81 @@
-use crate::sampling::{DimensionPair, SamplePattern, MAX_JOINT};
-use crate::settings::RenderSettings;
-use crate::trace::Shadow;
-use crate::Scene;
-use glint_geometry::{reflect_differential, spawn_ray, Hit, Ray, RayDifferential};
-use glint_lighting::{AreaSampling, EnvironmentLight, EnvironmentSampling, Light, ShadingModel};
+//! The direct-lighting integrator: the radiance of camera samples, shaded
+//! [`LANES`] at once.
+//!
+//! The route from a camera sample to its radiance, one file a step:
+//! [`DirectIntegrator::li`] (one ray) or the render's chunks give the first
+//! hits to `li_first_hits`, whose wave (`wave.rs`) sends misses to the
+//! environment, emitters to their radiance and surfaces to
+//! `local_shading_lanes`; `with_direct_lighting` (`shade.rs`) adds ambient,
+//! each light's samples and the environment's, drawn where each lane's
+//! camera sample alone draws them (`points.rs`), through the surface points
+//! set up once for all of them and their shadow test (`shaded_lanes.rs`,
+//! their reflectances from `surfaces.rs`); lanes on mirrors reflect into the
+//! next wave. `events.rs` shows each step to a tracer (`glint explain`);
+//! `tests.rs` holds each lane to the integrator one ray at a time.
+//!
+//! The lanes are the camera samples: the [`LANES`] samples of a pixel (or,
+//! for pixels of fewer samples, the runs of samples of consecutive pixels a
+//! [`LaneSamples`] names) that
+//! [`glint_geometry::ShapeList::closest_primitives_lanes`] found the hits of
+//! together are shaded together too. Their surface points, reflectances and
+//! shadow-ray origins are set up once; then, for each of a light's N samples in
+//! turn, every lane's light point, direction, Phong reflection ([`PhongLanes`],
+//! each lane with its own material) and horizon test run in SIMD lanes, the
+//! shadow rays from as many origins are traced as one batch, and each lane adds
+//! its own sample to its own sum. With one sample per light (`--light-samples
+//! 1`, the way Mitsuba's `direct` integrator is usually run) a shading point has
+//! no light samples for [`crate::light_samples`]' lanes to batch; with more,
+//! this is the wavefront form of the same sums.
+//!
+//! Every scene whose closest hits are found in lanes is shaded so, in
+//! either shading model, whatever its light and environment patterns:
+//! each lane takes its points as its camera sample alone takes them
+//! (`LanePoints`), the lanes whose points come from their own streams
+//! drawing only where `li_at` draws. Lanes on mirrors reflect their rays as
+//! the next wave of lanes, one reflection deeper
+//! ([`DirectIntegrator::li_wave`]), with their differentials where the scene
+//! reads footprints; lanes not in a wave are masked, not traced apart.
+//! Physical shading draws
+//! each lane's light samples with its own point's sampler (by area or solid
+//! angle) and takes them through the diffuse kernel a point's light samples
+//! share ([`crate::physical::DiffusePoints`]), or on glossy points through
+//! the BRDF with its lobe in lanes ([`PhongLanes::brdf_cos`]), weighted by
+//! multiple importance against as many directions drawn from each lane's
+//! lobe, whose rays are traced together ([`DirectIntegrator::lobe_sum`]); its
+//! environment samples are drawn together across the lanes
+//! ([`glint_lighting::EnvironmentLight::sample_each`]), and the lanes that
+//! miss read the map. Textures
+//! filtered over a footprint are looked up lane by lane, from each lane's ray
+//! differentials. Every lane
+//! repeats the scalar path's operations in its order, and its random numbers
+//! come from its own camera sample's stream or its own points of its pixel's
+//! Sobol sequence, so each sample's radiance and the shading counts are those
+//! of `li_at`, the integrator one ray at a time that the tests hold the
+//! lanes to (`reference.rs`, in test builds), bit for bit.
 
-/// How far from the point it was found for a culling serves, as a fraction of
-/// the point's distance to the light: a pixel's samples on one surface then
-/// share one (a pixel spans about a thousandth of its distance from the camera
-/// at 512², so a hundredth covers it with room), at the price of faces
-/// widened by that much.
-pub(crate) const CULL_REACH: f32 = 0.01;
+mod events;
+mod points;
+mod shade;
+mod shaded_lanes;
+mod surfaces;
+#[cfg(test)]
+mod tests;
+pub(crate) mod wave;
+
+pub(crate) use points::PairAllocation;
+
+use crate::context::SampleContext;
+use crate::sampling::LaneSamples;
+use crate::trace::Tracer;
+use glam::Vec3;
+use glint_geometry::lanes::LANES;
+use glint_geometry::RayLanes;
+
+use crate::sampling::{DimensionPair, SamplePattern};
+use crate::settings::RenderSettings;
+use crate::Scene;
+use glint_geometry::{Ray, RayDifferential};
+use glint_lighting::{AreaSampling, EnvironmentLight, EnvironmentSampling, Light, ShadingModel};
 
 /// The direct-lighting integrator of the course report (section 2.5), with the
 /// environment and mirror reflections of section 2.7.
@@ -37,6 +102,25 @@ pub struct DirectIntegrator {
 }
 
 impl DirectIntegrator {
+    /// given by the ray differentials `diff` (read where the scene filters
+    /// textures over footprints), for the camera sample `ctx` was started on
+    /// ([`SampleContext::begin_sample`]): the render's own route, in one lane.
+    pub fn li<T: Tracer>(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        diff: &RayDifferential,
+        ctx: &mut SampleContext<T>,
+    ) -> Vec3 {
+        let rays = RayLanes::new([*ray; LANES]);
+        let diffs = [*diff; LANES];
+        let closest = scene.shapes.closest_lanes(&rays, 1);
+        let samples = LaneSamples::of_pixel(ctx.sample);
+        let footprints = scene.needs_differentials().then_some(&diffs);
+        self.li_first_hits(scene, &rays, footprints, &closest, 1, &samples, ctx)
+            .lane(0)
+    }
+
     /// The integrator `settings` describe (their sample counts, patterns and
     /// depth; the rest is the render loop's).
     pub fn new(settings: &RenderSettings) -> Self {
@@ -92,93 +176,5 @@ impl DirectIntegrator {
         }
         let own = DimensionPair::Environment { depth };
         pairs.take(own, self.environment_samples)
-    }
-}
-
-/// Which Sobol dimension pair each of a shading point's 2D samples reads. At the
-/// camera ray's hit, the first light-like sample (area lights in scene order,
-/// then the environment) that takes one sample per camera sample reads the
-/// pixel's own sequence, dimensions 2 and 3 ([`DimensionPair::Joint`]):
-/// stratified together with the pixel position,
-/// which lowers the error of a pixel's soft shadows (measured on the Cornell
-/// box's floor: about half the relative MSE at 256 samples, and a steeper
-/// convergence slope, than independent pairs). Every other sample keeps its own
-/// sequence.
-pub(crate) struct PairAllocation {
-    depth: u32,
-    next_joint: u32,
-}
-
-impl PairAllocation {
-    pub(crate) fn new(depth: u32) -> Self {
-        Self {
-            depth,
-            next_joint: 1,
-        }
-    }
-
-    /// The pair for a sample that would otherwise read `own`, taking
-    /// `per_sample` points per camera sample.
-    #[inline]
-    pub(crate) fn take(&mut self, own: DimensionPair, per_sample: u32) -> DimensionPair {
-        if self.depth == 0 && per_sample == 1 && self.next_joint <= MAX_JOINT {
-            self.next_joint += 1;
-            DimensionPair::Joint {
-                k: self.next_joint - 1,
-            }
-        } else {
-            own
-        }
-    }
-}
-
-/// The ray `ray` reflects into at `hit` by a perfect mirror, and its
-/// differentials ([`reflect_differential`]), leaving from an origin offset
-/// to its side ([`spawn_ray`]).
-pub(crate) fn mirror_ray(hit: &Hit, ray: &Ray, diff: &RayDifferential) -> (Ray, RayDifferential) {
-    let surface = hit.differentials(diff);
-    let (wi, reflected_diff) = reflect_differential(hit, ray.direction, diff, &surface);
-    (spawn_ray(hit, wi), reflected_diff)
-}
-
-/// The nearest object blocking `shadow` before `t_max`, as a tracer reports
-/// it (the integrator itself only asks whether anything does). A closest-hit
-/// query: call it in a tracer's hook only.
-pub(crate) fn blocker(scene: &Scene, shadow: &Ray, t_max: f32) -> Shadow {
-    match scene.shapes.closest_hit(shadow, t_max) {
-        Some(hit) => Shadow::Blocked {
-            object: hit.shape,
-            t: hit.t,
-        },
-        // Counted as blocked by a test the closest-hit query rounds differently.
-        None => Shadow::Blocked {
-            object: u32::MAX,
-            t: f32::NAN,
-        },
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_first_single_sample_at_the_camera_hit_reads_the_joint_pair() {
-        let light = |light| DimensionPair::Light { light, depth: 0 };
-        let environment = DimensionPair::Environment { depth: 0 };
-        // One sample each at the camera ray's hit: the first light-like one is joint.
-        let mut pairs = PairAllocation::new(0);
-        assert_eq!(pairs.take(light(1), 1), DimensionPair::Joint { k: 1 });
-        assert_eq!(pairs.take(light(2), 1), light(2));
-        assert_eq!(pairs.take(environment, 1), environment);
-        // Without area lights, the environment takes it.
-        assert_eq!(
-            PairAllocation::new(0).take(environment, 1),
-            DimensionPair::Joint { k: 1 }
-        );
-        // Several samples per camera sample, or a reflection's hit: their own.
-        assert_eq!(PairAllocation::new(0).take(light(0), 4), light(0));
-        let deeper = DimensionPair::Light { light: 0, depth: 1 };
-        assert_eq!(PairAllocation::new(1).take(deeper, 1), deeper);
     }
 }

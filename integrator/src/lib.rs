@@ -34,7 +34,6 @@
 //!   `log2(L/W)`, with its `L` and `W`.
 
 mod aov;
-mod camera_lanes;
 mod context;
 pub mod counters;
 mod direct;

@@ -1,16 +1,17 @@
 //! The integrator one ray at a time: the reference the camera-sample lanes
-//! ([`crate::camera_lanes`]) are tested against, bit for bit, radiance and
+//! ([`crate::direct`]) are tested against, bit for bit, radiance and
 //! counts, in test builds only. A render, `glint explain` and
 //! [`DirectIntegrator::li`] all take the lanes; this is the same integrator
 //! written the plain way, sample after sample, each light and environment
 //! sample through its own shadow ray, the course's report read line by line.
 
 use crate::context::SampleContext;
-use crate::direct::{mirror_ray, PairAllocation};
-use crate::shading_point::ShadingPoint;
+use crate::direct::wave::mirror_ray;
+use crate::direct::PairAllocation;
 use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::physical::{power_heuristic, DiffusePoints};
 use crate::sampling::{DimensionPair, PointChunk, SamplePoints};
+use crate::shading_point::ShadingPoint;
 use crate::texture_lookup::texture_footprint;
 use crate::trace::Tracer;
 use crate::{DirectIntegrator, Scene, ShadingCounters, Skips, SurfaceKind};

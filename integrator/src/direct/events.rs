@@ -8,8 +8,8 @@
 //! ray. Every hook is called under `if T::ON`, so a render compiles none of
 //! it.
 
-use super::{ShadedLanes, Wave};
-use crate::direct::blocker;
+use super::shaded_lanes::ShadedLanes;
+use super::wave::Wave;
 use crate::physical::power_heuristic;
 use crate::shading_point::ShadingPoint;
 use crate::texture_lookup::texture_footprint;
@@ -400,5 +400,22 @@ impl ShadedLanes<'_> {
                 value,
             }
         });
+    }
+}
+
+/// The nearest object blocking `shadow` before `t_max`, as a tracer reports
+/// it (the integrator itself only asks whether anything does). A closest-hit
+/// query: call it in a tracer's hook only.
+pub(crate) fn blocker(scene: &Scene, shadow: &Ray, t_max: f32) -> Shadow {
+    match scene.shapes.closest_hit(shadow, t_max) {
+        Some(hit) => Shadow::Blocked {
+            object: hit.shape,
+            t: hit.t,
+        },
+        // Counted as blocked by a test the closest-hit query rounds differently.
+        None => Shadow::Blocked {
+            object: u32::MAX,
+            t: f32::NAN,
+        },
     }
 }

@@ -2,8 +2,8 @@
 //! .exr files that say where they belong and which render they are of,
 //! `glint assemble` puts them together into the single render's bytes, and
 //! `glint farm` writes the scripts that run the tiles on Slurm or GNU
-//! parallel (run here by hand, by GNU parallel where installed; the Slurm
-//! run is `tools/cluster/test-slurm.sh`, docs/testing.md).
+//! parallel (run here by hand and by GNU parallel; the Slurm run is
+//! `cli/tests/farm_slurm.rs`, docs/testing.md).
 
 mod common;
 

@@ -430,7 +430,7 @@ fn bench_shadows(
                 );
                 for (_, rays) in pair {
                     blocked += list
-                        .any_hits_among(&occluders, black_box(rays), t_max, 0xff)
+                        .any_hits_among(&occluders, black_box(rays), t_max, (1 << LANES) - 1)
                         .count_ones();
                 }
             }

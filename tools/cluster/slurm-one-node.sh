@@ -1,6 +1,6 @@
 #!/bin/bash
 # Starts a one-node Slurm cluster on this machine, for trying `glint farm
-# slurm` and for tools/cluster/test-slurm.sh: munge for authentication, a
+# slurm` and for cli/tests/farm_slurm.rs (which runs it itself): munge for authentication, a
 # slurm.conf with this machine as the only node (all its CPUs, processes
 # tracked without cgroups), then slurmctld and slurmd as plain daemons. It
 # needs root, and no systemd (it works in a container).

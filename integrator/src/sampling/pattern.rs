@@ -19,7 +19,7 @@ pub enum SamplePattern {
     /// pixel and [`DimensionPair`](super::DimensionPair); any N, best at powers of
     /// two. The default: `glint bench` measures it ahead of the others (about 4×
     /// sooner than `random` to the same error on the Cornell box's soft shadows,
-    /// 1.75× on the environment scene; see `docs/run-time-against-error.md`).
+    /// 1.92× on the environment scene; see `docs/run-time-against-error.md`).
     #[default]
     Sobol,
 }

@@ -1,5 +1,5 @@
 //! `Film::read` on files other programs wrote (`tests/data/formats`, made by
-//! `tools/corpus/formats.py` from one 40 × 24 render, `render.pfm`): Pillow,
+//! `measure/corpus/formats.py` from one 40 × 24 render, `render.pfm`): Pillow,
 //! OpenCV, OpenEXR's bindings, stb_image_write and hand-made files, in every
 //! format a student's ray tracer writes. Each is read as what it is, whatever
 //! its name, with the values its writer stored and what it did to them.

@@ -1,4 +1,4 @@
-//! Physical shading against Mitsuba 3, through `tools/mitsuba/agreement.py`:
+//! Physical shading against Mitsuba 3, through `measure/mitsuba/agreement.py`:
 //! the physical Cornell box, the analytic area light, and a diffuse and a
 //! mirror sphere under an HDR map (small, as Mitsuba follows the mirrors in
 //! Python; measured larger by hand, in docs/physical-shading.md), each
@@ -18,7 +18,7 @@ use std::process::Command;
 
 fn agreement(python: &Path, scene: &str, extra: &[&str]) {
     let out = Command::new(python)
-        .arg(repo().join("tools/mitsuba/agreement.py"))
+        .arg(repo().join("measure/mitsuba/agreement.py"))
         .arg(repo().join("scenes").join(scene))
         .args(["--glint", env!("CARGO_BIN_EXE_glint")])
         .args(extra)
@@ -36,7 +36,7 @@ fn agreement(python: &Path, scene: &str, extra: &[&str]) {
 #[test]
 fn physical_scenes_agree_with_mitsuba() {
     let Some(python) = python_with_mitsuba() else {
-        eprintln!("skipped: no Python with the mitsuba package (see tools/mitsuba/README.md)");
+        eprintln!("skipped: no Python with the mitsuba package (see measure/mitsuba/README.md)");
         return;
     };
     let small = ["--seeds", "6", "--spp", "32", "--resolution", "48x48"];

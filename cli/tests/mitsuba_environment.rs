@@ -1,8 +1,8 @@
 //! Glint's lat-long environment lighting against Mitsuba 3's, through
-//! `tools/mitsuba/envmap.py`: a diffuse sphere under the shipped map, with the
+//! `measure/mitsuba/envmap.py`: a diffuse sphere under the shipped map, with the
 //! map resampled onto Mitsuba's rows (docs/environment-lighting.md). Runs only
 //! where a Python with the `mitsuba` package is found (`GLINT_MITSUBA_VENV`, or
-//! `target/mitsuba-venv` as `tools/mitsuba/compare.sh` makes it); elsewhere it
+//! `target/mitsuba-venv` as `measure/mitsuba/compare.sh` makes it); elsewhere it
 //! says so and passes.
 
 mod common;
@@ -18,11 +18,11 @@ fn ratios(cell: &str) -> Vec<f64> {
 #[test]
 fn a_diffuse_sphere_under_the_shipped_map_agrees_with_mitsuba() {
     let Some(python) = python_with_mitsuba() else {
-        eprintln!("skipped: no Python with the mitsuba package (see tools/mitsuba/README.md)");
+        eprintln!("skipped: no Python with the mitsuba package (see measure/mitsuba/README.md)");
         return;
     };
     let out = Command::new(python)
-        .arg(repo().join("tools/mitsuba/envmap.py"))
+        .arg(repo().join("measure/mitsuba/envmap.py"))
         .arg(repo().join("scenes/environments/studio-latlong.hdr"))
         .args(["--spp", "16", "--glint", env!("CARGO_BIN_EXE_glint")])
         .output()

@@ -1,5 +1,5 @@
-//! Glint's side of the peer benchmark against Embree (`tools/embree/compare.sh`,
-//! which builds `tools/embree/peer.cpp` and runs both in turn on the same files).
+//! Glint's side of the peer benchmark against Embree (`measure/embree/compare.sh`,
+//! which builds `measure/embree/peer.cpp` and runs both in turn on the same files).
 //!
 //! `cargo bench -p glint-tests --bench peer -- write DIR TRIANGLES...` writes the
 //! inputs: for each size a displaced grid (`grid-N.mesh`) and, for each, three

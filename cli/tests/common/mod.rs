@@ -91,7 +91,7 @@ pub fn repo() -> PathBuf {
 
 /// The Python of a virtual environment where `import mitsuba` works
 /// (`GLINT_MITSUBA_VENV`, or `target/mitsuba-venv` as
-/// `tools/mitsuba/compare.sh` makes it); `None` where there is none.
+/// `measure/mitsuba/compare.sh` makes it); `None` where there is none.
 pub fn python_with_mitsuba() -> Option<PathBuf> {
     let venv = std::env::var_os("GLINT_MITSUBA_VENV")
         .map(PathBuf::from)

@@ -277,51 +277,14 @@ impl TriangleMesh {
         };
         let (uv0, uv1, uv2) = (uv_at(0), uv_at(1), uv_at(2));
         let uv = bary[0] * uv0 + bary[1] * uv1 + bary[2] * uv2;
-        // ∂p/∂u, ∂p/∂v from the uv deltas (pbrt-v4 section 6.5.3); for a
-        // degenerate uv mapping, any frame around the normal.
-        let (duv02, duv12) = (uv0 - uv2, uv1 - uv2);
-        let (dp02, dp12) = (a - c, b - c);
-        let det = duv02.x * duv12.y - duv02.y * duv12.x;
-        let (mut dpdu, mut dpdv) = if det.abs() > 1e-12 {
-            let inv = 1.0 / det;
-            (
-                (duv12.y * dp02 - duv02.y * dp12) * inv,
-                (duv02.x * dp12 - duv12.x * dp02) * inv,
-            )
-        } else {
-            (Vec3::ZERO, Vec3::ZERO)
-        };
+        // ∂p/∂u, ∂p/∂v from the uv deltas; for a degenerate uv mapping, any
+        // frame around the normal.
+        let duv = (uv0 - uv2, uv1 - uv2);
+        let (mut dpdu, mut dpdv) = uv_derivatives(duv, (a - c, b - c));
         if !(dpdu.is_finite() && dpdv.is_finite()) || dpdu.cross(dpdv).length_squared() == 0.0 {
             (dpdu, dpdv) = face.any_orthonormal_pair();
         }
-        let (shading_normal, dndu, dndv) = if self.normals.is_empty() {
-            (face, Vec3::ZERO, Vec3::ZERO)
-        } else {
-            let n = tri.map(|v| self.normals[v as usize]);
-            let interpolated =
-                (bary[0] * n[0] + bary[1] * n[1] + bary[2] * n[2]).normalize_or_zero();
-            if interpolated == Vec3::ZERO {
-                (face, Vec3::ZERO, Vec3::ZERO)
-            } else {
-                let (dn02, dn12) = (n[0] - n[2], n[1] - n[2]);
-                let (dndu, dndv) = if det.abs() > 1e-12 {
-                    let inv = 1.0 / det;
-                    (
-                        (duv12.y * dn02 - duv02.y * dn12) * inv,
-                        (duv02.x * dn12 - duv12.x * dn02) * inv,
-                    )
-                } else {
-                    (Vec3::ZERO, Vec3::ZERO)
-                };
-                // The shading normal on the geometric normal's side.
-                let s = if interpolated.dot(face) < 0.0 {
-                    -interpolated
-                } else {
-                    interpolated
-                };
-                (s, dndu, dndv)
-            }
-        };
+        let (shading_normal, dndu, dndv) = self.shading_normal(tri, bary, face, duv);
         Some(Hit {
             t,
             point,
@@ -337,6 +300,52 @@ impl TriangleMesh {
             shape: 0,
             primitive: 0,
         })
+    }
+
+    /// The shading normal at barycentric point `bary` of the triangle of
+    /// corners `tri`, interpolated and turned to the side of its face normal
+    /// `face`, and its derivatives along u and v (from the uv deltas `duv`);
+    /// `face` where the mesh has no normals or they cancel there.
+    fn shading_normal(
+        &self,
+        tri: [u32; 3],
+        bary: [f32; 3],
+        face: Vec3,
+        duv: (Vec2, Vec2),
+    ) -> (Vec3, Vec3, Vec3) {
+        if self.normals.is_empty() {
+            return (face, Vec3::ZERO, Vec3::ZERO);
+        }
+        let n = tri.map(|v| self.normals[v as usize]);
+        let interpolated = (bary[0] * n[0] + bary[1] * n[1] + bary[2] * n[2]).normalize_or_zero();
+        if interpolated == Vec3::ZERO {
+            return (face, Vec3::ZERO, Vec3::ZERO);
+        }
+        let (dndu, dndv) = uv_derivatives(duv, (n[0] - n[2], n[1] - n[2]));
+        let s = if interpolated.dot(face) < 0.0 {
+            -interpolated
+        } else {
+            interpolated
+        };
+        (s, dndu, dndv)
+    }
+}
+
+/// The derivatives along u and v of a quantity over a triangle whose corner
+/// differences are `d = (q₀ − q₂, q₁ − q₂)` and uv differences `duv = (uv₀ −
+/// uv₂, uv₁ − uv₂)`: the solution of `duv · (∂q/∂u, ∂q/∂v) = d` (pbrt-v4,
+/// section 6.5.3), or zero where the uv mapping is degenerate.
+fn uv_derivatives((duv02, duv12): (Vec2, Vec2), (d02, d12): (Vec3, Vec3)) -> (Vec3, Vec3) {
+    let det = duv02.x * duv12.y - duv02.y * duv12.x;
+    match det.abs() > 1e-12 {
+        true => {
+            let inv = 1.0 / det;
+            (
+                (duv12.y * d02 - duv02.y * d12) * inv,
+                (duv02.x * d12 - duv12.x * d02) * inv,
+            )
+        }
+        false => (Vec3::ZERO, Vec3::ZERO),
     }
 }
 

@@ -2,10 +2,11 @@
 //! and again with a [`PixelTrace`] recording every step of the samples asked
 //! for, and checks that the two agree bit for bit.
 
-use crate::render::PixelRenderer;
-use crate::trace::{PixelTrace, SampleSelection, SampleTrace};
+use crate::render::{accumulate, PixelRenderer};
+use crate::trace::{Event, PixelTrace, SampleSelection, SampleTrace, Tracer};
 use crate::{DirectIntegrator, RenderSettings, SampleContext, Scene, SettingsError};
 use glam::{UVec2, Vec2, Vec3};
+use glint_geometry::lanes;
 
 /// A pixel's radiance and the recorded steps of its selected samples.
 #[derive(Clone, Debug, PartialEq)]
@@ -77,7 +78,7 @@ pub fn explain_pixel(
         settings.environment_samples,
         PixelTrace::new(selection),
     );
-    let traced = renderer.pixel(x, y, &mut pixel_samples, &mut traced_ctx);
+    let traced = traced_pixel(&renderer, (x, y), &mut pixel_samples, &mut traced_ctx);
     if rendered.to_array().map(f32::to_bits) != traced.to_array().map(f32::to_bits) {
         return Err(ExplainError::Diverged { rendered, traced });
     }
@@ -87,4 +88,31 @@ pub fn explain_pixel(
         radiance: rendered,
         samples: traced_ctx.tracer.samples,
     })
+}
+
+/// Pixel `(x, y)` as [`PixelRenderer::pixel`] computes it, its chunks'
+/// camera samples seen by `ctx`'s tracer: the render's own `chunk_values`
+/// (whose stages record their steps), with the chunk's start, its camera
+/// stage and each sample's radiance recorded around it.
+fn traced_pixel<T: Tracer>(
+    renderer: &PixelRenderer,
+    (x, y): (u32, u32),
+    pixel_samples: &mut [Vec2],
+    ctx: &mut SampleContext<T>,
+) -> Vec3 {
+    let spp = pixel_samples.len();
+    let candidates = renderer.candidates(x, 1, y);
+    let mut sum = Vec3::ZERO;
+    for chunk in renderer.pixel_chunks(x, y, pixel_samples) {
+        let lanes = lanes::bits(lanes::first_lanes(chunk.jitters.len()));
+        (ctx.tracer).start_chunk(chunk.jitters.len(), |k| chunk.samples.lane(k).sample);
+        (ctx.tracer).record(lanes, renderer.camera_events(&chunk));
+        let values = renderer.chunk_values(&chunk, candidates, ctx);
+        let radiance = |k| Event::SampleRadiance {
+            value: values.lane(k),
+        };
+        (ctx.tracer).record(lanes, radiance);
+        accumulate(&mut sum, &values, 0..chunk.jitters.len(), &mut ctx.counters);
+    }
+    sum / spp as f32
 }

@@ -13,7 +13,6 @@ use crate::physical::{power_heuristic, DiffusePoints};
 use crate::sampling::{DimensionPair, PointChunk, SamplePoints};
 use crate::shading_point::ShadingPoint;
 use crate::texture_lookup::texture_footprint;
-use crate::trace::Tracer;
 use crate::{DirectIntegrator, Scene, ShadingCounters, Skips, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
@@ -32,13 +31,13 @@ impl DirectIntegrator {
     /// one ray at a time: the scalar reference the lanes are tested against.
     /// Light and environment samples come from the camera sample `ctx` was
     /// started on ([`SampleContext::begin_sample`]).
-    pub(crate) fn li_one_ray<T: Tracer>(
+    pub(crate) fn li_one_ray(
         &self,
         scene: &Scene,
         ray: &Ray,
         diff: &RayDifferential,
         depth: u32,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let hit = scene.shapes.closest_hit(ray, f32::INFINITY);
         self.li_at(scene, ray, diff, hit, depth, ctx)
@@ -46,14 +45,14 @@ impl DirectIntegrator {
 
     /// [`Self::li_one_ray`] for a ray whose closest hit is already found:
     /// `hit`, or `None` for a miss.
-    pub(crate) fn li_at<T: Tracer>(
+    pub(crate) fn li_at(
         &self,
         scene: &Scene,
         ray: &Ray,
         diff: &RayDifferential,
         hit: Option<Hit>,
         depth: u32,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let Some(hit) = hit else {
             return self.environment_seen(scene, ray, diff, ctx);
@@ -90,12 +89,12 @@ impl DirectIntegrator {
     }
 
     /// The environment's radiance along a ray that hits nothing (black without one).
-    fn environment_seen<T: Tracer>(
+    fn environment_seen(
         &self,
         scene: &Scene,
         ray: &Ray,
         diff: &RayDifferential,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let Some(env) = &scene.environment else {
             return Vec3::ZERO;
@@ -116,12 +115,12 @@ impl DirectIntegrator {
 
     /// The light reflected at `hit` by its material (ambient, lights and
     /// environment), its textures read over the ray's footprint.
-    fn local_shading<T: Tracer>(
+    fn local_shading(
         &self,
         scene: &Scene,
         at: &SurfaceHit,
         depth: u32,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         if at.material.uses_footprint() {
             ctx.counters.footprints += 1;
@@ -139,12 +138,12 @@ impl DirectIntegrator {
 
     /// The radiance a mirror at `hit` reflects towards the ray, tinted: the
     /// reflected ray followed one level deeper, with its differentials.
-    fn mirror_reflection<T: Tracer>(
+    fn mirror_reflection(
         &self,
         scene: &Scene,
         at: &SurfaceHit,
         depth: u32,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let (reflected, reflected_diff) = mirror_ray(at.hit, at.ray, at.diff);
         ctx.counters.reflection_rays += 1;
@@ -154,12 +153,12 @@ impl DirectIntegrator {
 
     /// The local shading of `point`, `depth` reflections deep: ambient, the
     /// lights and the environment.
-    fn shade<T: Tracer>(
+    fn shade(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         depth: u32,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         self.shade_with(
             scene,
@@ -188,13 +187,13 @@ impl DirectIntegrator {
     /// What both shading models share: `ambient · kd`, plus what each light
     /// adds (`light_term(index, light, pairs, ctx)`, in scene order, taking
     /// its dimension pair from `pairs` if it samples), plus the environment.
-    pub(crate) fn shade_with<T: Tracer>(
+    pub(crate) fn shade_with(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         depth: u32,
-        ctx: &mut SampleContext<T>,
-        mut light_term: impl FnMut(usize, &Light, &mut PairAllocation, &mut SampleContext<T>) -> Vec3,
+        ctx: &mut SampleContext,
+        mut light_term: impl FnMut(usize, &Light, &mut PairAllocation, &mut SampleContext) -> Vec3,
     ) -> Vec3 {
         let mut radiance = scene.ambient * point.kd;
         let mut pairs = PairAllocation::new(depth);
@@ -208,10 +207,10 @@ impl DirectIntegrator {
     /// Light `pair`'s points for this camera sample, in the buffer taken from
     /// `ctx.light_points` (the caller puts it back).
     #[inline]
-    pub(crate) fn draw_light_points<T: Tracer>(
+    pub(crate) fn draw_light_points(
         &self,
         pair: DimensionPair,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> SamplePoints {
         let mut samples = std::mem::take(&mut ctx.light_points);
         ctx.fill_points(self.light_pattern, pair, &mut samples);
@@ -220,13 +219,13 @@ impl DirectIntegrator {
 
     /// The environment's light at `point` (zero without environment samples),
     /// its sample points taken from `pairs`.
-    pub(crate) fn environment_term<T: Tracer>(
+    pub(crate) fn environment_term(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         pairs: &mut PairAllocation,
         depth: u32,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         if self.environment_samples == 0 || scene.environment.is_none() {
             return Vec3::ZERO;
@@ -241,14 +240,14 @@ impl DirectIntegrator {
     /// The average over the light's samples (the dimension pair `pair` of the
     /// Sobol pattern) of the Phong reflection of each visible sample, times the
     /// light's color.
-    fn area_light<T: Tracer>(
+    fn area_light(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         index: usize,
         light: &AreaLight,
         pair: DimensionPair,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let samples = self.draw_light_points(pair, ctx);
         let occluders = self.occluders(scene, point, index);
@@ -262,12 +261,12 @@ impl DirectIntegrator {
     /// importance-sampled from the environment (the points of
     /// `environment_pattern` over [0, 1)² mapped to directions), for a shading
     /// point `depth` reflections deep.
-    pub(crate) fn environment_light<T: Tracer>(
+    pub(crate) fn environment_light(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         pair: DimensionPair,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let Some(env) = &scene.environment else {
             return Vec3::ZERO;
@@ -288,12 +287,12 @@ impl DirectIntegrator {
     }
 
     /// The local shading of `point` in physical units, `depth` reflections deep.
-    pub(crate) fn shade_physical<T: Tracer>(
+    pub(crate) fn shade_physical(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         depth: u32,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         self.shade_with(
             scene,
@@ -318,7 +317,7 @@ impl DirectIntegrator {
     /// `point`: light samples from `pair`, and on a glossy material as many
     /// specular-lobe samples, combined by the power heuristic.
     #[allow(clippy::too_many_arguments)]
-    fn physical_area_light<T: Tracer>(
+    fn physical_area_light(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
@@ -326,7 +325,7 @@ impl DirectIntegrator {
         light: &AreaLight,
         pair: DimensionPair,
         depth: u32,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let x = point.hit.point;
         let n = self.light_samples;
@@ -364,7 +363,7 @@ impl DirectIntegrator {
     /// at `point`: directions uniform over its cone, and on a glossy material
     /// as many specular-lobe samples, combined by the power heuristic.
     #[allow(clippy::too_many_arguments)]
-    fn physical_sphere_light<T: Tracer>(
+    fn physical_sphere_light(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
@@ -372,7 +371,7 @@ impl DirectIntegrator {
         light: &SphereLight,
         pair: DimensionPair,
         depth: u32,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let x = point.hit.point;
         let n = self.light_samples;
@@ -404,14 +403,14 @@ impl DirectIntegrator {
     /// The sum over `light_samples` directions drawn from `point`'s specular
     /// lobe of [`ShadingPoint::lobe_sample`] towards the light at `index`,
     /// whose own sampling has density `light_pdf(y)` towards its point `y`.
-    fn lobe_samples<T: Tracer>(
+    fn lobe_samples(
         &self,
         scene: &Scene,
         point: &ShadingPoint,
         index: usize,
         depth: u32,
         light_pdf: impl Fn(Vec3) -> f32,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let pair = DimensionPair::Brdf {
             light: index as u32,
@@ -448,10 +447,10 @@ impl ShadingPoint<'_> {
     /// An environment sample's value `L · f · cos θ / p` if unblocked, short
     /// of its shadow ray, or `None` (counted) where it needs no shadow ray.
     /// Counts the shadow ray it needs.
-    fn environment_sample_unshadowed<T: Tracer>(
+    fn environment_sample_unshadowed(
         &self,
         s: &EnvironmentSample,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Option<Vec3> {
         if s.pdf.is_nan() || s.pdf <= 0.0 || s.radiance == Vec3::ZERO {
             ctx.counters.environment_skips.zero_density += 1;
@@ -475,13 +474,13 @@ impl ShadingPoint<'_> {
     /// or each up to its shadow ray one by one and then their shadow rays
     /// tested together (the origins of `spawn_ray`, so the same answers and
     /// the same sum, bit for bit).
-    fn add_environment_samples<T: Tracer>(
+    fn add_environment_samples(
         &self,
         scene: &Scene,
         drawn: &[EnvironmentSample],
         one_by_one: bool,
         sum: &mut Vec3,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) {
         if one_by_one {
             for s in drawn {
@@ -516,7 +515,7 @@ impl ShadingPoint<'_> {
     /// The BRDF times the cosine for light from direction `l`: the specular
     /// lobe only where `ks` is nonzero.
     #[inline]
-    pub(crate) fn brdf_cos<T: Tracer>(&self, l: Vec3, ctx: &mut SampleContext<T>) -> Vec3 {
+    pub(crate) fn brdf_cos(&self, l: Vec3, ctx: &mut SampleContext) -> Vec3 {
         if self.has_specular {
             ctx.counters.specular_lobes += 1;
         }
@@ -526,12 +525,12 @@ impl ShadingPoint<'_> {
     /// Phong reflection towards `v` of a unit light at `target`, or zero if the
     /// light is behind the surface or a shadow ray finds it occluded (testing only
     /// `occluders`). The shadow ray is only traced when the light could contribute.
-    pub(crate) fn unoccluded_reflection<T: Tracer>(
+    pub(crate) fn unoccluded_reflection(
         &self,
         scene: &Scene,
         target: &RayTarget,
         occluders: &Occluders,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         // A direction of no length (the light's point is the shading point)
         // is not above the surface either: `ng · 0 > 0` is false.
@@ -562,13 +561,13 @@ impl ShadingPoint<'_> {
     /// The sum over `samples` (coordinates on `light`) of the point's Phong
     /// reflection of each light point that shines on it and is not blocked
     /// (testing only `occluders`), before the light's colour and the average.
-    pub(crate) fn area_light_sum<T: Tracer>(
+    pub(crate) fn area_light_sum(
         &self,
         scene: &Scene,
         light: &AreaLight,
         samples: &SamplePoints,
         occluders: &Occluders,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         if samples.len() < LANES_FROM_SAMPLES {
             return self.area_light_sum_one_by_one(scene, light, samples, occluders, ctx);
@@ -610,26 +609,19 @@ impl ShadingPoint<'_> {
     }
 
     /// Adds one chunk's lanes to the counts ([`count_lanes`]).
-    fn count<T: Tracer>(
-        &self,
-        ctx: &mut SampleContext<T>,
-        used: u32,
-        lit: u32,
-        shaded: u32,
-        traced: u32,
-    ) {
+    fn count(&self, ctx: &mut SampleContext, used: u32, lit: u32, shaded: u32, traced: u32) {
         let specular = if self.has_specular { u32::MAX } else { 0 };
         count_lanes(&mut ctx.counters, used, lit, shaded, traced, specular);
     }
 
     /// [`Self::area_light_sum`] one sample at a time.
-    pub(crate) fn area_light_sum_one_by_one<T: Tracer>(
+    pub(crate) fn area_light_sum_one_by_one(
         &self,
         scene: &Scene,
         light: &AreaLight,
         samples: &SamplePoints,
         occluders: &Occluders,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let mut sum = Vec3::ZERO;
         for u in samples.iter() {
@@ -646,12 +638,7 @@ impl ShadingPoint<'_> {
 
     /// `f · cos θ · I / r²` of a point light, or zero behind the surface or in
     /// shadow.
-    fn point_light<T: Tracer>(
-        &self,
-        scene: &Scene,
-        light: &PointLight,
-        ctx: &mut SampleContext<T>,
-    ) -> Vec3 {
+    fn point_light(&self, scene: &Scene, light: &PointLight, ctx: &mut SampleContext) -> Vec3 {
         ctx.counters.point_light_samples += 1;
         let d = light.position - self.hit.point;
         let distance2 = d.length_squared();
@@ -675,14 +662,14 @@ impl ShadingPoint<'_> {
     /// `target` on a light, drawn with solid-angle density `pdf` (the shadow
     /// ray testing only `occluders`), `w` its power-heuristic weight against
     /// the specular lobe's density (1 without `mis`).
-    fn light_sample<T: Tracer>(
+    fn light_sample(
         &self,
         scene: &Scene,
         target: &RayTarget,
         pdf: f32,
         mis: bool,
         occluders: &Occluders,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let Some(value) = self.light_sample_unshadowed(target, pdf, mis, ctx) else {
             return Vec3::ZERO;
@@ -700,7 +687,7 @@ impl ShadingPoint<'_> {
     /// as [`ShadingPoint::area_light_sum`] does (the same origins and ends, so
     /// the same answers and the same sum, bit for bit).
     #[allow(clippy::too_many_arguments)]
-    fn light_samples_shadowed_in_lanes<T: Tracer>(
+    fn light_samples_shadowed_in_lanes(
         &self,
         scene: &Scene,
         light: &AreaLight,
@@ -708,7 +695,7 @@ impl ShadingPoint<'_> {
         samples: &SamplePoints,
         mis: bool,
         occluders: &Occluders,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let origins = self.shadow_origins();
         let mut sum = Vec3::ZERO;
@@ -738,13 +725,13 @@ impl ShadingPoint<'_> {
     /// Up to [`LANES`] light samples short of their shadow rays, one by one
     /// ([`Self::light_sample_unshadowed`]): each lane's light point, its value
     /// if unblocked, and the lanes that need a shadow ray.
-    fn unshadowed_one_by_one<T: Tracer>(
+    fn unshadowed_one_by_one(
         &self,
         light: &AreaLight,
         sampler: &AreaLightSampler,
         chunk: &PointChunk,
         mis: bool,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> (Vec3Lanes, [Vec3; LANES], u32) {
         let mut values = [Vec3::ZERO; LANES];
         let mut positions = [self.hit.point; LANES];
@@ -763,11 +750,11 @@ impl ShadingPoint<'_> {
     /// [`Self::unshadowed_one_by_one`] for a diffuse point (no lobe, so no
     /// MIS), the direction, horizon test and `kd/π · cos θ / p` in lanes: each
     /// lane [`Self::light_sample_unshadowed`]'s value and counts, bit for bit.
-    fn unshadowed_diffuse_lanes<T: Tracer>(
+    fn unshadowed_diffuse_lanes(
         &self,
         sampler: &AreaLightSampler,
         chunk: &PointChunk,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> (Vec3Lanes, [Vec3; LANES], u32) {
         let mut positions = [self.hit.point; LANES];
         let mut pdfs = [0.0; LANES];
@@ -790,12 +777,12 @@ impl ShadingPoint<'_> {
     /// [`Self::light_sample`] short of its shadow ray: the sample's value
     /// `f · cos θ · w / p` if unblocked, or `None` (counted) where it needs no
     /// shadow ray. Counts the shadow ray it needs.
-    fn light_sample_unshadowed<T: Tracer>(
+    fn light_sample_unshadowed(
         &self,
         target: &RayTarget,
         pdf: f32,
         mis: bool,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Option<Vec3> {
         if !(pdf > 0.0 && pdf.is_finite()) {
             ctx.counters.light_skips.zero_density += 1;
@@ -820,13 +807,13 @@ impl ShadingPoint<'_> {
     /// whose surface is scene object `object` and whose light sampling draws
     /// the direction towards its point `y` with density `light_pdf(y)`: zero
     /// unless the ray from the point along `l` reaches that light first.
-    fn lobe_sample<T: Tracer>(
+    fn lobe_sample(
         &self,
         scene: &Scene,
         light_pdf: &impl Fn(Vec3) -> f32,
         object: u32,
         l: Vec3,
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
         let pdf = self.material.specular_pdf(self.n, l, self.v);
         if !(pdf > 0.0 && pdf.is_finite()) {
@@ -850,12 +837,7 @@ impl ShadingPoint<'_> {
     /// `f(l, v) · cos θ` towards the unit direction `l`, or `None` where no
     /// ray need be traced: `l` below the geometric surface, or a zero BRDF,
     /// counted in the skips `skips` picks (a light's or a lobe's).
-    fn reflection_towards<T: Tracer>(
-        &self,
-        l: Vec3,
-        skips: SkipsOf,
-        ctx: &mut SampleContext<T>,
-    ) -> Option<Vec3> {
+    fn reflection_towards(&self, l: Vec3, skips: SkipsOf, ctx: &mut SampleContext) -> Option<Vec3> {
         if !self.above_surface(l) {
             skips(&mut ctx.counters).below_surface += 1;
             return None;

@@ -326,35 +326,48 @@ impl<'a> PixelRenderer<'a> {
 
     /// The radiance of pixel `(x, y)`: the sum of its finite camera samples
     /// over `spp` (a sample that is not finite counts as zero).
-    /// It depends only on the scene, the settings and `(x, y)`. With a tracer
-    /// on (`T::ON`), it sees each step of the samples in their lanes.
-    pub(crate) fn pixel<T: Tracer>(
+    /// It depends only on the scene, the settings and `(x, y)`.
+    pub(crate) fn pixel(
         &self,
         x: u32,
         y: u32,
         pixel_samples: &mut [Vec2],
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> Vec3 {
-        let pixel = self.pixel_index(x, y);
-        self.fill_jitters(pixel, pixel_samples);
         let candidates = self.candidates(x, 1, y);
         let mut sum = Vec3::ZERO;
-        for (chunk, jitters) in pixel_samples.chunks(LANES).enumerate() {
-            let first = PixelSample {
-                seed: self.settings.seed,
-                pixel,
-                sample: (chunk * LANES) as u64,
-            };
-            let chunk = SampleChunk {
+        for chunk in self.pixel_chunks(x, y, pixel_samples) {
+            let values = self.chunk_values(&chunk, candidates, ctx);
+            accumulate(&mut sum, &values, 0..chunk.jitters.len(), &mut ctx.counters);
+        }
+        sum / self.settings.spp as f32
+    }
+
+    /// The chunks of [`LANES`] camera samples of pixel `(x, y)`, their
+    /// positions drawn into `pixel_samples` (`spp` of them).
+    pub(crate) fn pixel_chunks<'s>(
+        &self,
+        x: u32,
+        y: u32,
+        pixel_samples: &'s mut [Vec2],
+    ) -> impl Iterator<Item = SampleChunk<'s>> + use<'s, '_> {
+        let pixel = self.pixel_index(x, y);
+        self.fill_jitters(pixel, pixel_samples);
+        let seed = self.settings.seed;
+        let samples: &'s [Vec2] = pixel_samples;
+        samples
+            .chunks(LANES)
+            .enumerate()
+            .map(move |(chunk, jitters)| SampleChunk {
                 x0: x,
                 y,
                 jitters,
-                samples: LaneSamples::of_pixel(first),
-            };
-            let values = self.chunk_values(&chunk, candidates, ctx);
-            accumulate(&mut sum, &values, 0..jitters.len(), ctx);
-        }
-        sum / self.settings.spp as f32
+                samples: LaneSamples::of_pixel(PixelSample {
+                    seed,
+                    pixel,
+                    sample: (chunk * LANES) as u64,
+                }),
+            })
     }
 
     /// Pixels rendered together, each the same as [`Self::pixel`]: where a
@@ -372,12 +385,12 @@ impl<'a> PixelRenderer<'a> {
     /// Pixels `(x0 + i, y)` for `i < run_length()`, [`Self::pixel`] each,
     /// bit for bit, their camera samples in the lanes of one chunk (`jitters`
     /// is a buffer of [`LANES`] positions).
-    pub(crate) fn pixel_run<T: Tracer>(
+    pub(crate) fn pixel_run(
         &self,
         x0: u32,
         y: u32,
         jitters: &mut [Vec2; LANES],
-        ctx: &mut SampleContext<T>,
+        ctx: &mut SampleContext,
     ) -> [Vec3; LANES] {
         let (run, spp) = (self.run_length(), self.settings.spp as usize);
         let mut samples = LaneSamples {
@@ -399,7 +412,7 @@ impl<'a> PixelRenderer<'a> {
         let values = self.chunk_values(&chunk, self.candidates(x0, run, y), ctx);
         let mut sums = [Vec3::ZERO; LANES];
         for (i, sum) in sums.iter_mut().enumerate().take(run) {
-            accumulate(sum, &values, i * spp..(i + 1) * spp, ctx);
+            accumulate(sum, &values, i * spp..(i + 1) * spp, &mut ctx.counters);
             *sum /= spp as f32;
         }
         sums
@@ -421,7 +434,7 @@ impl<'a> PixelRenderer<'a> {
     /// The objects the camera rays through pixels `(x0..x0 + count, y)` may
     /// hit, where the whole sample is taken in lanes (else all): those of the
     /// span of [`CANDIDATE_SPAN`] pixels or more that holds them.
-    fn candidates(&self, x0: u32, count: usize, y: u32) -> u64 {
+    pub(crate) fn candidates(&self, x0: u32, count: usize, y: u32) -> u64 {
         if !self.all_in_lanes {
             return u64::MAX;
         }
@@ -443,80 +456,31 @@ impl<'a> PixelRenderer<'a> {
         objects
     }
 
-    /// The radiance of a chunk's camera samples, all in lanes (with their
-    /// rays' differentials where the scene reads footprints); one by one
-    /// only for an AOV.
-    fn chunk_values<T: Tracer>(
+    /// The radiance of a chunk's camera samples: camera rays (with their
+    /// differentials where the scene reads footprints), closest hits (among
+    /// the objects `candidates` names where the whole sample is taken in
+    /// lanes) and shading, all in lanes; one by one only for an AOV. With a
+    /// tracer on (`T::ON`), it sees each step of the samples in their lanes
+    /// (`glint explain`, around this call).
+    pub(crate) fn chunk_values<T: Tracer>(
         &self,
         chunk: &SampleChunk,
         candidates: u64,
         ctx: &mut SampleContext<T>,
     ) -> Vec3Lanes {
-        let used = chunk.jitters.len();
-        ctx.tracer
-            .start_chunk(used, |k| chunk.samples.lane(k).sample);
-        let values = if self.all_in_lanes {
-            self.samples_in_lanes(chunk, candidates, ctx)
-        } else {
-            self.samples_by_rays(chunk, ctx)
+        let (scene, integrator, used) = (self.scene, self.integrator, chunk.jitters.len());
+        let (rays, diffs) = self.camera_rays(chunk);
+        let samples = &chunk.samples;
+        let Some(diffs) = diffs else {
+            let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
+            return integrator.li_first_hits(scene, &rays, None, &closest, used, samples, ctx);
         };
-        let value = |k| Event::SampleRadiance {
-            value: values.lane(k),
-        };
-        ctx.tracer
-            .record(lanes::bits(lanes::first_lanes(used)), value);
-        values
-    }
-
-    /// The radiance of a chunk's camera samples: camera rays, closest hits
-    /// among the objects `candidates` names, and shading, all in lanes.
-    fn samples_in_lanes<T: Tracer>(
-        &self,
-        chunk: &SampleChunk,
-        candidates: u64,
-        ctx: &mut SampleContext<T>,
-    ) -> Vec3Lanes {
-        let (scene, used) = (self.scene, chunk.jitters.len());
-        let (px, py) = chunk.raster_lanes();
-        let rays = centre_rays(&scene.camera, px, py);
-        self.record_camera(chunk, &rays, None, ctx);
-        let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
-        (self.integrator).li_first_hits(scene, &rays, None, &closest, used, &chunk.samples, ctx)
-    }
-
-    /// The radiance (or AOV) of a chunk's camera samples, each camera ray made
-    /// with its differentials: their closest hits found together and then
-    /// shaded together, or, for an AOV, one by one.
-    fn samples_by_rays<T: Tracer>(
-        &self,
-        chunk: &SampleChunk,
-        ctx: &mut SampleContext<T>,
-    ) -> Vec3Lanes {
-        let (scene, settings, used) = (self.scene, self.settings, chunk.jitters.len());
-        let (px, py) = chunk.raster_lanes();
-        let (ray_lanes, diffs) = match self.differentials {
-            true => camera_rays_lanes(&scene.camera, px, py, self.footprint_scale),
-            false => {
-                let rays = centre_rays(&scene.camera, px, py);
-                let diffs = lanes::array_from_fn(|k| RayDifferential::none(&rays.lane(k)));
-                (rays, diffs)
-            }
-        };
-        self.record_camera(chunk, &ray_lanes, Some(&diffs), ctx);
-        let closest =
-            (settings.aov.is_none()).then(|| scene.shapes.closest_lanes(&ray_lanes, used));
-        match &closest {
-            Some(closest) => (self.integrator).li_first_hits(
-                scene,
-                &ray_lanes,
-                self.differentials.then_some(&diffs),
-                closest,
-                used,
-                &chunk.samples,
-                ctx,
-            ),
-            None => self.samples_one_by_one(chunk, (&ray_lanes, &diffs)),
+        if self.settings.aov.is_some() {
+            return self.samples_one_by_one(chunk, (&rays, &diffs));
         }
+        let closest = scene.shapes.closest_lanes(&rays, used);
+        let footprints = self.differentials.then_some(&diffs);
+        integrator.li_first_hits(scene, &rays, footprints, &closest, used, samples, ctx)
     }
 
     /// Each of a chunk's camera samples' AOV, from its ray and
@@ -534,29 +498,46 @@ impl<'a> PixelRenderer<'a> {
         }))
     }
 
-    /// The camera stage of the lanes of `chunk`, whose rays are `rays`
-    /// (with their differentials where the scene reads footprints).
-    fn record_camera<T: Tracer>(
-        &self,
-        chunk: &SampleChunk,
-        rays: &RayLanes,
-        diffs: Option<&[RayDifferential; LANES]>,
-        ctx: &mut SampleContext<T>,
-    ) {
-        let camera = |k: usize| {
+    /// The camera rays of a chunk's lanes: without differentials where its
+    /// samples are taken in lanes whole, else with them (unit ones where the
+    /// scene reads no footprint).
+    fn camera_rays(&self, chunk: &SampleChunk) -> (RayLanes, Option<[RayDifferential; LANES]>) {
+        let camera = &self.scene.camera;
+        let (px, py) = chunk.raster_lanes();
+        if self.all_in_lanes {
+            return (centre_rays(camera, px, py), None);
+        }
+        let (rays, diffs) = match self.differentials {
+            true => camera_rays_lanes(camera, px, py, self.footprint_scale),
+            false => {
+                let rays = centre_rays(camera, px, py);
+                let diffs = lanes::array_from_fn(|k| RayDifferential::none(&rays.lane(k)));
+                (rays, diffs)
+            }
+        };
+        (rays, Some(diffs))
+    }
+
+    /// The camera stage of the lanes of `chunk` as a tracer sees it: each
+    /// lane's raster position, film point and ray (its own, recomputed),
+    /// with its differentials where the scene reads footprints.
+    pub(crate) fn camera_events<'c>(
+        &'c self,
+        chunk: &'c SampleChunk,
+    ) -> impl Fn(usize) -> Event + 'c {
+        let (rays, diffs) = self.camera_rays(chunk);
+        let diffs = diffs.filter(|_| self.differentials);
+        move |k: usize| {
             let raster = Vec2::new(chunk.x(k) as f32, chunk.y as f32) + chunk.jitters[k];
             let (ndc, film_point) = self.scene.camera.film_point(raster.x, raster.y);
-            let ray = rays.lane(k);
             Event::Camera {
                 raster,
                 ndc,
                 film_point,
-                ray,
-                differential: diffs.filter(|_| self.differentials).map(|d| d[k]),
+                ray: rays.lane(k),
+                differential: diffs.map(|d| d[k]),
             }
-        };
-        ctx.tracer
-            .record(lanes::bits(lanes::first_lanes(chunk.jitters.len())), camera);
+        }
     }
 }
 
@@ -589,13 +570,13 @@ fn objects_seen_by_pixels(scene: &Scene, x0: u32, count: usize, y: u32) -> u64 {
 }
 
 /// Adds a chunk's radiance `values` in `lanes` to `sum`, in order, leaving
-/// out (and counting) those that are NaN or infinite.
+/// out (and counting in `counters`) those that are NaN or infinite.
 #[inline]
-fn accumulate<T: Tracer>(
+pub(crate) fn accumulate(
     sum: &mut Vec3,
     values: &Vec3Lanes,
     lanes: std::ops::Range<usize>,
-    ctx: &mut SampleContext<T>,
+    counters: &mut ShadingCounters,
 ) {
     let finite = lanes::bits(values.x.is_finite() & values.y.is_finite() & values.z.is_finite());
     let (x, y, z) = (
@@ -607,7 +588,7 @@ fn accumulate<T: Tracer>(
         if finite >> k & 1 == 1 {
             *sum += Vec3::new(x[k], y[k], z[k]);
         } else {
-            ctx.counters.nonfinite_samples += 1;
+            counters.nonfinite_samples += 1;
         }
     }
 }
@@ -615,11 +596,11 @@ fn accumulate<T: Tracer>(
 /// A chunk of camera samples in lanes: runs of `samples.per_pixel` samples
 /// of pixels `(x0, y), (x0 + 1, y), …`, lane k at `jitters[k]` in its pixel
 /// (the lanes past `jitters` repeat the last).
-struct SampleChunk<'j> {
+pub(crate) struct SampleChunk<'j> {
     x0: u32,
     y: u32,
-    jitters: &'j [Vec2],
-    samples: LaneSamples,
+    pub(crate) jitters: &'j [Vec2],
+    pub(crate) samples: LaneSamples,
 }
 
 impl SampleChunk<'_> {

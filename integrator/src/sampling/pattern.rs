@@ -17,9 +17,9 @@ pub enum SamplePattern {
     Stratified,
     /// Consecutive points of an Owen-scrambled Sobol sequence, one sequence per
     /// pixel and [`DimensionPair`](super::DimensionPair); any N, best at powers of
-    /// two. The default: `glint bench` measures it ahead of the others (about 4×
+    /// two. The default: `glint bench` measures it ahead of the others (3.4×
     /// sooner than `random` to the same error on the Cornell box's soft shadows,
-    /// 1.92× on the environment scene; see `docs/run-time-against-error.md`).
+    /// 2.1× on the environment scene; see `docs/run-time-against-error.md`).
     #[default]
     Sobol,
 }

@@ -202,12 +202,17 @@ pub fn linear_to_srgb8(linear: f32) -> u8 {
     } else {
         linear.clamp(0.0, 1.0)
     };
-    let encoded = if c <= 0.003_130_8 {
+    (linear_to_srgb(c) * 255.0 + 0.5) as u8
+}
+
+/// The sRGB opto-electronic transfer function (IEC 61966-2-1), unquantised:
+/// a linear value in [0, 1] to its encoding in [0, 1].
+pub fn linear_to_srgb(c: f32) -> f32 {
+    if c <= 0.003_130_8 {
         12.92 * c
     } else {
         1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
-    (encoded * 255.0 + 0.5) as u8
+    }
 }
 
 /// `path`'s extension in lower case, which names its image format.

@@ -49,8 +49,9 @@ pub use camera::{
     Camera, CameraError, CameraRay, CameraRayDifferential, CameraRayLanes, F32Lanes, LANES,
 };
 pub use film::{
-    linear_to_srgb8, srgb_to_linear, AlphaChannel, FileFormat, Film, FilmError, ImageFile,
-    ImageFormat, PartialFilm, Placement, SampleEncoding, Tile, MAX_EXPANSION, MAX_LOAD_SIDE,
+    linear_to_srgb, linear_to_srgb8, srgb_to_linear, AlphaChannel, FileFormat, Film, FilmError,
+    ImageFile, ImageFormat, PartialFilm, Placement, SampleEncoding, Tile, MAX_EXPANSION,
+    MAX_LOAD_SIDE,
 };
 pub use output_paths::{check_output_file, check_output_folder, MAX_NAME_BYTES};
 

@@ -4,7 +4,9 @@
 
 use crate::jpeg::JpegEncoding;
 use glam::{UVec2, Vec3};
-use glint_camera::{srgb_to_linear, AlphaChannel, FileFormat, Film, SampleEncoding};
+use glint_camera::{
+    linear_to_srgb, srgb_to_linear, AlphaChannel, FileFormat, Film, SampleEncoding,
+};
 use std::path::{Path, PathBuf};
 
 /// A submission: linear RGB per pixel and how it was stored.
@@ -177,15 +179,6 @@ impl CodeSteps {
         let encoded = linear_to_srgb(linear.clamp(0.0, 1.0));
         let code = (encoded * self.max_code as f32).round() as usize;
         self.widths[code.min(self.max_code as usize)]
-    }
-}
-
-/// The sRGB curve, unquantised.
-fn linear_to_srgb(c: f32) -> f32 {
-    if c <= 0.003_130_8 {
-        12.92 * c
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
     }
 }
 

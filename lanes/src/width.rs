@@ -190,29 +190,51 @@ pub fn first_lanes(n: usize) -> F32Lanes {
 }
 
 /// Lane j of the result is lane `index[j]` of `values` (each index below
-/// [`LANES`]): one `vpermd` on AVX-512; on AVX2 a `vpermps` per 8-lane half
-/// of the result and source, blended by which half each index names; a
-/// lane-by-lane copy elsewhere.
+/// [`LANES`]): one `vpermd` on AVX-512 ([`permute_avx512`]); on AVX2 a
+/// `vpermps` per 8-lane half of the result and source, blended by which half
+/// each index names ([`permute_avx2`]); a lane-by-lane copy elsewhere
+/// ([`permute_lanes`]).
+#[inline(always)]
+pub fn permute(values: F32Lanes, index: U32Lanes) -> F32Lanes {
+    #[cfg(all(
+        target_arch = "x86_64",
+        target_feature = "avx512f",
+        not(feature = "lanes8")
+    ))]
+    let implementation = permute_avx512;
+    #[cfg(all(
+        target_arch = "x86_64",
+        target_feature = "avx2",
+        any(feature = "lanes8", not(target_feature = "avx512f"))
+    ))]
+    let implementation = permute_avx2;
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+    let implementation = permute_lanes;
+    implementation(values, index)
+}
+
+/// [`permute`] on AVX-512: one `vpermd`.
 #[cfg(all(
     target_arch = "x86_64",
     target_feature = "avx512f",
     not(feature = "lanes8")
 ))]
 #[inline(always)]
-pub fn permute(values: F32Lanes, index: U32Lanes) -> F32Lanes {
+fn permute_avx512(values: F32Lanes, index: U32Lanes) -> F32Lanes {
     use safe_arch::{m512i, permute_i32_m512i};
     let index = bytemuck::cast::<U32Lanes, m512i>(index);
     bytemuck::cast(permute_i32_m512i(index, bytemuck::cast(values)))
 }
 
-/// [`permute`] on AVX2 (the doc comment above).
-#[cfg(all(
-    target_arch = "x86_64",
-    target_feature = "avx2",
-    any(feature = "lanes8", not(target_feature = "avx512f"))
-))]
+/// [`permute`] on AVX2. Compiled wherever the CPU has AVX2, AVX-512 ones
+/// included, so that its test runs there too.
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[cfg_attr(
+    all(target_feature = "avx512f", not(feature = "lanes8"), not(test)),
+    allow(dead_code)
+)]
 #[inline(always)]
-pub fn permute(values: F32Lanes, index: U32Lanes) -> F32Lanes {
+fn permute_avx2(values: F32Lanes, index: U32Lanes) -> F32Lanes {
     use safe_arch::shuffle_av_f32_all_m256 as permute_half;
     use safe_arch::{blend_varying_m256, cmp_gt_mask_i32_m256i, m256, m256i};
     let halves: [m256; LANES / 8] = bytemuck::cast(values);
@@ -230,16 +252,13 @@ pub fn permute(values: F32Lanes, index: U32Lanes) -> F32Lanes {
     bytemuck::cast(permuted)
 }
 
-/// [`permute`] without AVX2 (the doc comment above).
-#[cfg(not(all(
-    target_arch = "x86_64",
-    any(
-        all(target_feature = "avx512f", not(feature = "lanes8")),
-        target_feature = "avx2"
-    )
-)))]
+/// [`permute`] lane by lane, on any CPU (and the others' test).
+#[cfg_attr(
+    all(target_arch = "x86_64", target_feature = "avx2", not(test)),
+    allow(dead_code)
+)]
 #[inline(always)]
-pub fn permute(values: F32Lanes, index: U32Lanes) -> F32Lanes {
+fn permute_lanes(values: F32Lanes, index: U32Lanes) -> F32Lanes {
     let (values, index) = (values.as_array(), index.as_array());
     from_fn(|j| values[index[j] as usize % LANES])
 }
@@ -368,18 +387,34 @@ mod tests {
         assert_eq!(all_bits().count_ones() as usize, LANES);
     }
 
-    /// Each lane of a permute is the indexed lane, repeats included.
+    /// Each lane of a permute is the indexed lane, repeats included, in
+    /// every implementation this CPU can run: the one [`permute`] uses and
+    /// the narrower ones (on AVX-512, the AVX2 blend of halves too).
     #[test]
     fn permute_takes_each_lane_from_its_index() {
+        type Permute = fn(F32Lanes, U32Lanes) -> F32Lanes;
+        #[allow(unused_mut)] // Only a CPU with AVX2 has more.
+        let mut implementations: Vec<(&str, Permute)> =
+            vec![("permute", permute), ("lane by lane", permute_lanes)];
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+        implementations.push(("AVX2", permute_avx2));
+        #[cfg(all(
+            target_arch = "x86_64",
+            target_feature = "avx512f",
+            not(feature = "lanes8")
+        ))]
+        implementations.push(("AVX-512", permute_avx512));
         let values = F32Lanes::new(std::array::from_fn(|k| 10.0 + k as f32));
         // Lanes from both halves, and the last one again and again.
         let index: [u32; LANES] = std::array::from_fn(|j| match j % 3 {
             0 => LANES as u32 - 1,
             _ => (5 * j as u32 + 3) % LANES as u32,
         });
-        let permuted = permute(values, U32Lanes::new(index));
-        for (j, (lane, from)) in permuted.as_array().iter().zip(index).enumerate() {
-            assert_eq!(*lane, 10.0 + from as f32, "lane {j}");
+        for (name, implementation) in implementations {
+            let permuted = implementation(values, U32Lanes::new(index));
+            for (j, (lane, from)) in permuted.as_array().iter().zip(index).enumerate() {
+                assert_eq!(*lane, 10.0 + from as f32, "{name}: lane {j}");
+            }
         }
     }
 }

@@ -6,9 +6,9 @@
 //! seeds. The script fails a
 //! scene whose image means differ by 0.3% or more, or whose relMSE between
 //! the two renderers exceeds their own noise by more than its tolerance
-//! (docs/physical-shading.md). Runs only where a Python with the `mitsuba`
-//! package is found (`GLINT_MITSUBA_VENV`, or `target/mitsuba-venv`); elsewhere
-//! it says so and passes.
+//! (docs/physical-shading.md). Needs a Python with the `mitsuba` package
+//! (`GLINT_MITSUBA_VENV`, or `target/mitsuba-venv` as `.ci/run` makes it);
+//! elsewhere it says so and skips, and under `CI=true` fails.
 
 mod common;
 use common::{python_with_mitsuba, repo};
@@ -36,7 +36,6 @@ fn agreement(python: &Path, scene: &str, extra: &[&str]) {
 #[test]
 fn physical_scenes_agree_with_mitsuba() {
     let Some(python) = python_with_mitsuba() else {
-        eprintln!("skipped: no Python with the mitsuba package (see measure/mitsuba/README.md)");
         return;
     };
     let small = ["--seeds", "6", "--spp", "32", "--resolution", "48x48"];

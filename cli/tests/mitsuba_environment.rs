@@ -1,9 +1,9 @@
 //! Glint's lat-long environment lighting against Mitsuba 3's, through
 //! `measure/mitsuba/envmap.py`: a diffuse sphere under the shipped map, with the
-//! map resampled onto Mitsuba's rows (docs/environment-lighting.md). Runs only
-//! where a Python with the `mitsuba` package is found (`GLINT_MITSUBA_VENV`, or
-//! `target/mitsuba-venv` as `measure/mitsuba/compare.sh` makes it); elsewhere it
-//! says so and passes.
+//! map resampled onto Mitsuba's rows (docs/environment-lighting.md). Needs a
+//! Python with the `mitsuba` package (`GLINT_MITSUBA_VENV`, or
+//! `target/mitsuba-venv` as `.ci/run` makes it); elsewhere it says so and
+//! skips, and under `CI=true` fails.
 
 mod common;
 use common::{python_with_mitsuba, repo};
@@ -18,7 +18,6 @@ fn ratios(cell: &str) -> Vec<f64> {
 #[test]
 fn a_diffuse_sphere_under_the_shipped_map_agrees_with_mitsuba() {
     let Some(python) = python_with_mitsuba() else {
-        eprintln!("skipped: no Python with the mitsuba package (see measure/mitsuba/README.md)");
         return;
     };
     let out = Command::new(python)

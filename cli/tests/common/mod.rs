@@ -90,8 +90,10 @@ pub fn repo() -> PathBuf {
 }
 
 /// The Python of a virtual environment where `import mitsuba` works
-/// (`GLINT_MITSUBA_VENV`, or `target/mitsuba-venv` as
-/// `measure/mitsuba/compare.sh` makes it); `None` where there is none.
+/// (`GLINT_MITSUBA_VENV`, or `target/mitsuba-venv` as `.ci/run` and
+/// `measure/mitsuba/compare.sh` make it), a real part ([`real_part`]):
+/// `None` where there is none, after saying so; under `CI=true` a missing
+/// one fails the test.
 pub fn python_with_mitsuba() -> Option<PathBuf> {
     let venv = std::env::var_os("GLINT_MITSUBA_VENV")
         .map(PathBuf::from)
@@ -101,7 +103,13 @@ pub fn python_with_mitsuba() -> Option<PathBuf> {
         .args(["-c", "import mitsuba"])
         .output()
         .is_ok_and(|o| o.status.success());
-    imports.then_some(python)
+    let missing = (!imports).then(|| {
+        format!(
+            "no Python with the mitsuba package in {} (python3 -m venv it, then pip install mitsuba; measure/mitsuba/README.md)",
+            venv.display()
+        )
+    });
+    real_part(missing).then_some(python)
 }
 
 /// A small class in `dir`: `scenes/` with Set 1 and Set 2, and

@@ -382,30 +382,50 @@ fn aovs_write_raw_values_to_float_files_and_false_color_to_png() {
     assert_input_error(&o, "invalid value 'bogus' for '--aov <BUFFER>'");
 }
 
+/// `--texture-filter F` renders what the scene renders with every texture's
+/// `filter = "F"` written in its file, to the byte, and the filters differ.
 #[test]
-fn texture_filter_override_changes_the_image() {
+fn texture_filter_override_is_the_filter_written_in_the_scene() {
     let dir = tempfile::tempdir().unwrap();
     let ground = scene("ground-mipmap");
-    let mut files = Vec::new();
-    for filter in ["nearest", "ewa"] {
-        let out = format!("{filter}.pfm");
-        let args = [
-            "render",
-            ground.as_str(),
-            "-o",
-            &out,
-            "--texture-filter",
-            filter,
-            "--resolution",
-            "64x36",
-            "--spp",
-            "1",
-        ];
+    let text = std::fs::read_to_string(&ground).unwrap();
+    let textures = Path::new(&ground).parent().unwrap().join("textures/");
+    let render = |scene: &str, out: &str, flags: &[&str]| {
+        let mut args = vec!["render", scene, "-o", out];
+        args.extend(["--resolution", "64x36", "--spp", "1"]);
+        args.extend(flags);
         let o = glint(&args, dir.path());
         assert!(o.status.success(), "{}", stderr(&o));
-        files.push(std::fs::read(dir.path().join(&out)).unwrap());
+        std::fs::read(dir.path().join(out)).unwrap()
+    };
+    let mut images = Vec::new();
+    for filter in ["nearest", "ewa"] {
+        let flagged = render(
+            &ground,
+            &format!("{filter}-flag.pfm"),
+            &["--texture-filter", filter],
+        );
+        let written = dir.path().join(format!("{filter}.toml"));
+        let edited = text
+            .replace("filter = \"trilinear\"", &format!("filter = \"{filter}\""))
+            .replace(
+                "file = \"textures/",
+                &format!("file = \"{}", textures.display()),
+            );
+        assert_ne!(edited, text);
+        std::fs::write(&written, edited).unwrap();
+        let in_file = render(
+            written.to_str().unwrap(),
+            &format!("{filter}-file.pfm"),
+            &[],
+        );
+        assert!(
+            flagged == in_file,
+            "--texture-filter {filter} differs from the file's filter"
+        );
+        images.push(flagged);
     }
-    assert_ne!(files[0], files[1]);
+    assert_ne!(images[0], images[1]);
 }
 
 /// Distance from `origin` along `direction` to the first hit on a sphere.

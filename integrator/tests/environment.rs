@@ -100,11 +100,25 @@ fn furnace_nearly_white_map_gives_one_within_monte_carlo_tolerance() {
     )
     .unwrap()
     .film;
-    let mean = film.pixels().iter().map(|p| p.x as f64).sum::<f64>() / film.pixels().len() as f64;
-    assert!((mean - 1.0).abs() < 0.01, "mean {mean}");
+    // Pixels are independent estimates of 1 (the map's ±0.001 aside): their
+    // mean lies within 4 standard errors, and a 1% bias would not.
+    let values: Vec<f64> = film.pixels().iter().map(|p| p.x as f64).collect();
+    let (mean, se) = mean_and_standard_error(&values);
+    let within = |bias: f64| (bias * mean - 1.0).abs() <= 4.0 * bias * se + 0.001;
+    assert!(within(1.0), "mean {mean} ± {se}");
+    assert!(!within(1.01), "a 1% bias would pass: ± {se}");
+    let sd = se * (values.len() as f64).sqrt();
     for p in film.pixels() {
-        assert!((p.x - 1.0).abs() < 0.15, "{p}");
+        assert!((p.x as f64 - 1.0).abs() < 6.0 * sd, "{p} (pixel sd {sd})");
     }
+}
+
+/// The mean of independent draws and its standard error.
+fn mean_and_standard_error(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (variance / n).sqrt())
 }
 
 #[test]

@@ -5,8 +5,10 @@
 //! integrator along them ([`DirectIntegrator::li`], the render's own path) with
 //! many seeds. A deterministic estimate (point lights) must equal the closed
 //! form to rounding; a Monte Carlo one must have its mean within
-//! [`MAX_STANDARD_ERRORS`] standard errors of the truth at every point, with a
-//! standard error small enough that a bias of a percent or two would fail
+//! [`MAX_STANDARD_ERRORS`] standard errors of the truth at every point, and,
+//! its control, beyond them from the truth biased by the bias it states (1%,
+//! 2% or 3% in the white furnace, whose glossy estimates are heavy-tailed)
+//! either way, so that such a bias would fail it
 //! ([`estimator_detects_a_small_bias`] shows one failing).
 
 use glam::{Vec2, Vec3};
@@ -71,13 +73,25 @@ fn standard_errors_off(values: &[f64], truth: f64, max_relative_error: f64) -> f
     (mean - truth).abs() / se.max(1e-6 * truth.abs())
 }
 
-fn assert_unbiased(what: &str, values: &[f64], truth: f64, max_relative_error: f64) {
-    let z = standard_errors_off(values, truth, max_relative_error);
+/// Asserts that the mean of `values` lies within [`MAX_STANDARD_ERRORS`] of
+/// `truth`, and, the control, that it lies beyond them from `truth` biased
+/// by `detected_bias` either way: the bias this check is stated to catch
+/// would fail it.
+fn assert_unbiased(what: &str, values: &[f64], truth: f64, detected_bias: f64) {
+    let z = standard_errors_off(values, truth, detected_bias);
     let (mean, se) = mean_and_standard_error(values);
     assert!(
         z < MAX_STANDARD_ERRORS,
         "{what}: mean {mean} (standard error {se}) is {z:.1} standard errors from the truth {truth}"
     );
+    for biased in [truth * (1.0 - detected_bias), truth * (1.0 + detected_bias)] {
+        let z = standard_errors_off(values, biased, detected_bias);
+        assert!(
+            z > MAX_STANDARD_ERRORS,
+            "{what}: a {}% bias would pass (mean {mean}, standard error {se}, only {z:.1} from {biased})",
+            100.0 * detected_bias
+        );
+    }
 }
 
 fn with(settings: &RenderSettings, change: impl FnOnce(&mut RenderSettings)) -> RenderSettings {
@@ -171,7 +185,7 @@ fn area_light_over_a_plane_matches_lamberts_polygon_formula() {
                 let (ray, hit) = ray_to(&d.scene, d.scene.camera.position(), target);
                 let truth =
                     0.5 / PI * radiance * lambert_polygon_irradiance(hit, Vec3::Y, &corners);
-                let values = estimates(&d.scene, &settings, &ray, 256);
+                let values = estimates(&d.scene, &settings, &ray, 4096);
                 assert_unbiased(
                     &format!("{strategy:?} {pattern:?} at {hit}"),
                     &values,
@@ -289,7 +303,7 @@ fn course_phong_under_an_area_light_matches_quadrature_of_the_reports_integral()
         }
         for pattern in [SamplePattern::Random, SamplePattern::Sobol] {
             let settings = with(&d.settings, |s| s.light_pattern = pattern);
-            let values = estimates(&d.scene, &settings, &ray, 256);
+            let values = estimates(&d.scene, &settings, &ray, 4096);
             assert_unbiased(&format!("{pattern:?} at {hit}"), &values, integral, 0.01);
         }
     }
@@ -316,7 +330,7 @@ fn diffuse_sphere_and_plane_under_a_uniform_sky_match_their_closed_forms() {
             "{hit} is on the sphere"
         );
         let truth = 0.8 * (1.0 + f64::from(n.y)) / 2.0;
-        let values = estimates(&d.scene, &settings, &ray, 256);
+        let values = estimates(&d.scene, &settings, &ray, 2048);
         assert_unbiased(&format!("sphere at {hit}"), &values, truth, 0.01);
         checked += 1;
     }
@@ -331,7 +345,7 @@ fn diffuse_sphere_and_plane_under_a_uniform_sky_match_their_closed_forms() {
         let distance = f64::from(Vec2::new(hit.x, hit.z).length());
         let shade = radius.powi(3) / (distance * distance + radius * radius).powf(1.5);
         let truth = 0.5 * (1.0 - shade);
-        let values = estimates(&d.scene, &settings, &ray, 256);
+        let values = estimates(&d.scene, &settings, &ray, 2048);
         assert_unbiased(&format!("plane at {hit}"), &values, truth, 0.01);
         checked += 1;
     }
@@ -364,12 +378,16 @@ fn white_furnace_reflects_exactly_its_radiance_with_every_strategy() {
             for ray in furnace_rays() {
                 // The glossy patch (x > 0) sampled by light alone has a
                 // heavy-tailed estimate (its standard deviation is 5–9 times
-                // that with multiple importance sampling): more seeds.
+                // that with multiple importance sampling): more seeds, and
+                // the check sees a bias of 3% there, 2% elsewhere.
                 let glossy_without_mis = !mis && ray.origin.x > 0.0;
-                let seeds = if glossy_without_mis { 1500 } else { 400 };
+                let (seeds, detected_bias) = match glossy_without_mis {
+                    true => (12000, 0.03),
+                    false => (1600, 0.02),
+                };
                 let values = estimates(&d.scene, &settings, &ray, seeds);
                 let what = format!("{strategy:?}, mis {mis}, at x = {}", ray.origin.x);
-                assert_unbiased(&what, &values, 1.0, 0.02);
+                assert_unbiased(&what, &values, 1.0, detected_bias);
             }
         }
     }
@@ -387,7 +405,7 @@ fn white_furnace_under_the_environment() {
     let d = glint_scene::parse(&source, "furnace-environment").unwrap();
     let settings = with(&d.settings, |s| s.environment_samples = 16);
     for ray in furnace_rays().into_iter().filter(|r| r.origin.x < 0.0) {
-        let values = estimates(&d.scene, &settings, &ray, 100);
+        let values = estimates(&d.scene, &settings, &ray, 800);
         assert_unbiased(&format!("x = {}", ray.origin.x), &values, 1.0, 0.01);
     }
 }
@@ -425,7 +443,7 @@ fn sphere_light_over_a_plane_matches_the_point_light_of_its_power() {
             // The whole sphere is above the point's horizon: h > R.
             assert!(height > radius);
             let truth = 0.5 * radiance * radius * radius * height / distance.powi(3);
-            let values = estimates(&d.scene, &settings, &ray, 256);
+            let values = estimates(&d.scene, &settings, &ray, 2048);
             assert_unbiased(&format!("mis {mis} at {hit}"), &values, truth, 0.01);
         }
     }

@@ -120,6 +120,45 @@ fn mirror_sphere_in_the_environment_scene() {
     ]));
 }
 
+/// Physical shading on a glossy sphere whose lobe samples reach the light:
+/// every sample's light and lobe pdfs and the MIS weights between them.
+#[test]
+fn physical_glossy_highlight_with_its_mis_weights() {
+    let s = scene("physical-glossy");
+    let text = explain(&[
+        &s,
+        "--pixel",
+        "162,148",
+        "--spp",
+        "4",
+        "--light-samples",
+        "2",
+        "--all-samples",
+    ]);
+    assert!(text.contains("by specular lobe"), "{text}");
+    assert!(text.matches("MIS weight 0.").count() >= 4, "{text}");
+    insta::assert_snapshot!(text);
+}
+
+/// The physical Cornell box's floor: each light sample's solid-angle pdf,
+/// for two camera samples.
+#[test]
+fn cornell_physical_floor_with_its_light_pdfs() {
+    let s = scene("cornell-physical");
+    let text = explain(&[
+        &s,
+        "--pixel",
+        "300,420",
+        "--spp",
+        "2",
+        "--light-samples",
+        "4",
+        "--all-samples",
+    ]);
+    assert!(text.contains("light pdf 3"), "{text}");
+    insta::assert_snapshot!(text);
+}
+
 #[test]
 fn bunny_through_the_bvh() {
     let s = scene("bunny");

@@ -236,6 +236,36 @@ mod tests {
         film
     }
 
+    /// The film's 8-bit quantisation: each code's linear value, and where a
+    /// linear value starts to round to it (found by bisection on
+    /// [`linear_to_srgb8`]), to six significant digits.
+    #[test]
+    fn srgb8_codes_and_their_linear_boundaries() {
+        let first_linear_of = |code: u8| {
+            let (mut lo, mut hi) = (0.0f32, 1.0f32);
+            for _ in 0..64 {
+                let mid = 0.5 * (lo + hi);
+                match linear_to_srgb8(mid) < code {
+                    true => lo = mid,
+                    false => hi = mid,
+                }
+            }
+            hi
+        };
+        let mut text = String::from("code  linear       from\n");
+        for code in (0..=255u8).step_by(15).chain([1, 2, 254]) {
+            let linear = srgb_to_linear(code as f32 / 255.0);
+            assert_eq!(linear_to_srgb8(linear), code);
+            let from = if code == 0 {
+                0.0
+            } else {
+                first_linear_of(code)
+            };
+            text += &format!("{code:>4}  {linear:<11.5e}  {from:.5e}\n");
+        }
+        insta::assert_snapshot!(text);
+    }
+
     #[test]
     fn srgb_curve_matches_known_values() {
         assert_eq!(linear_to_srgb8(0.0), 0);

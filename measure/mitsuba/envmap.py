@@ -163,12 +163,12 @@ def main():
         import mitsuba as mi
     except ImportError:
         sys.exit("envmap.py: error: the mitsuba package is not installed (pip install mitsuba)")
-    if not args.glint.is_file():
-        sys.exit(f"envmap.py: error: no {args.glint}; build it: cargo build --release -p glint-cli")
     mi.set_variant("scalar_rgb")
     if args.mitsuba_render:  # xml envmap seed out, from render_mitsuba
         xml, envmap, seed, out = args.maps
         return mitsuba_render_here(mi, xml, envmap, int(str(seed)), out)
+    if not args.glint.is_file():
+        sys.exit(f"envmap.py: error: no {args.glint}; build it: cargo build --release -p glint-cli")
     print("| map | Glint / Mitsuba, map as is (R, G, B) | Glint / Mitsuba, rows resampled (R, G, B) |")
     print("|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:

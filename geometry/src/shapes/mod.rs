@@ -246,6 +246,65 @@ mod tests {
         }
     }
 
+    /// Parallelogram hits against Cramer's rule in f64, written apart from
+    /// the shape's own test: `o + t d = p + a e₁ + b e₂`, a hit where `t > 0`
+    /// and `a, b ∈ [0, 1]`. Rays within 1e-4 of an edge are left out (either
+    /// answer is right there); the rest must agree, `t` to 1e-5.
+    #[test]
+    fn parallelogram_hits_match_cramers_rule_in_f64() {
+        let (p, e1, e2) = (
+            Vec3::new(-1.0, -0.5, -4.0),
+            Vec3::new(2.0, 0.3, -0.4),
+            Vec3::new(-0.2, 1.5, 0.3),
+        );
+        let shape = Parallelogram::new(p, e1, e2, true).unwrap();
+        let f64s = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+        let det3 = |c0: [f64; 3], c1: [f64; 3], c2: [f64; 3]| {
+            c0[0] * (c1[1] * c2[2] - c1[2] * c2[1]) - c1[0] * (c0[1] * c2[2] - c0[2] * c2[1])
+                + c2[0] * (c0[1] * c1[2] - c0[2] * c1[1])
+        };
+        let (mut hits, mut compared) = (0, 0);
+        for i in 0..4000 {
+            let k = i as f32;
+            let origin = Vec3::new(0.1 * (k * 0.37).sin(), 0.1 * (k * 0.11).cos(), 0.5);
+            let target = Vec3::new(
+                -1.6 + (k * 0.618).fract() * 3.4,
+                -0.9 + (k * 0.382).fract() * 2.6,
+                -4.0,
+            );
+            let ray = Ray::new(origin, target - origin);
+            // o − p = −t d + a e₁ + b e₂.
+            let (d, rhs) = (f64s(ray.direction), f64s(ray.origin - p));
+            let minus_d = d.map(|x| -x);
+            let det = det3(minus_d, f64s(e1), f64s(e2));
+            let t = det3(rhs, f64s(e1), f64s(e2)) / det;
+            let a = det3(minus_d, rhs, f64s(e2)) / det;
+            let b = det3(minus_d, f64s(e1), rhs) / det;
+            let near_edge = [a, 1.0 - a, b, 1.0 - b].iter().any(|x| x.abs() < 1e-4);
+            if near_edge {
+                continue;
+            }
+            let expected =
+                (t > 0.0 && (0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)).then_some(t);
+            let got = Shape::from(shape)
+                .intersect(&ray, f32::INFINITY)
+                .map(|h| h.t as f64);
+            compared += 1;
+            match (expected, got) {
+                (Some(t), Some(got)) => {
+                    hits += 1;
+                    assert!((got - t).abs() <= 1e-5 * t, "ray {i}: t {got} against {t}");
+                }
+                (None, None) => {}
+                _ => panic!("ray {i} (a {a}, b {b}): {got:?} against {expected:?}"),
+            }
+        }
+        assert!(
+            hits > 1000 && compared - hits > 1000,
+            "{hits} hits of {compared}"
+        );
+    }
+
     #[test]
     fn sphere_far_from_origin_keeps_precision() {
         // A small sphere 10^4 units away: the naive b² − 4ac loses the hit entirely

@@ -275,14 +275,9 @@ fn luminance_and_cosine_sampling_agree_within_their_standard_errors() {
             })
             .collect()
     };
-    let stats = |m: &[f64]| {
-        let mean = m.iter().sum::<f64>() / m.len() as f64;
-        let var = m.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (m.len() - 1) as f64;
-        (mean, var / m.len() as f64)
-    };
-    let (lum, lum_var) = stats(&means(EnvironmentSampling::Luminance));
-    let (cos, cos_var) = stats(&means(EnvironmentSampling::Cosine));
-    let standard_error = (lum_var + cos_var).sqrt();
+    let (lum, lum_se) = mean_and_standard_error(&means(EnvironmentSampling::Luminance));
+    let (cos, cos_se) = mean_and_standard_error(&means(EnvironmentSampling::Cosine));
+    let standard_error = lum_se.hypot(cos_se);
     assert!(standard_error > 0.0 && standard_error < 1e-2 * lum);
     assert!(
         (lum - cos).abs() < 4.0 * standard_error,

@@ -246,23 +246,21 @@ mod tests {
         }
     }
 
-    /// Parallelogram hits against Cramer's rule in f64, written apart from
+    /// Parallelogram hits against Cramer's rule in f64 (glam's `DMat3`), apart from
     /// the shape's own test: `o + t d = p + a e₁ + b e₂`, a hit where `t > 0`
     /// and `a, b ∈ [0, 1]`. Rays within 1e-4 of an edge are left out (either
     /// answer is right there); the rest must agree, `t` to 1e-5.
     #[test]
     fn parallelogram_hits_match_cramers_rule_in_f64() {
+        use glam::{DMat3, DVec3};
         let (p, e1, e2) = (
             Vec3::new(-1.0, -0.5, -4.0),
             Vec3::new(2.0, 0.3, -0.4),
             Vec3::new(-0.2, 1.5, 0.3),
         );
         let shape = Parallelogram::new(p, e1, e2, true).unwrap();
-        let f64s = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
-        let det3 = |c0: [f64; 3], c1: [f64; 3], c2: [f64; 3]| {
-            c0[0] * (c1[1] * c2[2] - c1[2] * c2[1]) - c1[0] * (c0[1] * c2[2] - c0[2] * c2[1])
-                + c2[0] * (c0[1] * c1[2] - c0[2] * c1[1])
-        };
+        let det3 = |c0: DVec3, c1: DVec3, c2: DVec3| DMat3::from_cols(c0, c1, c2).determinant();
+        let (e1, e2) = (e1.as_dvec3(), e2.as_dvec3());
         let (mut hits, mut compared) = (0, 0);
         for i in 0..4000 {
             let k = i as f32;
@@ -274,12 +272,11 @@ mod tests {
             );
             let ray = Ray::new(origin, target - origin);
             // o − p = −t d + a e₁ + b e₂.
-            let (d, rhs) = (f64s(ray.direction), f64s(ray.origin - p));
-            let minus_d = d.map(|x| -x);
-            let det = det3(minus_d, f64s(e1), f64s(e2));
-            let t = det3(rhs, f64s(e1), f64s(e2)) / det;
-            let a = det3(minus_d, rhs, f64s(e2)) / det;
-            let b = det3(minus_d, f64s(e1), rhs) / det;
+            let (minus_d, rhs) = (-ray.direction.as_dvec3(), (ray.origin - p).as_dvec3());
+            let det = det3(minus_d, e1, e2);
+            let t = det3(rhs, e1, e2) / det;
+            let a = det3(minus_d, rhs, e2) / det;
+            let b = det3(minus_d, e1, rhs) / det;
             let near_edge = [a, 1.0 - a, b, 1.0 - b].iter().any(|x| x.abs() < 1e-4);
             if near_edge {
                 continue;

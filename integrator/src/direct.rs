@@ -1,16 +1,27 @@
 //! The direct-lighting integrator: the radiance of camera samples, shaded
 //! [`LANES`] at once.
 //!
-//! The route from a camera sample to its radiance, one file a step:
-//! [`DirectIntegrator::li`] (one ray) or the render's chunks give the first
-//! hits to `li_first_hits`, whose wave (`wave.rs`) sends misses to the
-//! environment, emitters to their radiance and surfaces to
-//! `local_shading_lanes`; `with_direct_lighting` (`shade.rs`) adds ambient,
-//! each light's samples and the environment's, drawn where each lane's
-//! camera sample alone draws them (`points.rs`), through the surface points
-//! set up once for all of them and their shadow test (`shaded_lanes.rs`,
-//! their reflectances from `surfaces.rs`); lanes on mirrors reflect into the
-//! next wave. `events.rs` shows each step to a tracer (`glint explain`);
+//! The route from a camera sample to its radiance is seven calls, one file a
+//! step (pbrt-v4's `Render` → `EvaluatePixelSample` → `Li` → `SampleLd`, in
+//! lanes):
+//!
+//! 1. `render_rows` (`render.rs`, a tile's rows) →
+//!    `PixelRenderer::pixel` (its pixel's chunks of [`LANES`] samples) →
+//!    `chunk_values` (their camera rays and closest hits, the first [`Wave`]);
+//! 2. → [`DirectIntegrator::li_wave`] (`wave.rs`): misses see the
+//!    environment, emitters give their radiance, surfaces get their shading
+//!    points (ambient included) and mirrors reflect into the next wave;
+//! 3. → `with_direct_lighting` (`shade.rs`): each light's term and the
+//!    environment's, in the order the one-ray integrator adds them;
+//! 4. → `area_light_term`: a light's N samples, each lane's drawn where its
+//!    camera sample alone draws them (`points.rs`) →
+//!    `ShadedLanes::area_light` (`shaded_lanes.rs`, the points set up once
+//!    for all samples, their reflectances from `surfaces.rs`): one sample's
+//!    light point and Phong reflection in lanes →
+//!    `ShadedLanes::unoccluded`: its shadow rays, traced as one batch.
+//!
+//! [`DirectIntegrator::li`] (one ray) enters the same route at step 2, in one
+//! lane. `events.rs` shows each step to a tracer (`glint explain`);
 //! `tests.rs` holds each lane to the integrator one ray at a time.
 //!
 //! The lanes are the camera samples: the [`LANES`] samples of a pixel (or,
@@ -63,6 +74,7 @@ mod tests;
 pub(crate) mod wave;
 
 pub(crate) use points::PairAllocation;
+pub(crate) use wave::Wave;
 
 use crate::context::SampleContext;
 use crate::sampling::LaneSamples;
@@ -117,8 +129,8 @@ impl DirectIntegrator {
         let closest = scene.shapes.closest_lanes(&rays, 1);
         let samples = LaneSamples::of_pixel(ctx.sample);
         let footprints = scene.needs_differentials().then_some(&diffs);
-        self.li_first_hits(scene, &rays, footprints, &closest, 1, &samples, ctx)
-            .lane(0)
+        let wave = Wave::first(&rays, footprints, &closest, 1);
+        (self.li_wave(scene, wave, &mut self.lane_streams(&samples), ctx)).lane(0)
     }
 
     /// The integrator `settings` describe (their sample counts, patterns and

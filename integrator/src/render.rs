@@ -1,5 +1,6 @@
 use crate::context::SampleContext;
 use crate::counters::{ShadingCounters, TextureCounters};
+use crate::direct::Wave;
 use crate::sampling::{pixel_rng, LaneSamples, PixelSample, SobolPoints, PIXEL_STREAM};
 use crate::settings::{Crop, RenderSettings, SettingsError};
 use crate::trace::{Event, Tracer};
@@ -470,17 +471,21 @@ impl<'a> PixelRenderer<'a> {
     ) -> Vec3Lanes {
         let (scene, integrator, used) = (self.scene, self.integrator, chunk.jitters.len());
         let (rays, diffs) = self.camera_rays(chunk);
-        let samples = &chunk.samples;
-        let Some(diffs) = diffs else {
-            let closest = scene.shapes.closest_lanes_among(&rays, used, candidates);
-            return integrator.li_first_hits(scene, &rays, None, &closest, used, samples, ctx);
+        let closest = match &diffs {
+            None => scene.shapes.closest_lanes_among(&rays, used, candidates),
+            Some(diffs) if self.settings.aov.is_some() => {
+                return self.samples_one_by_one(chunk, (&rays, diffs));
+            }
+            Some(_) => scene.shapes.closest_lanes(&rays, used),
         };
-        if self.settings.aov.is_some() {
-            return self.samples_one_by_one(chunk, (&rays, &diffs));
-        }
-        let closest = scene.shapes.closest_lanes(&rays, used);
-        let footprints = self.differentials.then_some(&diffs);
-        integrator.li_first_hits(scene, &rays, footprints, &closest, used, samples, ctx)
+        let footprints = diffs.as_ref().filter(|_| self.differentials);
+        let wave = Wave::first(&rays, footprints, &closest, used);
+        integrator.li_wave(
+            scene,
+            wave,
+            &mut integrator.lane_streams(&chunk.samples),
+            ctx,
+        )
     }
 
     /// Each of a chunk's camera samples' AOV, from its ray and

@@ -13,6 +13,19 @@ use glam::Vec2;
 use glint_geometry::lanes::{self, F32Lanes, Float, LANES};
 
 impl DirectIntegrator {
+    /// The camera samples `samples` of a chunk's lanes with each lane's own
+    /// stream, as `SampleContext::begin_sample` makes it, where a pattern
+    /// draws from it (grid and Sobol points draw nothing).
+    pub(crate) fn lane_streams<'s>(&self, samples: &'s LaneSamples) -> LaneStreams<'s> {
+        let draws = |pattern| matches!(pattern, SamplePattern::Random | SamplePattern::Stratified);
+        LaneStreams {
+            samples,
+            live: 0,
+            rngs: (draws(self.light_pattern) || draws(self.environment_pattern))
+                .then(|| Pcg32Lanes::new(samples.stream_seeds())),
+        }
+    }
+
     /// Each lane's points of `pair` for the lights or the environment, as
     /// its camera sample takes them alone, the lanes `drawing` drawing from
     /// their streams where the pattern draws ([`LanePoints`]).

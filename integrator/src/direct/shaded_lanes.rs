@@ -152,9 +152,8 @@ impl<'a> ShadedLanes<'a> {
     /// and `radiance` its ambient part.
     pub(crate) fn on_one_object<T: Tracer>(
         scene: &'a Scene,
-        rays: &RayLanes,
-        closest: &ClosestLanes,
-        hit_lanes: u32,
+        (rays, closest): (&RayLanes, &ClosestLanes),
+        (hit_lanes, depth): (u32, u32),
         (object, shape, material): (u32, &Shape, &'a PhongMaterial),
         radiance: &mut Vec3Lanes,
         ctx: &mut SampleContext<T>,
@@ -199,7 +198,7 @@ impl<'a> ShadedLanes<'a> {
             phong: PhongLanes::of_lanes(hit_lanes, material, &kd, &ks, &n, &v, specular),
             object: Some(object),
             objects: [object; LANES],
-            depth: 0,
+            depth,
         }
     }
 

@@ -154,7 +154,7 @@ fn checks_over_footprints(scene: &mut Scene) {
     });
 }
 
-/// Every lane of [`DirectIntegrator::li_first_hits`] against `li_at` for
+/// Every lane of the first [`DirectIntegrator::li_wave`] against `li_at` for
 /// its sample alone, bit for bit, radiance and counts, over every pixel
 /// of `scene` and several shapes of chunk; the samples compared, with
 /// the counts added to `total` and the chunks' kinds to `common`.
@@ -213,15 +213,9 @@ fn compare_lanes_with_scalar(
                 pixels: std::array::from_fn(|run| pixel + 1000 * run as u64),
             };
             lanes.counters = ShadingCounters::default();
-            let values = integrator.li_first_hits(
-                scene,
-                &ray_lanes,
-                footprints.then_some(&diffs),
-                &closest,
-                used,
-                &samples,
-                &mut lanes,
-            );
+            let wave = Wave::first(&ray_lanes, footprints.then_some(&diffs), &closest, used);
+            let mut streams = integrator.lane_streams(&samples);
+            let values = integrator.li_wave(scene, wave, &mut streams, &mut lanes);
             let mut scalar = SampleContext::new(light_samples, integrator.environment_samples);
             for (k, ray) in rays.iter().enumerate().take(used) {
                 let sample = samples.lane(k);

@@ -5,7 +5,6 @@
 use super::points::LaneStreams;
 use super::shaded_lanes::ShadedLanes;
 use crate::context::SampleContext;
-use crate::sampling::{LaneSamples, Pcg32Lanes, SamplePattern};
 use crate::trace::{Event, Tracer};
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes, LANES};
@@ -16,41 +15,6 @@ use glint_geometry::{
 use glint_lighting::{AreaLight, Light, PhongMaterial, ShadingModel};
 
 impl DirectIntegrator {
-    /// The radiance of the first `used` of [`LANES`] camera samples, lane k
-    /// sample `samples.lane(k)`, whose camera rays `rays` (with their
-    /// differentials `diffs` where the scene reads footprints) have the
-    /// closest hits `closest`: for each, what `li_at` gives it alone (with
-    /// [`SampleContext::begin_sample`] for that sample), bit for bit.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn li_first_hits<T: Tracer>(
-        &self,
-        scene: &Scene,
-        rays: &RayLanes,
-        diffs: Option<&[RayDifferential; LANES]>,
-        closest: &ClosestLanes,
-        used: usize,
-        samples: &LaneSamples,
-        ctx: &mut SampleContext<T>,
-    ) -> Vec3Lanes {
-        // Each lane's own stream, as `SampleContext::begin_sample` makes it,
-        // where a pattern draws from it (grid and Sobol points draw nothing).
-        let draws = |pattern| matches!(pattern, SamplePattern::Random | SamplePattern::Stratified);
-        let mut streams = LaneStreams {
-            samples,
-            live: 0,
-            rngs: (draws(self.light_pattern) || draws(self.environment_pattern))
-                .then(|| Pcg32Lanes::new(samples.stream_seeds())),
-        };
-        let wave = Wave {
-            rays,
-            diffs,
-            closest,
-            lanes: (1 << used) - 1,
-            depth: 0,
-        };
-        self.li_wave(scene, wave, &mut streams, ctx)
-    }
-
     /// `li_at` for every lane of `wave`, `wave.depth` reflections deep, for
     /// the lanes' camera samples (`streams`): misses read the environment, emitters give their
     /// radiance, and surfaces their local shading and, on a mirror, the
@@ -83,13 +47,29 @@ impl DirectIntegrator {
             true => hits,
             false => FirstHits::of(scene, wave.closest, local),
         };
-        let on = (local, hits);
         // Of the lanes that draw no points for a term, only these go on
         // to draw later (for another term, or a next wave).
         streams.live = hit_lanes;
-        let shaded = match local {
-            0 => 0,
-            _ => self.local_shading_lanes(scene, &wave, on, streams, &mut radiance, ctx),
+        let shaded = match hits {
+            _ if local == 0 => 0,
+            FirstHits::OnOneEmitter(area) => {
+                ctx.tracer.record(local, |_| Event::Emitter {
+                    radiance: area.color,
+                });
+                let color = Vec3Lanes::splat(area.color);
+                radiance = Vec3Lanes::select(lanes::from_bits(local), &color, &radiance);
+                0
+            }
+            hits => {
+                let shaded = surface_lanes(scene, &wave, (local, hits), &mut radiance, ctx);
+                if T::ON {
+                    wave.trace_surfaces(scene, &shaded, &radiance, ctx);
+                }
+                if shaded.lanes != 0 {
+                    radiance = self.with_direct_lighting(scene, &shaded, streams, radiance, ctx);
+                }
+                shaded.lanes
+            }
         };
         // `li_at`'s `(1 − r)·local + r·mirror` on every surface: a zero
         // mirror term on all but mirrors (which turns a −0 to +0 there too),
@@ -158,52 +138,6 @@ impl DirectIntegrator {
         radiance
     }
 
-    /// The lanes of `local`, on surfaces (`hits`), shaded: an emitter's
-    /// radiance, or a material's ambient term, lights and environment
-    /// (`li_at`'s local shading), put in `radiance`. The lanes shaded on a
-    /// material are returned.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
-    pub(crate) fn local_shading_lanes<T: Tracer>(
-        &self,
-        scene: &Scene,
-        wave: &Wave,
-        (local, hits): (u32, FirstHits),
-        streams: &mut LaneStreams,
-        radiance: &mut Vec3Lanes,
-        ctx: &mut SampleContext<T>,
-    ) -> u32 {
-        let (rays, closest) = (wave.rays, wave.closest);
-        // Each arm builds the lanes in place: made over a default, or moved
-        // out of an `Option`, their kilobytes cost a zeroing or a copy a chunk.
-        let mut shaded = match hits {
-            FirstHits::OnOneObject(object, shape, material) => {
-                let on = (object, shape, material);
-                ShadedLanes::on_one_object(scene, rays, closest, local, on, radiance, ctx)
-            }
-            FirstHits::OnOneEmitter(area) => {
-                ctx.tracer.record(local, |_| Event::Emitter {
-                    radiance: area.color,
-                });
-                let color = Vec3Lanes::splat(area.color);
-                *radiance = Vec3Lanes::select(lanes::from_bits(local), &color, radiance);
-                return 0;
-            }
-            FirstHits::Several => {
-                let hits = (rays, wave.diffs, closest);
-                ShadedLanes::one_by_one(scene, hits, (local, wave.depth), radiance, ctx)
-            }
-        };
-        shaded.depth = wave.depth;
-        if T::ON {
-            wave.trace_surfaces(scene, &shaded, radiance, ctx);
-        }
-        if shaded.lanes != 0 {
-            *radiance = self.with_direct_lighting(scene, &shaded, streams, *radiance, ctx);
-        }
-        shaded.lanes
-    }
-
     /// The radiance along the rays the lanes `traced` of `wave` reflect
     /// into, on mirrors, found as the next wave one reflection deeper: the
     /// rays made in their own lanes ([`reflected_rays`]), their closest hits
@@ -232,6 +166,33 @@ impl DirectIntegrator {
             depth: wave.depth + 1,
         };
         self.li_wave(scene, next, streams, ctx)
+    }
+}
+
+/// The shading points of the lanes `local` of `wave`, on surfaces (`hits`,
+/// one object's all at once, else one by one), each lane's ambient term (or
+/// an emitter's radiance, set one by one) put in `radiance`.
+#[inline(always)]
+fn surface_lanes<'s, T: Tracer>(
+    scene: &'s Scene,
+    wave: &Wave,
+    (local, hits): (u32, FirstHits<'s>),
+    radiance: &mut Vec3Lanes,
+    ctx: &mut SampleContext<T>,
+) -> ShadedLanes<'s> {
+    let (rays, closest, depth) = (wave.rays, wave.closest, wave.depth);
+    // Each arm builds the lanes in place, as the value returned: made over a
+    // default, moved out of an `Option` or out of a local, their kilobytes
+    // cost a zeroing or a copy a chunk.
+    match hits {
+        FirstHits::OnOneObject(object, shape, material) => {
+            let on = (object, shape, material);
+            ShadedLanes::on_one_object(scene, (rays, closest), (local, depth), on, radiance, ctx)
+        }
+        FirstHits::OnOneEmitter(_) | FirstHits::Several => {
+            let hits = (rays, wave.diffs, closest);
+            ShadedLanes::one_by_one(scene, hits, (local, depth), radiance, ctx)
+        }
     }
 }
 
@@ -315,6 +276,26 @@ pub(crate) struct Wave<'a> {
     pub(crate) closest: &'a ClosestLanes,
     pub(crate) lanes: u32,
     pub(crate) depth: u32,
+}
+
+impl<'a> Wave<'a> {
+    /// The first wave: camera rays `rays` in the first `used` lanes, with
+    /// their differentials `diffs` where the scene reads footprints, and
+    /// their closest hits `closest`.
+    pub(crate) fn first(
+        rays: &'a RayLanes,
+        diffs: Option<&'a [RayDifferential; LANES]>,
+        closest: &'a ClosestLanes,
+        used: usize,
+    ) -> Self {
+        Self {
+            rays,
+            diffs,
+            closest,
+            lanes: (1 << used) - 1,
+            depth: 0,
+        }
+    }
 }
 
 /// The hit lanes of a wave on mirrors: each one's reflectivity `r` (zero

@@ -9,8 +9,6 @@ mod point;
 #[cfg(test)]
 mod tests;
 
-use point::{drawn_together, LANES_FROM_SAMPLES};
-
 use crate::context::SampleContext;
 use crate::direct::wave::mirror_ray;
 use crate::direct::PairAllocation;
@@ -20,7 +18,9 @@ use crate::texture_lookup::texture_footprint;
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::Vec3;
 use glint_geometry::{Hit, Occluders, Ray, RayDifferential, RayTarget};
-use glint_lighting::{AreaLight, Light, PhongMaterial, ShadingModel, SphereLight};
+use glint_lighting::{
+    AreaLight, EnvironmentSampling, Light, PhongMaterial, ShadingModel, SphereLight,
+};
 
 impl DirectIntegrator {
     /// Radiance arriving along `ray` (a camera ray, or a reflection ray `depth`
@@ -268,16 +268,16 @@ impl DirectIntegrator {
         let Some(env) = &scene.environment else {
             return Vec3::ZERO;
         };
-        let n = self.environment_samples as usize;
-        ctx.counters.environment_samples += n as u64;
-        let one_by_one = n < LANES_FROM_SAMPLES;
+        ctx.counters.environment_samples += u64::from(self.environment_samples);
         let mut sum = Vec3::ZERO;
         let mut samples = std::mem::take(&mut ctx.environment_points);
         ctx.fill_points(self.environment_pattern, pair, &mut samples);
-        for chunk in samples.chunks() {
-            let drawn = drawn_together(env, self.environment_sampling, point.n, &chunk);
-            let drawn = &drawn[..chunk.len];
-            point.add_environment_samples(scene, drawn, one_by_one, &mut sum, ctx);
+        for u in samples.iter() {
+            let s = match self.environment_sampling {
+                EnvironmentSampling::Luminance => env.sample(point.n, u),
+                EnvironmentSampling::Cosine => env.sample_cosine(point.n, u),
+            };
+            sum += point.environment_sample(scene, &s, ctx);
         }
         ctx.environment_points = samples;
         sum / self.environment_samples as f32
@@ -336,19 +336,12 @@ impl DirectIntegrator {
         let mis = self.mis && point.has_specular;
         let samples = self.draw_light_points(pair, ctx);
         let occluders = self.occluders(scene, point, index);
-        let mut sum = if samples.len() < LANES_FROM_SAMPLES {
-            let mut sum = Vec3::ZERO;
-            for u in samples.iter() {
-                let s = sampler.sample(u);
-                let target = light.shadow_target(s.point);
-                sum += point.light_sample(scene, &target, s.pdf, mis, &occluders, ctx);
-            }
-            sum
-        } else {
-            point.light_samples_shadowed_in_lanes(
-                scene, light, &sampler, &samples, mis, &occluders, ctx,
-            )
-        };
+        let mut sum = Vec3::ZERO;
+        for u in samples.iter() {
+            let s = sampler.sample(u);
+            let target = light.shadow_target(s.point);
+            sum += point.light_sample(scene, &target, s.pdf, mis, &occluders, ctx);
+        }
         ctx.light_points = samples;
         if mis {
             sum += self.lobe_samples(scene, point, index, depth, |y| sampler.pdf(y), ctx);

@@ -250,24 +250,30 @@ fn lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
     // each mirror's reflections, with their differentials, the next wave.
     // With mirrors, reflections are followed four deep, or one (a
     // mirror seen in a mirror is then black).
-    for (pattern, light_samples, footprints, sky_and_mirrors, max_depth) in [
-        (SamplePattern::Random, 1, false, false, 4),
-        (SamplePattern::Stratified, 1, false, false, 4),
-        (SamplePattern::Sobol, 1, false, false, 4),
-        (SamplePattern::Grid, 1, false, false, 4),
-        (SamplePattern::Random, 3, false, false, 4),
-        (SamplePattern::Sobol, 5, false, false, 4),
-        (SamplePattern::Grid, 4, false, false, 4),
-        (SamplePattern::Sobol, 1, true, false, 4),
-        (SamplePattern::Random, 4, true, false, 4),
-        (SamplePattern::Random, 1, false, true, 4),
-        (SamplePattern::Sobol, 4, true, true, 4),
-        (SamplePattern::Random, 3, false, true, 1),
+    use glint_lighting::EnvironmentSampling::{Cosine, Luminance};
+    // (light pattern, light samples, footprints, sky and mirrors, depth,
+    // environment sampling)
+    for (pattern, light_samples, footprints, sky_and_mirrors, max_depth, sampling) in [
+        (SamplePattern::Random, 1, false, false, 4, Luminance),
+        (SamplePattern::Stratified, 1, false, false, 4, Luminance),
+        (SamplePattern::Sobol, 1, false, false, 4, Luminance),
+        (SamplePattern::Grid, 1, false, false, 4, Luminance),
+        (SamplePattern::Random, 3, false, false, 4, Luminance),
+        (SamplePattern::Sobol, 5, false, false, 4, Luminance),
+        (SamplePattern::Grid, 4, false, false, 4, Luminance),
+        (SamplePattern::Sobol, 1, true, false, 4, Luminance),
+        (SamplePattern::Random, 4, true, false, 4, Luminance),
+        (SamplePattern::Random, 1, false, true, 4, Luminance),
+        (SamplePattern::Sobol, 4, true, true, 4, Luminance),
+        (SamplePattern::Random, 3, false, true, 1, Luminance),
         // Stratified points of a square count, and of another (a Latin
         // hypercube), drawn lane by lane; the grid's under the sky.
-        (SamplePattern::Stratified, 4, false, false, 4),
-        (SamplePattern::Stratified, 3, true, true, 4),
-        (SamplePattern::Grid, 4, false, true, 4),
+        (SamplePattern::Stratified, 4, false, false, 4, Luminance),
+        (SamplePattern::Stratified, 3, true, true, 4, Luminance),
+        (SamplePattern::Grid, 4, false, true, 4, Luminance),
+        // Directions cosine-weighted about each normal, one and several.
+        (SamplePattern::Sobol, 1, false, true, 4, Cosine),
+        (SamplePattern::Random, 3, true, true, 4, Cosine),
     ] {
         let mut scene = match sky_and_mirrors {
             false => room(),
@@ -308,7 +314,7 @@ fn lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
                 true => pattern,
                 false => SamplePattern::Sobol,
             },
-            environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
+            environment_sampling: sampling,
             max_depth,
             area_sampling: glint_lighting::AreaSampling::Auto,
             mis: true,
@@ -404,6 +410,7 @@ fn reflected_rays_are_mirror_rays() {
 #[test]
 fn physical_lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
     use glint_lighting::AreaSampling;
+    use glint_lighting::EnvironmentSampling::{Cosine, Luminance};
     let (mut total, mut common) = (ShadingCounters::default(), [0; 3]);
     // Glossy rooms also hold a point light and a sphere light; their
     // materials take every kind of lobe (Phong's with integral and
@@ -419,7 +426,8 @@ fn physical_lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
         })
     };
     // (light pattern, light samples, footprints, area sampling,
-    // environment samples, mirrors, glossy)
+    // environment samples, mirrors, glossy); the environment sampled by
+    // luminance, or where the cosine is named, by the cosine about each normal.
     #[rustfmt::skip]
     let cases = [
         (SamplePattern::Sobol, 1, false, AreaSampling::Auto, 0, false, false),
@@ -445,9 +453,47 @@ fn physical_lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
         (SamplePattern::Stratified, 3, false, AreaSampling::Auto, 0, true, true),
         (SamplePattern::Stratified, 1, false, AreaSampling::Auto, 2, true, true),
     ];
-    for (pattern, light_samples, footprints, area_sampling, environment_samples, mirrors, glossy) in
-        cases
-    {
+    let cosine_cases = [
+        (
+            SamplePattern::Sobol,
+            1,
+            false,
+            AreaSampling::Auto,
+            1,
+            false,
+            false,
+        ),
+        (
+            SamplePattern::Sobol,
+            4,
+            true,
+            AreaSampling::Auto,
+            5,
+            true,
+            true,
+        ),
+        (
+            SamplePattern::Random,
+            2,
+            false,
+            AreaSampling::Area,
+            3,
+            true,
+            false,
+        ),
+    ];
+    let cases =
+        (cases.iter().map(|&c| (c, Luminance))).chain(cosine_cases.iter().map(|&c| (c, Cosine)));
+    for (case, sampling) in cases {
+        let (
+            pattern,
+            light_samples,
+            footprints,
+            area_sampling,
+            environment_samples,
+            mirrors,
+            glossy,
+        ) = case;
         let mut scene = if glossy { glossy_room() } else { room() };
         scene.shading = ShadingModel::Physical;
         if environment_samples > 0 {
@@ -474,7 +520,7 @@ fn physical_lanes_give_each_samples_radiance_and_counts_bit_for_bit() {
                 true => pattern,
                 false => SamplePattern::Sobol,
             },
-            environment_sampling: glint_lighting::EnvironmentSampling::Luminance,
+            environment_sampling: sampling,
             max_depth: 4,
             area_sampling,
             mis: true,

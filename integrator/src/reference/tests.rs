@@ -1,10 +1,14 @@
-//! The reference's own lanes against its one-by-one sums.
+//! The light samples in lanes ([`LightSampleLanes`], the render's kernel
+//! for a shading point's area-light samples) against the reference's sums
+//! of one sample at a time.
 
 use super::*;
+use crate::light_samples::{count_lanes, LightSampleLanes};
 use crate::{SceneBuilder, SurfaceKind};
 use glam::{UVec2, Vec2};
 use glint_camera::Camera;
-use glint_geometry::{Parallelogram, Ray, Sphere};
+use glint_geometry::lanes::{self, F32Lanes, Vec3Lanes};
+use glint_geometry::{offset_ray_origin, Parallelogram, Ray, RayLanes, Sphere};
 use glint_lighting::{Light, PhongMaterial, SpecularLobe};
 use glint_texture::{TexCoord, Texture};
 
@@ -46,8 +50,52 @@ fn scene(material: PhongMaterial) -> crate::Scene {
     b.build(camera).unwrap()
 }
 
+/// [`ShadingPoint::area_light_sum`] with [`LANES`](glint_geometry::lanes::LANES)
+/// samples at a time in lanes, as the render shades them: each chunk's light
+/// points, reflections and horizon tests in [`LightSampleLanes`], its
+/// shadow rays traced together from the point offset to the side each
+/// leaves on, each lane's value added in order.
+fn area_light_sum_in_lanes(
+    point: &ShadingPoint,
+    scene: &Scene,
+    light: &AreaLight,
+    samples: &SamplePoints,
+    (occluders, ctx): (&Occluders, &mut SampleContext),
+) -> Vec3 {
+    let (x, error, g) = (point.hit.point, point.hit.error, point.hit.geometric_normal);
+    let front = Vec3Lanes::splat(offset_ray_origin(x, error, g));
+    let back = Vec3Lanes::splat(offset_ray_origin(x, error, -g));
+    let (receiver, ng) = (Vec3Lanes::splat(x), Vec3Lanes::splat(point.ng));
+    let specular = if point.has_specular { u32::MAX } else { 0 };
+    let reflect = |l: &Vec3Lanes| {
+        let (kd, ks, n, v) = (point.kd, point.ks, point.n, point.v);
+        point
+            .material
+            .reflect_lanes(kd, ks, n, l, v, point.has_specular)
+    };
+    let mut sum = Vec3::ZERO;
+    for chunk in samples.chunks() {
+        let used = chunk.used();
+        let u = (chunk.lanes.x, chunk.lanes.y);
+        let s = LightSampleLanes::new(light, u, &receiver, &ng, used, reflect);
+        count_lanes(&mut ctx.counters, used, s.lit, s.shaded, s.traced, specular);
+        let from_back = lanes::lt(s.towards.dot_splat(g), F32Lanes::ZERO);
+        let origin = Vec3Lanes::select(from_back, &back, &front);
+        let direction = light.shadow_ends(&s.position) - origin;
+        let rays = RayLanes { origin, direction };
+        let visible = s.traced & !scene.shapes.any_hits_among(occluders, &rays, 1.0, s.traced);
+        for k in lanes::each_set(s.lit) {
+            sum += match visible >> k & 1 {
+                1 => s.reflected.lane(k),
+                _ => Vec3::ZERO,
+            };
+        }
+    }
+    sum
+}
+
 #[test]
-fn eight_lanes_give_the_one_by_one_sum_and_counts_bit_for_bit() {
+fn light_samples_in_lanes_give_the_one_by_one_sum_and_counts_bit_for_bit() {
     let materials = [
         PhongMaterial::new(Vec3::new(0.7, 0.4, 0.2), 16.0),
         PhongMaterial::new(Vec3::new(0.7, 0.4, 0.2), 7.5),
@@ -104,14 +152,9 @@ fn eight_lanes_give_the_one_by_one_sum_and_counts_bit_for_bit() {
                 for occluders in [Occluders::ALL, culled] {
                     let mut lanes = SampleContext::new(0, 0);
                     let mut scalar = SampleContext::new(0, 0);
-                    let a = point.area_light_sum(&scene, light, &samples, &occluders, &mut lanes);
-                    let b = point.area_light_sum_one_by_one(
-                        &scene,
-                        light,
-                        &samples,
-                        &occluders,
-                        &mut scalar,
-                    );
+                    let in_lanes = (&occluders, &mut lanes);
+                    let a = area_light_sum_in_lanes(&point, &scene, light, &samples, in_lanes);
+                    let b = point.area_light_sum(&scene, light, &samples, &occluders, &mut scalar);
                     assert_eq!(
                         a.to_array().map(f32::to_bits),
                         b.to_array().map(f32::to_bits),

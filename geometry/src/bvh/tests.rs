@@ -24,30 +24,42 @@ fn binary_depth(bounds: &[Bounds3], options: BuildOptions) -> usize {
     depth(&nodes, 0)
 }
 
+/// The tree over each scene against the same tree built by object medians
+/// alone (a depth limit of [`halvings_to_leaf`] forces median splits all the
+/// way down), in SAH cost: at most `bound` times its cost. Where boxes are
+/// apart, planes between them pay: SAH must win by the stated margin. Where
+/// every box overlaps most others, no plane separates anything and the
+/// greedy binary SAH has nothing to win; its unbalanced splits then collapse
+/// into about a quarter more wide nodes than the balanced median tree (115
+/// against 89 here), and it comes out up to 4.5 % worse (−0.1 % to 4.5 % over
+/// six seeds of this scene).
 #[test]
 fn stats_of_deterministic_scenes() {
     let scenes = [
         (
             "jittered grid, 1000 small boxes",
             jittered_grid(10, 0x9E37_79B9_7F4A_7C15),
+            0.96,
+        ),
+        (
+            "5000 small boxes apart",
+            random_boxes(5000, 10.0, 0.05, 0.5, 3),
+            0.85,
         ),
         (
             "1000 overlapping boxes",
             random_boxes(1000, 10.0, 0.5, 4.0, 99),
+            1.05,
         ),
     ];
     let mut report = String::new();
-    for (name, bounds) in scenes {
+    for (name, bounds, bound) in scenes {
         let bvh = Bvh::build(&bounds);
         check_invariants(&bvh, &bounds);
         let s = bvh.stats();
-        // Leaves of at most 4 need at least 250 of them, so with at most four
-        // children per node, depth ≥ 4.
+        // Leaves of at most 4 need at least n/4 of them, so with at most four
+        // children per node, depth ≥ log4(n/4).
         assert!((4..=24).contains(&s.max_depth), "{name}: {s:?}");
-        // SAH must not lose to the same tree built by object medians alone (a
-        // depth limit of 8 forces median splits all the way down). The build
-        // minimises the binary tree's cost, and collapsing can shift it a
-        // little: on heavily overlapping boxes the two come within a few percent.
         let median = Bvh::build_with(
             &bounds,
             BuildOptions {
@@ -58,8 +70,8 @@ fn stats_of_deterministic_scenes() {
         check_invariants(&median, &bounds);
         let median_cost = median.stats().sah_cost;
         assert!(
-            s.sah_cost < 1.05 * median_cost,
-            "{name}: {s:?} vs {median_cost}"
+            s.sah_cost < bound * median_cost,
+            "{name}: {s:?} against the medians' {median_cost}, over {bound}×"
         );
         writeln!(
             report,

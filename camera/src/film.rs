@@ -75,6 +75,18 @@ impl Film {
         }
     }
 
+    /// A film of `resolution` holding `pixels` (row-major from the top-left
+    /// corner), or `None` where their count is not `width × height`.
+    pub fn from_pixels(resolution: UVec2, pixels: Vec<Vec3>) -> Option<Self> {
+        let count = resolution.x as usize * resolution.y as usize;
+        (pixels.len() == count).then_some(Self { resolution, pixels })
+    }
+
+    /// The pixels, row-major from the top-left corner, handed back.
+    pub fn into_pixels(self) -> Vec<Vec3> {
+        self.pixels
+    }
+
     pub fn resolution(&self) -> UVec2 {
         self.resolution
     }
@@ -123,6 +135,14 @@ impl Film {
             source,
         };
         self.stage(path)?.persist().map_err(io_err)
+    }
+
+    /// The film encoded as a file of `format` would hold it: the bytes
+    /// [`Film::save`] writes.
+    pub fn to_bytes(&self, format: ImageFormat) -> Result<Vec<u8>, FilmError> {
+        let mut out = std::io::Cursor::new(Vec::new());
+        self.encode(format, &mut out, Path::new("(in memory)"))?;
+        Ok(out.into_inner())
     }
 
     /// [`Film::save`] up to putting the file in place

@@ -10,7 +10,7 @@ use glint_integrator::{
     Aov, AreaSampling, Crop, EnvironmentSampling, RenderControl, RenderSettings, SamplePattern,
     TextureLevel,
 };
-use glint_scene::SceneDescription;
+use glint_scene::{OverrideError, Overrides, SceneDescription};
 use glint_texture::TextureFilter;
 use std::path::{Path, PathBuf};
 
@@ -635,74 +635,33 @@ impl SceneArgs {
     pub(crate) fn load(&self) -> Result<SceneDescription, Failure> {
         let mut description =
             glint_scene::load(&self.scene).map_err(|e| Failure::Input(e.to_string()))?;
-        self.apply_overrides(&mut description.settings);
-        let scene = &mut description.scene;
-        // The map's distribution is part of loading it, not of the render.
-        let start = std::time::Instant::now();
-        scene.prepare(&description.settings);
-        description.timings.assets += start.elapsed();
-        if let Some(filter) = self.texture_filter {
-            scene.override_texture_filter(filter);
-        }
-        if let Some(level) = self.texture_level {
-            if level == TextureLevel::Report
-                && self
-                    .texture_filter
-                    .is_some_and(|f| f != TextureFilter::Trilinear)
-            {
-                return Err(Failure::Input(
-                    "--texture-level report reads the report's level trilinearly: leave out --texture-filter, or give trilinear".into(),
-                ));
-            }
-            scene.set_texture_level(level);
-        }
-        if let Some(resolution) = self.resolution {
-            scene.camera = scene
-                .camera
-                .with_resolution(resolution)
-                .map_err(|e| Failure::Input(format!("--resolution: {e}")))?;
-        }
-        description
-            .settings
-            .validate()
-            .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
+        self.overrides().apply(&mut description).map_err(|e| {
+            Failure::Input(match e {
+                OverrideError::ReportLevelFilter => "--texture-level report reads the report's level trilinearly: leave out --texture-filter, or give trilinear".into(),
+                OverrideError::Resolution(e) => format!("--resolution: {e}"),
+                OverrideError::Settings(e) => format!("render settings: {e}"),
+            })
+        })?;
         Ok(description)
     }
 
-    fn apply_overrides(&self, settings: &mut RenderSettings) {
-        let args = self;
-        if let Some(spp) = args.spp {
-            settings.spp = spp;
-        }
-        if let Some(n) = args.light_samples {
-            settings.light_samples = n;
-        }
-        if let Some(p) = args.sampler {
-            settings.pixel_pattern = p;
-        }
-        if let Some(p) = args.light_sampler {
-            settings.light_pattern = p;
-        }
-        if let Some(seed) = args.seed {
-            settings.seed = seed;
-        }
-        if let Some(strategy) = args.area_sampling {
-            settings.area_sampling = strategy;
-        }
-        if args.no_mis {
-            settings.mis = false;
-        }
-        if let Some(depth) = args.max_depth {
-            settings.max_depth = depth;
-        }
-        if let Some(n) = args.environment_samples {
-            settings.environment_samples = n;
-        }
-        if let Some(p) = args.environment_sampler {
-            settings.environment_pattern = p;
-        }
-        if let Some(s) = args.environment_sampling {
-            settings.environment_sampling = s;
+    /// The settings this command's flags replace.
+    pub(crate) fn overrides(&self) -> Overrides {
+        Overrides {
+            spp: self.spp,
+            light_samples: self.light_samples,
+            pixel_sampler: self.sampler,
+            light_sampler: self.light_sampler,
+            max_depth: self.max_depth,
+            environment_samples: self.environment_samples,
+            environment_sampler: self.environment_sampler,
+            environment_sampling: self.environment_sampling,
+            area_sampling: self.area_sampling,
+            mis: self.no_mis.then_some(false),
+            seed: self.seed,
+            resolution: self.resolution,
+            texture_filter: self.texture_filter,
+            texture_level: self.texture_level,
         }
     }
 }

@@ -17,6 +17,8 @@
 //! - [`load`] reads a scene file and the assets it names; [`parse`] and [`parse_in`]
 //!   read scene text. Each gives a [`SceneDescription`] (the scene, its render
 //!   settings and its material names) or a [`SceneError`].
+//! - [`Overrides`] replace a loaded scene's settings, textures' filter and
+//!   resolution, as `glint render`'s flags do.
 //! - [`parse_resolution_parts`] and [`MAX_RESOLUTION`]: the resolution check the
 //!   command line shares with the file format.
 
@@ -26,11 +28,13 @@ mod files;
 mod format;
 pub mod mitsuba;
 mod obj;
+mod overrides;
 mod values;
 
 pub use build::{LoadTimings, SceneDescription};
 pub use error::SceneError;
 pub use files::{read_text, MAX_DOCUMENT_BYTES, MAX_MESH_BYTES, MAX_SCENE_BYTES};
+pub use overrides::{OverrideError, Overrides};
 pub use values::{parse_resolution_parts, MAX_RESOLUTION};
 
 use std::path::Path;

@@ -95,17 +95,33 @@ pub fn repo() -> PathBuf {
 /// `None` where there is none, after saying so; under `CI=true` a missing
 /// one fails the test.
 pub fn python_with_mitsuba() -> Option<PathBuf> {
-    let venv = std::env::var_os("GLINT_MITSUBA_VENV")
+    let install = "then pip install mitsuba; measure/mitsuba/README.md";
+    python_in_venv(
+        ("GLINT_MITSUBA_VENV", "target/mitsuba-venv"),
+        "mitsuba",
+        install,
+    )
+}
+
+/// The Python of the virtual environment `$VAR` (or `default` in the
+/// repository) where `import MODULES` works, a real part ([`real_part`]);
+/// where there is none, `install` says how to make it.
+pub fn python_in_venv(
+    (var, default): (&str, &str),
+    modules: &str,
+    install: &str,
+) -> Option<PathBuf> {
+    let venv = std::env::var_os(var)
         .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join("target/mitsuba-venv"));
+        .unwrap_or_else(|| repo().join(default));
     let python = venv.join("bin/python");
     let imports = Command::new(&python)
-        .args(["-c", "import mitsuba"])
+        .args(["-c", &format!("import {modules}")])
         .output()
         .is_ok_and(|o| o.status.success());
     let missing = (!imports).then(|| {
         format!(
-            "no Python with the mitsuba package in {} (python3 -m venv it, then pip install mitsuba; measure/mitsuba/README.md)",
+            "no Python that imports {modules} in {} (python3 -m venv it, {install})",
             venv.display()
         )
     });

@@ -401,7 +401,7 @@ fn default_environment_samples(scene: &Path) -> u32 {
 /// This build's identity for the reference cache: the package version and a
 /// hash of the running executable, so that a rebuilt Glint renders anew.
 fn version() -> String {
-    let exe = std::env::current_exe()
+    let exe = crate::program()
         .ok()
         .and_then(|p| std::fs::read(p).ok())
         .map_or_else(

@@ -252,6 +252,15 @@ fn diff<'py>(
     Ok(d)
 }
 
+/// The `glint` command line `args` (the first the program's name), run in
+/// this process as the `glint` program runs it; `program` is the path job
+/// scripts call it by. Returns the exit status.
+#[pyfunction]
+fn main(py: Python<'_>, program: PathBuf, args: Vec<String>) -> u8 {
+    let args = args.into_iter().map(Into::into).collect();
+    py.detach(|| glint_cli::run(Some(program), args))
+}
+
 /// A missing file, as Python names one.
 fn not_found(path: &Path) -> PyErr {
     let message = "No such file or directory".to_string();
@@ -267,6 +276,7 @@ fn _glint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(imwrite, m)?)?;
     m.add_function(wrap_pyfunction!(encode, m)?)?;
     m.add_function(wrap_pyfunction!(diff, m)?)?;
+    m.add_function(wrap_pyfunction!(main, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

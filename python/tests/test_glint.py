@@ -210,3 +210,17 @@ def test_ctrl_c_raises_keyboard_interrupt_promptly():
     assert child.returncode != 0
     # The render stops at each worker's next pixel; the process exits well within a second or two.
     assert took < 5.0, took
+
+
+def test_the_installed_glint_command_is_the_program(glint_bin, tmp_path):
+    command = os.path.join(os.path.dirname(sys.executable), "glint")
+    assert os.path.exists(command), "pip install puts glint on PATH"
+    scene = str(SCENES / "cornell-set1.toml")
+    flags = ["--spp", "2", "--resolution", "32x24"]
+    cli(glint_bin, "render", scene, *flags, "-o", str(tmp_path / "rust.png"))
+    cli(command, "render", scene, *flags, "-o", str(tmp_path / "python.png"))
+    assert (tmp_path / "python.png").read_bytes() == (tmp_path / "rust.png").read_bytes()
+    bad = subprocess.run([command, "render", scene, "--spp", "zero"], capture_output=True, text=True)
+    expected = subprocess.run([glint_bin, "render", scene, "--spp", "zero"], capture_output=True, text=True)
+    assert (bad.returncode, bad.stderr) == (2, expected.stderr)
+    assert len(bad.stderr.splitlines()) == 1

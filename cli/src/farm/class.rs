@@ -106,7 +106,7 @@ impl ClassPlan {
             )));
         }
         let absolute = |path: &Path| std::path::absolute(path).unwrap_or_else(|_| path.to_owned());
-        let glint = std::env::current_exe()
+        let glint = crate::program()
             .map_err(|e| Failure::Other(format!("cannot find the glint executable: {e}")))?;
         Ok(ClassPlan {
             glint,

@@ -69,7 +69,7 @@ impl Sweep {
         let bench = parse_bench(&args.scene, &dir, &args.bench_options)?;
         let split = crate::bench::sweep_split(&bench)?;
         let absolute = |path: &Path| std::path::absolute(path).unwrap_or_else(|_| path.to_owned());
-        let glint = std::env::current_exe()
+        let glint = crate::program()
             .map_err(|e| Failure::Other(format!("cannot find the glint executable: {e}")))?;
         Ok(Sweep {
             glint,

@@ -80,7 +80,7 @@ impl Plan {
             )));
         }
         let absolute = |path: &Path| std::path::absolute(path).unwrap_or_else(|_| path.to_owned());
-        let glint = std::env::current_exe()
+        let glint = crate::program()
             .map_err(|e| Failure::Other(format!("cannot find the glint executable: {e}")))?;
         Ok(Plan {
             glint,

@@ -39,9 +39,14 @@ __all__ = [
     "load_string",
     "load_dict",
     "__version__",
+    "cpu_features",
 ]
 
 __version__: str = _glint.__version__
+
+#: The x86-64 instruction sets this build uses (``pip install ./python``
+#: builds for this machine's CPU; a wheel for others for ``x86-64-v3``).
+cpu_features: "list[str]" = list(_glint.cpu_features)
 
 PathLike = Union[str, "os.PathLike[str]"]
 

@@ -267,6 +267,23 @@ fn not_found(path: &Path) -> PyErr {
     pyo3::exceptions::PyFileNotFoundError::new_err((2, message, path.display().to_string()))
 }
 
+/// The x86-64 instruction sets this build was compiled to use (the CPU
+/// level a wheel needs): `target-cpu=native` gives this machine's, a wheel
+/// for other machines `x86-64-v3`'s (AVX2, FMA, ...).
+fn cpu_features() -> Vec<&'static str> {
+    let all = [
+        ("sse4.2", cfg!(target_feature = "sse4.2")),
+        ("avx", cfg!(target_feature = "avx")),
+        ("avx2", cfg!(target_feature = "avx2")),
+        ("fma", cfg!(target_feature = "fma")),
+        ("avx512f", cfg!(target_feature = "avx512f")),
+    ];
+    all.into_iter()
+        .filter(|(_, on)| *on)
+        .map(|(name, _)| name)
+        .collect()
+}
+
 #[pymodule]
 fn _glint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
@@ -278,5 +295,6 @@ fn _glint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(diff, m)?)?;
     m.add_function(wrap_pyfunction!(main, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("cpu_features", cpu_features())?;
     Ok(())
 }

@@ -33,6 +33,8 @@ __all__ = [
     "Scene",
     "SceneError",
     "diff",
+    "grade",
+    "GradeReport",
     "imread",
     "imwrite",
     "load",
@@ -210,3 +212,64 @@ def diff(test: Any, reference: Any) -> Dict[str, Any]:
     ``rel_mse``, ``flip`` (mean), ``max_difference`` and its pixel, and each
     image's channel means."""
     return _glint.diff(_image_array(test), _image_array(reference))
+
+
+class GradeReport:
+    """``glint grade``'s verdicts on a scene's submissions: ``passed`` (every
+    one), ``submissions`` (one dict each: ``verdict``, ``rejected`` regions
+    with their channels' z, ...), and ``to_dict()``, the document ``glint
+    grade --format json`` prints."""
+
+    def __init__(self, document: Dict[str, Any]) -> None:
+        self._document = document
+
+    @property
+    def passed(self) -> bool:
+        return self._document["pass"] == len(self._document["submissions"])
+
+    @property
+    def submissions(self) -> "list[Dict[str, Any]]":
+        return self._document["submissions"]
+
+    def to_dict(self) -> Dict[str, Any]:
+        return json.loads(json.dumps(self._document))
+
+    def __repr__(self) -> str:
+        d = self._document
+        return f"<GradeReport: {d['pass']} pass, {d['fail']} fail, {d['unreadable']} unreadable>"
+
+
+def grade(
+    scene: PathLike,
+    *submissions: Any,
+    spp: Optional[int] = None,
+    pixel_sampler: Optional[str] = None,
+    light_samples: Optional[int] = None,
+    light_sampler: Optional[str] = None,
+    alpha: float = 0.01,
+    block: Optional[int] = None,
+    cache: Optional[PathLike] = None,
+) -> GradeReport:
+    """Grades image files or float32 ``(h, w, 3)`` arrays against the scene
+    file ``scene`` as ``glint grade SCENE IMAGE...`` does, under the settings
+    the submissions state (``--spp``, ``--sampler``, ...), at significance
+    ``alpha``; references are cached in ``cache`` where given. An array is
+    graded as the lossless PFM file of its values."""
+    import tempfile
+
+    stated = {"spp": spp, "pixel_sampler": pixel_sampler, "light_samples": light_samples, "light_sampler": light_sampler}
+    with tempfile.TemporaryDirectory(prefix="glint-grade-") as folder:
+        files = []
+        for k, submission in enumerate(submissions):
+            if isinstance(submission, (str, os.PathLike)):
+                files.append(os.fspath(submission))
+            else:
+                path = os.path.join(folder, f"submission-{k}.pfm")
+                imwrite(path, submission)
+                files.append(path)
+        if not files:
+            raise ValueError("give the images to grade after the scene")
+        text = _glint.grade_json(
+            os.fspath(scene), files, stated, alpha, block, None if cache is None else os.fspath(cache)
+        )
+    return GradeReport(json.loads(text))

@@ -16,6 +16,7 @@
 
 mod convert;
 mod errors;
+mod grade;
 mod render;
 
 use convert::{array_of, film_of, overrides_of, toml_of};
@@ -252,6 +253,22 @@ fn diff<'py>(
     Ok(d)
 }
 
+/// `glint grade SCENE FILE... --format json` with these settings: the
+/// document as text.
+#[pyfunction]
+#[pyo3(signature = (scene, files, stated, alpha=0.01, block=None, cache=None))]
+fn grade_json(
+    py: Python<'_>,
+    scene: PathBuf,
+    files: Vec<PathBuf>,
+    stated: grade::Stated,
+    alpha: f64,
+    block: Option<u32>,
+    cache: Option<PathBuf>,
+) -> PyResult<String> {
+    py.detach(|| grade::grade_json(scene, files, stated, (alpha, block, cache)))
+}
+
 /// The `glint` command line `args` (the first the program's name), run in
 /// this process as the `glint` program runs it; `program` is the path job
 /// scripts call it by. Returns the exit status.
@@ -294,6 +311,7 @@ fn _glint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(encode, m)?)?;
     m.add_function(wrap_pyfunction!(diff, m)?)?;
     m.add_function(wrap_pyfunction!(main, m)?)?;
+    m.add_function(wrap_pyfunction!(grade_json, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("cpu_features", cpu_features())?;
     Ok(())

@@ -224,3 +224,26 @@ def test_the_installed_glint_command_is_the_program(glint_bin, tmp_path):
     expected = subprocess.run([glint_bin, "render", scene, "--spp", "zero"], capture_output=True, text=True)
     assert (bad.returncode, bad.stderr) == (2, expected.stderr)
     assert len(bad.stderr.splitlines()) == 1
+
+
+def test_grade_is_the_clis_document(glint_bin, tmp_path):
+    scene = str(SCENES / "cornell-set1.toml")
+    flags = ["--spp", "4", "--sampler", "random", "--light-samples", "4", "--light-sampler", "random"]
+    good, bad = tmp_path / "good.pfm", tmp_path / "bad.pfm"
+    cli(glint_bin, "render", scene, *flags, "--resolution", "64x64", "--seed", "5", "-o", str(good))
+    image = glint.imread(good)
+    glint.imwrite(bad, (image * np.float32(0.9)))
+    stated = {"spp": 4, "pixel_sampler": "random", "light_samples": 4, "light_sampler": "random"}
+    cache = tmp_path / "cache"
+    done = subprocess.run(
+        [glint_bin, "grade", scene, str(good), str(bad), *flags, "--format", "json", "--cache", str(cache)],
+        capture_output=True, text=True)
+    assert done.returncode == 1, done.stderr
+    report = glint.grade(scene, good, bad, cache=cache, **stated)
+    assert report.to_dict() == json.loads(done.stdout)
+    assert not report.passed
+    assert [s["verdict"] for s in report.submissions] == ["pass", "fail"]
+    # An array is graded as its lossless file.
+    assert glint.grade(scene, np.asarray(image), cache=cache, **stated).passed
+    with pytest.raises(ValueError, match="sampler"):
+        glint.grade(scene, good, pixel_sampler="halton")

@@ -1,0 +1,98 @@
+//! `glint grade` for one scene's images from Python: the class path the
+//! command takes, its JSON document as text.
+
+use glint_grade::class::{self, ClassOptions, Entry, Progress};
+use glint_grade::course::Scenes;
+use glint_grade::{Cache, GradeError, StatedSettings, TestOptions};
+use glint_integrator::SamplePattern;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+/// The settings a class's submissions state, by `glint grade`'s flag names.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub(crate) struct Stated {
+    spp: Option<u32>,
+    pixel_sampler: Option<String>,
+    light_samples: Option<u32>,
+    light_sampler: Option<String>,
+}
+
+/// No progress shown.
+struct Quiet;
+
+impl Progress for Quiet {
+    fn rendering(&self, _: &str) {}
+    fn graded(&self, _: usize, _: usize) {}
+}
+
+/// `glint grade SCENE FILE... --format json` with the stated settings,
+/// `alpha`, `block` and reference cache folder (none without).
+pub(crate) fn grade_json(
+    scene: PathBuf,
+    files: Vec<PathBuf>,
+    stated: Stated,
+    (alpha, block, cache): (f64, Option<u32>, Option<PathBuf>),
+) -> PyResult<String> {
+    let pattern = |name: Option<String>| -> PyResult<Option<SamplePattern>> {
+        name.map(|n| {
+            SamplePattern::from_name(&n).ok_or_else(|| {
+                let names = SamplePattern::NAMES.join(", ");
+                PyValueError::new_err(format!("unknown sampler \"{n}\"; expected one of {names}"))
+            })
+        })
+        .transpose()
+    };
+    let stated = StatedSettings {
+        spp: stated.spp,
+        pixel_pattern: pattern(stated.pixel_sampler)?,
+        light_samples: stated.light_samples,
+        light_pattern: pattern(stated.light_sampler)?,
+    };
+    stated
+        .validate()
+        .map_err(|e| PyValueError::new_err(format!("the submissions' settings: {e}")))?;
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return Err(PyValueError::new_err(format!(
+            "alpha is {alpha}; expected 0 < alpha < 1"
+        )));
+    }
+    glint_grade::GradeScene::load(&scene).map_err(input)?;
+    let entries: Vec<Entry> = files
+        .into_iter()
+        .map(|file| Entry {
+            student: file
+                .file_stem()
+                .map_or(String::new(), |s| s.to_string_lossy().into_owned()),
+            scene: scene.display().to_string(),
+            file,
+            stated,
+        })
+        .collect();
+    for entry in &entries {
+        glint_grade::Submission::load(&entry.file).map_err(PyValueError::new_err)?;
+    }
+    let options = ClassOptions {
+        test: TestOptions { alpha, block },
+        cache: Cache { dir: cache },
+    };
+    let scenes = Scenes::Folder(PathBuf::new());
+    let grades = class::grade_class(
+        &entries,
+        &scenes,
+        &PathBuf::new(),
+        &options,
+        &Quiet,
+        &|_, _, _, _| Ok(()),
+    )
+    .map_err(input)?;
+    let rows = glint_grade::report::rows(&grades);
+    let json = serde_json::to_string_pretty(&glint_grade::report::json(&rows))
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(json + "\n")
+}
+
+fn input(e: GradeError) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}

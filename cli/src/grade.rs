@@ -551,17 +551,7 @@ fn entries(
             scene.display()
         )));
     }
-    let entries = submissions
-        .iter()
-        .map(|file| Entry {
-            student: file
-                .file_stem()
-                .map_or(String::new(), |s| s.to_string_lossy().into_owned()),
-            scene: scene.display().to_string(),
-            file: file.clone(),
-            stated: *stated,
-        })
-        .collect();
+    let entries = class::entries_of_scene(scene, submissions, stated);
     // The scene and images are named on the command line: a bad one is bad
     // input, found before any reference is rendered.
     glint_grade::GradeScene::load(scene).map_err(failure)?;

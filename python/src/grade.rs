@@ -1,7 +1,7 @@
 //! `glint grade` for one scene's images from Python: the class path the
 //! command takes, its JSON document as text.
 
-use glint_grade::class::{self, ClassOptions, Entry, Progress};
+use glint_grade::class::{self, ClassOptions, Progress};
 use glint_grade::course::Scenes;
 use glint_grade::{Cache, GradeError, StatedSettings, TestOptions};
 use glint_integrator::SamplePattern;
@@ -59,17 +59,7 @@ pub(crate) fn grade_json(
         )));
     }
     glint_grade::GradeScene::load(&scene).map_err(input)?;
-    let entries: Vec<Entry> = files
-        .into_iter()
-        .map(|file| Entry {
-            student: file
-                .file_stem()
-                .map_or(String::new(), |s| s.to_string_lossy().into_owned()),
-            scene: scene.display().to_string(),
-            file,
-            stated,
-        })
-        .collect();
+    let entries = class::entries_of_scene(&scene, &files, &stated);
     for entry in &entries {
         glint_grade::Submission::load(&entry.file).map_err(PyValueError::new_err)?;
     }

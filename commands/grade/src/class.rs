@@ -49,6 +49,24 @@ pub struct Entry {
     pub stated: StatedSettings,
 }
 
+/// One scene's submissions, named by their files (`glint grade SCENE
+/// IMAGE…`): each student the file's stem, all judged under `stated`.
+pub fn entries_of_scene(scene: &Path, files: &[PathBuf], stated: &StatedSettings) -> Vec<Entry> {
+    let student = |file: &Path| {
+        file.file_stem()
+            .map_or(String::new(), |s| s.to_string_lossy().into_owned())
+    };
+    files
+        .iter()
+        .map(|file| Entry {
+            student: student(file),
+            scene: scene.display().to_string(),
+            file: file.clone(),
+            stated: *stated,
+        })
+        .collect()
+}
+
 /// The submissions of a folder: every image `DIR/STUDENT/SCENE.EXT`, the
 /// scene named by the file's stem, students and files in name order.
 pub fn entries_from_folder(dir: &Path, stated: &StatedSettings) -> Result<Vec<Entry>, GradeError> {

@@ -150,6 +150,32 @@ class Scene:
         x, y = pixel
         return self._inner.explain_json(x, y, sample=sample, all_samples=all_samples, stage=stage)
 
+    def explain_against(
+        self,
+        pixel: Tuple[int, int],
+        student: Union[Mapping[str, Any], str, PathLike],
+        *,
+        sample: int = 0,
+        all_samples: bool = False,
+        stage: Optional[str] = None,
+    ) -> Dict[str, Any]:
+        """A student's ``glint-explain/1`` document (a dict, JSON text, or
+        the path of a ``.json`` file) against Glint's for this pixel:
+        ``glint explain --against STUDENT.json --json``'s comparison, with
+        the first stage where they part."""
+        if isinstance(student, Mapping):
+            text = json.dumps(student)
+        elif isinstance(student, os.PathLike) or (isinstance(student, str) and not student.lstrip().startswith("{")):
+            with open(os.fspath(student), encoding="utf-8") as f:
+                text = f.read()
+        else:
+            text = student
+        x, y = pixel
+        document = self._inner.explain_json(
+            x, y, sample=sample, all_samples=all_samples, stage=stage, against=text
+        )
+        return json.loads(document)
+
 
 def _progress(progress: Any) -> Tuple[Optional[Callable[[int, int], Any]], Callable[[], None]]:
     """A ``(done, total)`` callback for ``progress``, and what closes it."""

@@ -31,6 +31,7 @@ class Scene:
         sample: int = 0,
         all_samples: bool = False,
         stage: Optional[str] = None,
+        against: Optional[str] = None,
     ) -> str: ...
 
 def load(path: str, overrides: Dict[str, Any]) -> Scene: ...

@@ -103,8 +103,11 @@ impl Scene {
     }
 
     /// `glint explain SCENE --pixel X,Y --json` with the same settings: the
-    /// `glint-explain/1` document as JSON text, ending in a newline.
-    #[pyo3(signature = (x, y, *, sample=0, all_samples=false, stage=None))]
+    /// `glint-explain/1` document as JSON text, ending in a newline; with
+    /// `against` (a student's document as JSON text), `--against`'s
+    /// comparison instead.
+    #[pyo3(signature = (x, y, *, sample=0, all_samples=false, stage=None, against=None))]
+    #[allow(clippy::too_many_arguments)]
     fn explain_json(
         &self,
         py: Python<'_>,
@@ -113,6 +116,7 @@ impl Scene {
         sample: u64,
         all_samples: bool,
         stage: Option<&str>,
+        against: Option<&str>,
     ) -> PyResult<String> {
         use glint_integrator::trace::SampleSelection;
         let stage = stage
@@ -133,10 +137,41 @@ impl Scene {
         let explained = py
             .detach(|| glint_explain::explain(scene, settings, x, y, selection))
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
-        let json = serde_json::to_string_pretty(&explained.json(stage))
-            .map_err(|e| glint_error(py, &e.to_string()))?;
+        let document = match against {
+            None => explained.json(stage),
+            Some(student) => compare(&explained, student, stage)?,
+        };
+        let json =
+            serde_json::to_string_pretty(&document).map_err(|e| glint_error(py, &e.to_string()))?;
         Ok(json + "\n")
     }
+}
+
+/// A student's document (JSON text) against Glint's explanation, limited
+/// to `stage`: `glint explain --against`'s comparison document.
+fn compare(
+    explained: &glint_explain::Explanation,
+    student: &str,
+    stage: Option<glint_explain::Stage>,
+) -> PyResult<serde_json::Value> {
+    use glint_explain::against::{self, Node};
+    let student = Node::parse(student).map_err(|e| {
+        let message = e.to_string();
+        let message = message
+            .split(" at line ")
+            .next()
+            .unwrap_or(&message)
+            .to_owned();
+        pyo3::exceptions::PyValueError::new_err(format!(
+            "the student's document:{}:{}: {message}",
+            e.line(),
+            e.column()
+        ))
+    })?;
+    let comparison = against::compare(&student, &explained.json(None), stage).map_err(|e| {
+        pyo3::exceptions::PyValueError::new_err(format!("the student's document: {e}"))
+    })?;
+    Ok(comparison.json())
 }
 
 /// Loads the scene file at `path` with `overrides` (a dict of setting names).

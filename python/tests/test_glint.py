@@ -247,3 +247,22 @@ def test_grade_is_the_clis_document(glint_bin, tmp_path):
     assert glint.grade(scene, np.asarray(image), cache=cache, **stated).passed
     with pytest.raises(ValueError, match="sampler"):
         glint.grade(scene, good, pixel_sampler="halton")
+
+
+def test_explain_against_is_the_clis_comparison(glint_bin, tmp_path):
+    path = SCENES / "cornell-set1.toml"
+    flags = ["--spp", "4", "--resolution", "48x40"]
+    scene = glint.load(path, spp=4, resolution=(48, 40))
+    student = scene.explain((20, 30))
+    student["film"]["srgb8"] = [0, 0, 0]
+    student_file = tmp_path / "student.json"
+    student_file.write_text(json.dumps(student))
+    done = subprocess.run(
+        [glint_bin, "explain", str(path), *flags, "--pixel", "20,30", "--against", str(student_file), "--json"],
+        capture_output=True, text=True)
+    assert done.returncode == 1, done.stderr
+    expected = json.loads(done.stdout)
+    assert scene.explain_against((20, 30), student) == expected
+    assert scene.explain_against((20, 30), student_file) == expected
+    with pytest.raises(ValueError, match="student"):
+        scene.explain_against((20, 30), "{ not json")

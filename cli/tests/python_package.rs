@@ -1,6 +1,7 @@
 //! The Python package (`python/`): built into the virtual environment
 //! `GLINT_PYTHON_VENV` (or `target/python-venv`, which `.ci/run` makes with
-//! maturin, numpy and pytest) and its pytest suite (`python/tests`) run
+//! maturin, numpy, pytest and nbclient) and its pytest suite (`python/tests`,
+//! the example notebook `python/examples/glint.ipynb` executed too) run
 //! against this build's `glint`: renders, explain documents and images the
 //! same bytes as the command line's, every bad input its exception, the GIL
 //! released, Ctrl-C a `KeyboardInterrupt`. A real part ([`common::real_part`]):
@@ -14,8 +15,9 @@ use std::process::Command;
 #[test]
 fn the_python_package_passes_its_pytest_suite() {
     let venv = ("GLINT_PYTHON_VENV", "target/python-venv");
-    let install = "then pip install maturin numpy pytest";
-    let Some(python) = python_in_venv(venv, "maturin, numpy, pytest", install) else {
+    let install = "then pip install maturin numpy pytest nbclient nbformat ipykernel";
+    let modules = "maturin, numpy, pytest, nbclient, ipykernel";
+    let Some(python) = python_in_venv(venv, modules, install) else {
         return;
     };
     let bin = python.parent().expect("the venv's bin/");

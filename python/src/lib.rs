@@ -262,20 +262,23 @@ fn diff<'py>(
     reference: PyReadonlyArray3<'_, f32>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (test, reference) = (film_of(&test)?, film_of(&reference)?);
-    let size = test.resolution();
-    if size != reference.resolution() {
-        let r = reference.resolution();
-        return Err(pyo3::exceptions::PyValueError::new_err(format!(
-            "the images differ in size: {}x{} and {}x{}",
-            size.x, size.y, r.x, r.y
-        )));
-    }
-    let region = glint_metrics::Region::full(size.x, size.y);
-    let c = py.detach(|| {
-        let test = glint_metrics::ImageView::new(size.x, size.y, test.pixels());
-        let reference = glint_metrics::ImageView::new(size.x, size.y, reference.pixels());
-        glint_metrics::compare(test, reference, region)
-    });
+    let (size, other) = (test.resolution(), reference.resolution());
+    let c = py
+        .detach(|| {
+            let test_view = glint_metrics::ImageView {
+                width: size.x,
+                height: size.y,
+                pixels: test.pixels(),
+            };
+            let reference_view = glint_metrics::ImageView {
+                width: other.x,
+                height: other.y,
+                pixels: reference.pixels(),
+            };
+            let region = glint_metrics::Region::full(size.x, size.y);
+            glint_metrics::try_compare(test_view, reference_view, region)
+        })
+        .map_err(pyo3::exceptions::PyValueError::new_err)?;
     let d = PyDict::new(py);
     d.set_item("rmse", c.rmse)?;
     d.set_item("rel_mse", c.rel_mse)?;

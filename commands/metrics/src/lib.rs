@@ -57,7 +57,7 @@ mod mse;
 mod region;
 mod rel_mse;
 
-pub use compare::{compare, compare_with_flip_map, Comparison};
+pub use compare::{compare, compare_with_flip_map, try_compare, Comparison};
 pub use error_map::ErrorMap;
 pub use flip::{flip, FLIP_PIXELS_PER_DEGREE};
 pub use heatmap::{heatmap, magma, save_heatmap};

@@ -34,6 +34,7 @@ __all__ = [
     "SceneError",
     "diff",
     "grade",
+    "grade_class",
     "GradeReport",
     "imread",
     "imwrite",
@@ -265,25 +266,34 @@ class GradeReport:
         return f"<GradeReport: {d['pass']} pass, {d['fail']} fail, {d['unreadable']} unreadable>"
 
 
+#: The settings submissions state, by ``glint grade``'s flag names
+#: (``pixel_sampler`` for ``--sampler``).
+STATED = ("spp", "pixel_sampler", "light_samples", "light_sampler")
+
+
+def _stated(stated: Mapping[str, Any]) -> Dict[str, Any]:
+    unknown = sorted(set(stated) - set(STATED))
+    if unknown:
+        raise TypeError(f"unknown stated setting {unknown[0]!r}; the stated settings are {', '.join(STATED)}")
+    return {name: stated.get(name) for name in STATED}
+
+
 def grade(
     scene: PathLike,
     *submissions: Any,
-    spp: Optional[int] = None,
-    pixel_sampler: Optional[str] = None,
-    light_samples: Optional[int] = None,
-    light_sampler: Optional[str] = None,
     alpha: float = 0.01,
     block: Optional[int] = None,
     cache: Optional[PathLike] = None,
+    **stated: Any,
 ) -> GradeReport:
     """Grades image files or float32 ``(h, w, 3)`` arrays against the scene
     file ``scene`` as ``glint grade SCENE IMAGE...`` does, under the settings
-    the submissions state (``--spp``, ``--sampler``, ...), at significance
-    ``alpha``; references are cached in ``cache`` where given. An array is
-    graded as the lossless PFM file of its values."""
+    the submissions state (:data:`STATED`: ``spp``, ``pixel_sampler``,
+    ``light_samples``, ``light_sampler``), at significance ``alpha``;
+    references are cached in ``cache`` where given. An array is graded as
+    the lossless PFM file of its values."""
     import tempfile
 
-    stated = {"spp": spp, "pixel_sampler": pixel_sampler, "light_samples": light_samples, "light_sampler": light_sampler}
     with tempfile.TemporaryDirectory(prefix="glint-grade-") as folder:
         files = []
         for k, submission in enumerate(submissions):
@@ -295,7 +305,29 @@ def grade(
                 files.append(path)
         if not files:
             raise ValueError("give the images to grade after the scene")
-        text = _glint.grade_json(
-            os.fspath(scene), files, stated, alpha, block, None if cache is None else os.fspath(cache)
-        )
+        text = _glint.grade_json(os.fspath(scene), files, _stated(stated), alpha, block, _path(cache))
     return GradeReport(json.loads(text))
+
+
+def grade_class(
+    submissions: PathLike,
+    *,
+    scenes: Optional[PathLike] = None,
+    alpha: float = 0.01,
+    block: Optional[int] = None,
+    cache: Optional[PathLike] = None,
+    **stated: Any,
+) -> GradeReport:
+    """Grades a class as ``glint grade --class`` does: ``submissions`` is a
+    folder of ``STUDENT/SCENE.EXT`` images or a CSV manifest
+    (``student,scene,file``, and settings columns where students differ),
+    the scenes ``NAME.toml`` in ``scenes`` (else beside it); the rest as
+    :func:`grade`."""
+    text = _glint.grade_class_json(
+        os.fspath(submissions), _path(scenes), _stated(stated), alpha, block, _path(cache)
+    )
+    return GradeReport(json.loads(text))
+
+
+def _path(path: Optional[PathLike]) -> Optional[str]:
+    return None if path is None else os.fspath(path)

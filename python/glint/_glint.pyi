@@ -49,3 +49,11 @@ def grade_json(
     block: Optional[int] = None,
     cache: Optional[str] = None,
 ) -> str: ...
+def grade_class_json(
+    submissions: str,
+    scenes: Optional[str],
+    stated: Dict[str, Any],
+    alpha: float = 0.01,
+    block: Optional[int] = None,
+    cache: Optional[str] = None,
+) -> str: ...

@@ -7,7 +7,7 @@ use glint_grade::{Cache, GradeError, StatedSettings, TestOptions};
 use glint_integrator::SamplePattern;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The settings a class's submissions state, by `glint grade`'s flag names.
 #[derive(FromPyObject)]
@@ -33,8 +33,44 @@ pub(crate) fn grade_json(
     scene: PathBuf,
     files: Vec<PathBuf>,
     stated: Stated,
-    (alpha, block, cache): (f64, Option<u32>, Option<PathBuf>),
+    test: (f64, Option<u32>, Option<PathBuf>),
 ) -> PyResult<String> {
+    let stated = stated_settings(stated)?;
+    glint_grade::GradeScene::load(&scene).map_err(input)?;
+    let entries = class::entries_of_scene(&scene, &files, &stated);
+    for entry in &entries {
+        glint_grade::Submission::load(&entry.file).map_err(PyValueError::new_err)?;
+    }
+    let scenes = Scenes::Folder(PathBuf::new());
+    report_json(&entries, (&scenes, &PathBuf::new()), test)
+}
+
+/// `glint grade --class CLASS [--scenes DIR] --format json`: a class folder
+/// (`CLASS/STUDENT/SCENE.EXT`) or manifest (CSV), its scenes in `scenes`
+/// (else beside it).
+pub(crate) fn grade_class_json(
+    class: PathBuf,
+    scenes: Option<PathBuf>,
+    stated: Stated,
+    test: (f64, Option<u32>, Option<PathBuf>),
+) -> PyResult<String> {
+    let stated = stated_settings(stated)?;
+    let base = class
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+        .to_owned();
+    let entries = match class.is_dir() {
+        true => class::entries_from_folder(&class, &stated),
+        false => class::entries_from_manifest(&class, &stated),
+    }
+    .map_err(input)?;
+    let scenes = Scenes::Folder(scenes.unwrap_or_else(|| base.clone()));
+    report_json(&entries, (&scenes, &base), test)
+}
+
+/// The stated settings, their sampler names read and checked.
+fn stated_settings(stated: Stated) -> PyResult<StatedSettings> {
     let pattern = |name: Option<String>| -> PyResult<Option<SamplePattern>> {
         name.map(|n| {
             SamplePattern::from_name(&n).ok_or_else(|| {
@@ -53,30 +89,28 @@ pub(crate) fn grade_json(
     stated
         .validate()
         .map_err(|e| PyValueError::new_err(format!("the submissions' settings: {e}")))?;
+    Ok(stated)
+}
+
+/// The class path for `entries` and its document as text.
+fn report_json(
+    entries: &[class::Entry],
+    (scenes, base): (&Scenes, &Path),
+    (alpha, block, cache): (f64, Option<u32>, Option<PathBuf>),
+) -> PyResult<String> {
     if !(alpha > 0.0 && alpha < 1.0) {
         return Err(PyValueError::new_err(format!(
             "alpha is {alpha}; expected 0 < alpha < 1"
         )));
     }
-    glint_grade::GradeScene::load(&scene).map_err(input)?;
-    let entries = class::entries_of_scene(&scene, &files, &stated);
-    for entry in &entries {
-        glint_grade::Submission::load(&entry.file).map_err(PyValueError::new_err)?;
-    }
     let options = ClassOptions {
         test: TestOptions { alpha, block },
         cache: Cache { dir: cache },
     };
-    let scenes = Scenes::Folder(PathBuf::new());
-    let grades = class::grade_class(
-        &entries,
-        &scenes,
-        &PathBuf::new(),
-        &options,
-        &Quiet,
-        &|_, _, _, _| Ok(()),
-    )
-    .map_err(input)?;
+    let nothing_more =
+        |_: usize, _: &class::Row, _: &glint_grade::Submission, _: &class::Group| Ok(());
+    let grades = class::grade_class(entries, scenes, base, &options, &Quiet, &nothing_more)
+        .map_err(input)?;
     let rows = glint_grade::report::rows(&grades);
     let json = serde_json::to_string_pretty(&glint_grade::report::json(&rows))
         .map_err(|e| PyValueError::new_err(e.to_string()))?;

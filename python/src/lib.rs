@@ -307,6 +307,22 @@ fn grade_json(
     py.detach(|| grade::grade_json(scene, files, stated, (alpha, block, cache)))
 }
 
+/// `glint grade --class CLASS [--scenes DIR] --format json` with these
+/// settings: the document as text.
+#[pyfunction]
+#[pyo3(signature = (class, scenes, stated, alpha=0.01, block=None, cache=None))]
+fn grade_class_json(
+    py: Python<'_>,
+    class: PathBuf,
+    scenes: Option<PathBuf>,
+    stated: grade::Stated,
+    alpha: f64,
+    block: Option<u32>,
+    cache: Option<PathBuf>,
+) -> PyResult<String> {
+    py.detach(|| grade::grade_class_json(class, scenes, stated, (alpha, block, cache)))
+}
+
 /// The `glint` command line `args` (the first the program's name), run in
 /// this process as the `glint` program runs it; `program` is the path job
 /// scripts call it by. Returns the exit status.
@@ -350,6 +366,7 @@ fn _glint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(diff, m)?)?;
     m.add_function(wrap_pyfunction!(main, m)?)?;
     m.add_function(wrap_pyfunction!(grade_json, m)?)?;
+    m.add_function(wrap_pyfunction!(grade_class_json, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("cpu_features", cpu_features())?;
     Ok(())

@@ -266,3 +266,26 @@ def test_explain_against_is_the_clis_comparison(glint_bin, tmp_path):
     assert scene.explain_against((20, 30), student_file) == expected
     with pytest.raises(ValueError, match="student"):
         scene.explain_against((20, 30), "{ not json")
+
+
+def test_a_class_is_graded_as_the_cli_grades_it(glint_bin, tmp_path):
+    import shutil
+
+    scenes = tmp_path / "scenes"
+    scenes.mkdir()
+    shutil.copy(SCENES / "cornell-set1.toml", scenes / "set1.toml")
+    flags = ["--spp", "4", "--sampler", "random", "--light-samples", "4", "--light-sampler", "random"]
+    for k, student in enumerate(["ada", "bo"]):
+        (tmp_path / "class" / student).mkdir(parents=True)
+        cli(glint_bin, "render", str(scenes / "set1.toml"), *flags, "--resolution", "48x48",
+            "--seed", str(k + 1), "-o", str(tmp_path / "class" / student / "set1.png"))
+    cache = tmp_path / "cache"
+    done = subprocess.run(
+        [glint_bin, "grade", "--class", str(tmp_path / "class"), "--scenes", str(scenes), *flags,
+         "--format", "json", "--cache", str(cache)],
+        capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    report = glint.grade_class(tmp_path / "class", scenes=scenes, cache=cache, spp=4, pixel_sampler="random",
+                               light_samples=4, light_sampler="random")
+    assert report.to_dict() == json.loads(done.stdout)
+    assert report.passed and len(report.submissions) == 2

@@ -244,11 +244,13 @@ def diff(test: Any, reference: Any) -> Dict[str, Any]:
 class GradeReport:
     """``glint grade``'s verdicts on a scene's submissions: ``passed`` (every
     one), ``submissions`` (one dict each: ``verdict``, ``rejected`` regions
-    with their channels' z, ...), and ``to_dict()``, the document ``glint
-    grade --format json`` prints."""
+    with their channels' z, ...), ``heatmaps`` (each graded submission's
+    ``--heatmap`` picture as a uint8 ``(h, w, 3)`` array, else None), and
+    ``to_dict()``, the document ``glint grade --format json`` prints."""
 
-    def __init__(self, document: Dict[str, Any]) -> None:
-        self._document = document
+    def __init__(self, graded: Tuple[str, "list[Optional[np.ndarray]]"]) -> None:
+        text, self.heatmaps = graded
+        self._document = json.loads(text)
 
     @property
     def passed(self) -> bool:
@@ -305,8 +307,8 @@ def grade(
                 files.append(path)
         if not files:
             raise ValueError("give the images to grade after the scene")
-        text = _glint.grade_json(os.fspath(scene), files, _stated(stated), alpha, block, _path(cache))
-    return GradeReport(json.loads(text))
+        graded = _glint.grade_json(os.fspath(scene), files, _stated(stated), alpha, block, _path(cache))
+    return GradeReport(graded)
 
 
 def grade_class(
@@ -323,10 +325,10 @@ def grade_class(
     (``student,scene,file``, and settings columns where students differ),
     the scenes ``NAME.toml`` in ``scenes`` (else beside it); the rest as
     :func:`grade`."""
-    text = _glint.grade_class_json(
+    graded = _glint.grade_class_json(
         os.fspath(submissions), _path(scenes), _stated(stated), alpha, block, _path(cache)
     )
-    return GradeReport(json.loads(text))
+    return GradeReport(graded)
 
 
 def _path(path: Optional[PathLike]) -> Optional[str]:

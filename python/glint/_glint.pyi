@@ -48,7 +48,7 @@ def grade_json(
     alpha: float = 0.01,
     block: Optional[int] = None,
     cache: Optional[str] = None,
-) -> str: ...
+) -> Tuple[str, list[Optional[npt.NDArray[np.uint8]]]]: ...
 def grade_class_json(
     submissions: str,
     scenes: Optional[str],
@@ -56,4 +56,4 @@ def grade_class_json(
     alpha: float = 0.01,
     block: Optional[int] = None,
     cache: Optional[str] = None,
-) -> str: ...
+) -> Tuple[str, list[Optional[npt.NDArray[np.uint8]]]]: ...

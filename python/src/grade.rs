@@ -8,6 +8,7 @@ use glint_integrator::SamplePattern;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// The settings a class's submissions state, by `glint grade`'s flag names.
 #[derive(FromPyObject)]
@@ -34,7 +35,7 @@ pub(crate) fn grade_json(
     files: Vec<PathBuf>,
     stated: Stated,
     test: (f64, Option<u32>, Option<PathBuf>),
-) -> PyResult<String> {
+) -> PyResult<Graded> {
     let stated = stated_settings(stated)?;
     glint_grade::GradeScene::load(&scene).map_err(input)?;
     let entries = class::entries_of_scene(&scene, &files, &stated);
@@ -53,7 +54,7 @@ pub(crate) fn grade_class_json(
     scenes: Option<PathBuf>,
     stated: Stated,
     test: (f64, Option<u32>, Option<PathBuf>),
-) -> PyResult<String> {
+) -> PyResult<Graded> {
     let stated = stated_settings(stated)?;
     let base = class
         .parent()
@@ -92,12 +93,20 @@ fn stated_settings(stated: Stated) -> PyResult<StatedSettings> {
     Ok(stated)
 }
 
-/// The class path for `entries` and its document as text.
+/// A graded class: `glint grade --format json`'s document as text, and each
+/// submission's heat map (`--heatmap`'s RGB8 pixels and its size) where it
+/// was graded.
+pub(crate) struct Graded {
+    pub(crate) json: String,
+    pub(crate) heatmaps: Vec<Option<(glam::UVec2, Vec<u8>)>>,
+}
+
+/// The class path for `entries`: its document and heat maps.
 fn report_json(
     entries: &[class::Entry],
     (scenes, base): (&Scenes, &Path),
     (alpha, block, cache): (f64, Option<u32>, Option<PathBuf>),
-) -> PyResult<String> {
+) -> PyResult<Graded> {
     if !(alpha > 0.0 && alpha < 1.0) {
         return Err(PyValueError::new_err(format!(
             "alpha is {alpha}; expected 0 < alpha < 1"
@@ -107,14 +116,25 @@ fn report_json(
         test: TestOptions { alpha, block },
         cache: Cache { dir: cache },
     };
-    let nothing_more =
-        |_: usize, _: &class::Row, _: &glint_grade::Submission, _: &class::Group| Ok(());
-    let grades = class::grade_class(entries, scenes, base, &options, &Quiet, &nothing_more)
+    let heatmaps = Mutex::new(vec![None; entries.len()]);
+    let keep_heatmap =
+        |i: usize, row: &class::Row, s: &glint_grade::Submission, g: &class::Group| {
+            if let class::Outcome::Graded(grade) = &row.outcome {
+                let pixels = glint_grade::heatmap::heatmap(grade, &s.film, &g.references.objects);
+                heatmaps.lock().expect("no panic holds it")[i] =
+                    Some((s.film.resolution(), pixels));
+            }
+            Ok(())
+        };
+    let grades = class::grade_class(entries, scenes, base, &options, &Quiet, &keep_heatmap)
         .map_err(input)?;
     let rows = glint_grade::report::rows(&grades);
     let json = serde_json::to_string_pretty(&glint_grade::report::json(&rows))
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    Ok(json + "\n")
+    Ok(Graded {
+        json: json + "\n",
+        heatmaps: heatmaps.into_inner().expect("no panic holds it"),
+    })
 }
 
 fn input(e: GradeError) -> PyErr {

@@ -303,8 +303,9 @@ fn grade_json(
     alpha: f64,
     block: Option<u32>,
     cache: Option<PathBuf>,
-) -> PyResult<String> {
-    py.detach(|| grade::grade_json(scene, files, stated, (alpha, block, cache)))
+) -> PyResult<GradedPy<'_>> {
+    let graded = py.detach(|| grade::grade_json(scene, files, stated, (alpha, block, cache)))?;
+    Ok(graded_py(py, graded))
 }
 
 /// `glint grade --class CLASS [--scenes DIR] --format json` with these
@@ -319,8 +320,30 @@ fn grade_class_json(
     alpha: f64,
     block: Option<u32>,
     cache: Option<PathBuf>,
-) -> PyResult<String> {
-    py.detach(|| grade::grade_class_json(class, scenes, stated, (alpha, block, cache)))
+) -> PyResult<GradedPy<'_>> {
+    let graded =
+        py.detach(|| grade::grade_class_json(class, scenes, stated, (alpha, block, cache)))?;
+    Ok(graded_py(py, graded))
+}
+
+/// A graded class for Python: the document's text and each submission's
+/// heat map as a `(height, width, 3)` uint8 array (None where not graded).
+type GradedPy<'py> = (String, Vec<Option<Bound<'py, numpy::PyArray3<u8>>>>);
+
+fn graded_py(py: Python<'_>, graded: grade::Graded) -> GradedPy<'_> {
+    use numpy::IntoPyArray;
+    let heatmaps = graded
+        .heatmaps
+        .into_iter()
+        .map(|map| {
+            map.map(|(size, rgb)| {
+                numpy::ndarray::Array3::from_shape_vec((size.y as usize, size.x as usize, 3), rgb)
+                    .expect("a heat map fills its image")
+                    .into_pyarray(py)
+            })
+        })
+        .collect();
+    (graded.json, heatmaps)
 }
 
 /// The `glint` command line `args` (the first the program's name), run in

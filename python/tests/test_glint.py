@@ -243,6 +243,17 @@ def test_grade_is_the_clis_document(glint_bin, tmp_path):
     assert report.to_dict() == json.loads(done.stdout)
     assert not report.passed
     assert [s["verdict"] for s in report.submissions] == ["pass", "fail"]
+    # Each graded submission's heat map is glint grade --heatmap's picture.
+    heatmap = tmp_path / "bad-heat.png"
+    cli_heat = subprocess.run(
+        [glint_bin, "grade", scene, str(bad), *flags, "--cache", str(cache), "--heatmap", str(heatmap)],
+        capture_output=True, text=True)
+    assert cli_heat.returncode == 1, cli_heat.stderr
+    codes = report.heatmaps[1].astype(np.float32) / np.float32(255)
+    linear = np.where(codes <= 0.04045, codes / np.float32(12.92), ((codes + np.float32(0.055)) / np.float32(1.055)) ** np.float32(2.4))
+    assert report.heatmaps[1].dtype == np.uint8 and report.heatmaps[1].shape == image.shape
+    assert np.allclose(linear, glint.imread(heatmap), rtol=1e-5, atol=1e-7)
+    assert not np.array_equal(report.heatmaps[0], report.heatmaps[1])
     # An array is graded as its lossless file.
     assert glint.grade(scene, np.asarray(image), cache=cache, **stated).passed
     with pytest.raises(ValueError, match="sampler"):

@@ -121,12 +121,8 @@ fn compare(explanation: &Explanation, path: &Path, args: &ExplainArgs) -> Result
     let name = path.display();
     let text = glint_scene::read_text(path, glint_scene::MAX_DOCUMENT_BYTES, "a document")
         .map_err(|e| Failure::Input(format!("{name}: cannot read the document: {e}")))?;
-    let student = Node::parse(&text).map_err(|e| {
-        // serde_json's message ends in " at line L column C": moved to the front.
-        let message = e.to_string();
-        let message = message.split(" at line ").next().unwrap_or(&message);
-        Failure::Input(format!("{name}:{}:{}: {message}", e.line(), e.column()))
-    })?;
+    let student = Node::parse(&text)
+        .map_err(|e| Failure::Input(format!("{name}{}", against::located(&e))))?;
     let comparison = against::compare(&student, &explanation.json(None), args.stage)
         .map_err(|e| Failure::Input(format!("{name}: {e}")))?;
     print(&match args.json {

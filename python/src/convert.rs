@@ -12,7 +12,8 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
-/// The film as a `(height, width, 3)` float32 array, its buffer moved, not copied.
+/// The film as a `(height, width, 3)` float32 array: its pixels flattened
+/// once into the buffer the array takes over.
 pub(crate) fn array_of(py: Python<'_>, film: Film) -> Bound<'_, PyArray3<f32>> {
     let size = film.resolution();
     let (w, h) = (size.x as usize, size.y as usize);

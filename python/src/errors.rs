@@ -27,8 +27,7 @@ pub(crate) fn scene_error(py: Python<'_>, error: SceneError) -> PyErr {
     let message = error.to_string();
     match error {
         SceneError::Read { path, source } if source.kind() == std::io::ErrorKind::NotFound => {
-            let text = "No such file or directory".to_string();
-            pyo3::exceptions::PyFileNotFoundError::new_err((2, text, path.display().to_string()))
+            not_found(&path)
         }
         SceneError::Read { path, .. } => raise(
             py,
@@ -53,4 +52,10 @@ pub(crate) fn scene_error(py: Python<'_>, error: SceneError) -> PyErr {
             (message, file, Some(line), Some(column), field),
         ),
     }
+}
+
+/// A missing file, as Python names one (`FileNotFoundError`, errno 2).
+pub(crate) fn not_found(path: &std::path::Path) -> PyErr {
+    let message = "No such file or directory".to_string();
+    pyo3::exceptions::PyFileNotFoundError::new_err((2, message, path.display().to_string()))
 }

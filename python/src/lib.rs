@@ -20,7 +20,7 @@ mod grade;
 mod render;
 
 use convert::{array_of, film_of, overrides_of, toml_of};
-use errors::{glint_error, scene_error};
+use errors::{glint_error, not_found, scene_error};
 use glint_camera::{Film, ImageFormat};
 use glint_integrator::{Crop, RenderSettings};
 use glint_scene::SceneDescription;
@@ -156,17 +156,8 @@ fn compare(
 ) -> PyResult<serde_json::Value> {
     use glint_explain::against::{self, Node};
     let student = Node::parse(student).map_err(|e| {
-        let message = e.to_string();
-        let message = message
-            .split(" at line ")
-            .next()
-            .unwrap_or(&message)
-            .to_owned();
-        pyo3::exceptions::PyValueError::new_err(format!(
-            "the student's document:{}:{}: {message}",
-            e.line(),
-            e.column()
-        ))
+        let at = against::located(&e);
+        pyo3::exceptions::PyValueError::new_err(format!("the student's document{at}"))
     })?;
     let comparison = against::compare(&student, &explained.json(None), stage).map_err(|e| {
         pyo3::exceptions::PyValueError::new_err(format!("the student's document: {e}"))
@@ -353,12 +344,6 @@ fn graded_py(py: Python<'_>, graded: grade::Graded) -> GradedPy<'_> {
 fn main(py: Python<'_>, program: PathBuf, args: Vec<String>) -> u8 {
     let args = args.into_iter().map(Into::into).collect();
     py.detach(|| glint_cli::run(Some(program), args))
-}
-
-/// A missing file, as Python names one.
-fn not_found(path: &Path) -> PyErr {
-    let message = "No such file or directory".to_string();
-    pyo3::exceptions::PyFileNotFoundError::new_err((2, message, path.display().to_string()))
 }
 
 /// The x86-64 instruction sets this build was compiled to use (the CPU

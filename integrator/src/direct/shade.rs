@@ -91,8 +91,9 @@ impl DirectIntegrator {
     /// drawn together across the lanes at its camera sample's points, from
     /// the map ([`EnvironmentLight::sample_each`]) or about each lane's normal
     /// ([`EnvironmentLight::sample_cosine_each`]), then `L · f · cos θ / p`
-    /// (the lobe too on glossy lanes) and the shadow rays in lanes, each lane summing
-    /// its own samples in order, bit for bit `add_environment_samples`.
+    /// (the lobe too on glossy lanes) and the shadow rays in lanes, each lane
+    /// summing its own samples in order: bit for bit the one-ray reference's
+    /// `environment_light`.
     pub(crate) fn environment_term_lanes<T: Tracer>(
         &self,
         scene: &Scene,

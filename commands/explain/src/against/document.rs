@@ -98,3 +98,11 @@ impl<'de> Visitor<'de> for NodeVisitor {
         Ok(Node::Object(entries))
     }
 }
+
+/// A JSON error as `:LINE:COLUMN: message`, to follow a document's name:
+/// serde_json's own " at line L column C" moved to the front.
+pub fn located(e: &serde_json::Error) -> String {
+    let message = e.to_string();
+    let message = message.split(" at line ").next().unwrap_or(&message);
+    format!(":{}:{}: {message}", e.line(), e.column())
+}

@@ -24,7 +24,7 @@ mod keys;
 mod walk;
 
 pub use comparison::{Comparison, Difference, StageComparison, Tolerance};
-pub use document::Node;
+pub use document::{located, Node};
 use keys::*;
 pub use keys::{PIPELINE_ORDER, SKIPPED};
 use walk::{same, Walk};

@@ -273,15 +273,8 @@ fn read_json(
     layout: &Layout,
     ids: &BTreeSet<String>,
 ) -> Result<Rows, String> {
-    let document: Json = serde_json::from_str(text).map_err(|e| {
-        let message = e.to_string();
-        let message = message
-            .split(" at line ")
-            .next()
-            .unwrap_or(&message)
-            .to_owned();
-        format!(":{}:{}: {message}", e.line(), e.column())
-    })?;
+    let document: Json =
+        serde_json::from_str(text).map_err(|e| glint_explain::against::located(&e))?;
     // Glint's own document: its cases' expected objects.
     let glint = document.get("schema").and_then(Json::as_str) == Some(super::SCHEMA);
     let items = match (&document, glint) {

@@ -155,8 +155,13 @@ pub(crate) fn diff(args: &DiffArgs) -> Result<(), Failure> {
         .map_err(|e| Failure::Input(format!("{}: --region: {e}", args.test.display())))?;
 
     let (t, r) = (ImageView::from(&test), ImageView::from(&reference));
-    let flip_map = flip(t, r);
-    let c = compare_with_flip_map(t, r, region, &flip_map);
+    let unmeasurable = |e| Failure::Input(format!("{}: {e}", args.test.display()));
+    let flip_map = flip(t, r).map_err(unmeasurable)?;
+    let c = compare_with_flip_map(t, r, region, &flip_map).map_err(unmeasurable)?;
+    let non_finite = [
+        non_finite_count(t, region).map_err(unmeasurable)?,
+        non_finite_count(r, region).map_err(unmeasurable)?,
+    ];
 
     let heat = match &args.heatmap {
         Some(path) => Some(write_heatmap(path, args, (t, r), flip_map, region)?),
@@ -172,11 +177,18 @@ pub(crate) fn diff(args: &DiffArgs) -> Result<(), Failure> {
     let out = match args.json {
         true => {
             let verdict = (tolerance, within);
-            let document = json_document(args, (&test, &reference), region, &c, &heat, verdict);
+            let document = json_document(
+                args,
+                (&test, &reference),
+                region,
+                (&c, non_finite),
+                &heat,
+                verdict,
+            );
             serde_json::to_string_pretty(&document).expect("JSON of numbers and strings") + "\n"
         }
         false => {
-            let mut text = table(args, (&test, &reference), region, &c, &heat);
+            let mut text = table(args, (&test, &reference), region, (&c, non_finite), &heat);
             let (value, tolerance) = (number(value), tolerance_text(args, tolerance));
             text += &match within {
                 true => format!("within tolerance: {label} {value} <= {tolerance}\n"),
@@ -210,6 +222,11 @@ fn tolerance_text(args: &DiffArgs, tolerance: f64) -> String {
     }
 }
 
+/// A measurement refused after [`diff`] checked its sizes and region.
+fn other(e: glint_metrics::MetricsError) -> Failure {
+    Failure::Other(e.to_string())
+}
+
 /// The heat map written: its file, the error it shows and its scale.
 struct Heat {
     path: PathBuf,
@@ -226,7 +243,7 @@ fn write_heatmap(
 ) -> Result<Heat, Failure> {
     let (map, name) = match args.heatmap_metric {
         HeatmapMetric::Flip => (flip_map, "FLIP"),
-        HeatmapMetric::Relmse => (rel_mse_map(t, r), "relMSE per pixel"),
+        HeatmapMetric::Relmse => (rel_mse_map(t, r).map_err(other)?, "relMSE per pixel"),
     };
     let scale = args
         .heatmap_scale
@@ -234,7 +251,8 @@ fn write_heatmap(
             HeatmapMetric::Flip => 1.0,
             HeatmapMetric::Relmse => percentile_99(&map, region),
         });
-    save_heatmap(path, map.width, map.height, &heatmap(&map, scale)).map_err(Failure::Other)?;
+    let colors = heatmap(&map, scale).map_err(other)?;
+    save_heatmap(path, map.width, map.height, &colors).map_err(Failure::Other)?;
     Ok(Heat {
         path: path.to_owned(),
         name,
@@ -247,11 +265,10 @@ fn table(
     args: &DiffArgs,
     (test, reference): (&Film, &Film),
     region: Region,
-    c: &Comparison,
+    (c, non_finite): (&Comparison, [u64; 2]),
     heat: &Option<Heat>,
 ) -> String {
     let size = test.resolution();
-    let (t, r) = (ImageView::from(test), ImageView::from(reference));
     let mut table = Table::default();
     table.row("A (test)", [args.test.display().to_string()]);
     table.row("B (reference)", [args.reference.display().to_string()]);
@@ -269,10 +286,7 @@ fn table(
             [number(c.means_test[i]), number(c.means_reference[i])],
         );
     }
-    table.row(
-        "non-finite",
-        [non_finite_count(t, region), non_finite_count(r, region)].map(|n| n.to_string()),
-    );
+    table.row("non-finite", non_finite.map(|n| n.to_string()));
     table.row("RMSE", [number(c.rmse)]);
     table.row("relMSE", [number(c.rel_mse)]);
     table.row("mean FLIP", [number(c.flip)]);
@@ -312,13 +326,12 @@ fn json_document(
     args: &DiffArgs,
     (test, reference): (&Film, &Film),
     region: Region,
-    c: &Comparison,
+    (c, non_finite): (&Comparison, [u64; 2]),
     heat: &Option<Heat>,
     (tolerance, within): (f64, bool),
 ) -> serde_json::Value {
     use serde_json::json;
     let finite = |v: f64| v.is_finite().then_some(v);
-    let (t, r) = (ImageView::from(test), ImageView::from(reference));
     let m = c.max_difference;
     let size = test.resolution();
     json!({
@@ -331,7 +344,7 @@ fn json_document(
             "test": c.means_test.to_array().map(finite),
             "reference": c.means_reference.to_array().map(finite),
         },
-        "non_finite": {"test": non_finite_count(t, region), "reference": non_finite_count(r, region)},
+        "non_finite": {"test": non_finite[0], "reference": non_finite[1]},
         "rmse": finite(c.rmse),
         "rel_mse": finite(c.rel_mse),
         "flip": finite(c.flip),

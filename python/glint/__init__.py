@@ -281,19 +281,22 @@ def _stated(stated: Mapping[str, Any]) -> Dict[str, Any]:
 
 
 def grade(
-    scene: PathLike,
+    scene: Union[PathLike, Scene],
     *submissions: Any,
     alpha: float = 0.01,
     block: Optional[int] = None,
     cache: Optional[PathLike] = None,
     **stated: Any,
 ) -> GradeReport:
-    """Grades image files or float32 ``(h, w, 3)`` arrays against the scene
-    file ``scene`` as ``glint grade SCENE IMAGE...`` does, under the settings
-    the submissions state (:data:`STATED`: ``spp``, ``pixel_sampler``,
-    ``light_samples``, ``light_sampler``), at significance ``alpha``;
-    references are cached in ``cache`` where given. An array is graded as
-    the lossless PFM file of its values."""
+    """Grades image files or float32 ``(h, w, 3)`` arrays against ``scene``
+    (a scene file, or a :class:`Scene` from :func:`load_string` or
+    :func:`load_dict`, its settings replaced or not) as ``glint grade SCENE
+    IMAGE...`` does, under the settings the submissions state
+    (:data:`STATED`: ``spp``, ``pixel_sampler``, ``light_samples``,
+    ``light_sampler``), at significance ``alpha``; references are cached in
+    ``cache`` where given (a scene from memory by its text and replaced
+    settings, a file by its bytes). An array is graded as the lossless PFM
+    file of its values."""
     import tempfile
 
     with tempfile.TemporaryDirectory(prefix="glint-grade-") as folder:
@@ -307,7 +310,8 @@ def grade(
                 files.append(path)
         if not files:
             raise ValueError("give the images to grade after the scene")
-        graded = _glint.grade_json(os.fspath(scene), files, _stated(stated), alpha, block, _path(cache))
+        against = scene._inner if isinstance(scene, Scene) else os.fspath(scene)
+        graded = _glint.grade_json(against, files, _stated(stated), alpha, block, _path(cache))
     return GradeReport(graded)
 
 

@@ -1,6 +1,6 @@
 """The extension module behind :mod:`glint` (Rust, pyo3). Use :mod:`glint`."""
 
-from typing import Any, Callable, Dict, Optional, Tuple
+from typing import Any, Callable, Dict, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -42,7 +42,7 @@ def encode(image: npt.NDArray[np.float32], format: str) -> bytes: ...
 def diff(test: npt.NDArray[np.float32], reference: npt.NDArray[np.float32]) -> Dict[str, Any]: ...
 def main(program: str, args: list[str]) -> int: ...
 def grade_json(
-    scene: str,
+    scene: Union[str, Scene],
     files: list[str],
     stated: Dict[str, Any],
     alpha: float = 0.01,

@@ -3,12 +3,12 @@
 
 use glint_grade::class::{self, ClassOptions, Progress};
 use glint_grade::course::Scenes;
-use glint_grade::{Cache, GradeError, StatedSettings, TestOptions};
+use glint_grade::{Cache, GradeError, GradeScene, StatedSettings, TestOptions};
 use glint_integrator::SamplePattern;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 /// The settings a class's submissions state, by `glint grade`'s flag names.
 #[derive(FromPyObject)]
@@ -28,21 +28,34 @@ impl Progress for Quiet {
     fn graded(&self, _: usize, _: usize) {}
 }
 
+/// What one scene's submissions are graded against.
+pub(crate) enum Against {
+    /// A scene file, loaded as `glint grade SCENE` loads it.
+    File(PathBuf),
+    /// A scene already loaded.
+    Loaded(Box<GradeScene>),
+}
+
 /// `glint grade SCENE FILE... --format json` with the stated settings,
 /// `alpha`, `block` and reference cache folder (none without).
 pub(crate) fn grade_json(
-    scene: PathBuf,
+    scene: Against,
     files: Vec<PathBuf>,
     stated: Stated,
     test: (f64, Option<u32>, Option<PathBuf>),
 ) -> PyResult<Graded> {
     let stated = stated_settings(stated)?;
-    glint_grade::GradeScene::load(&scene).map_err(input)?;
-    let entries = class::entries_of_scene(&scene, &files, &stated);
+    let (path, scenes) = match scene {
+        Against::File(path) => {
+            GradeScene::load(&path).map_err(input)?;
+            (path, Scenes::Folder(PathBuf::new()))
+        }
+        Against::Loaded(scene) => (scene.path.clone(), Scenes::Loaded(Arc::new(*scene))),
+    };
+    let entries = class::entries_of_scene(&path, &files, &stated);
     for entry in &entries {
         glint_grade::Submission::load(&entry.file).map_err(PyValueError::new_err)?;
     }
-    let scenes = Scenes::Folder(PathBuf::new());
     report_json(&entries, (&scenes, &PathBuf::new()), test)
 }
 

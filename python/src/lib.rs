@@ -23,16 +23,59 @@ use convert::{array_of, film_of, overrides_of, toml_of};
 use errors::{glint_error, not_found, scene_error};
 use glint_camera::{Film, ImageFormat};
 use glint_integrator::{Crop, RenderSettings};
+use glint_metrics::ImageView;
 use glint_scene::SceneDescription;
 use numpy::{PyArray3, PyReadonlyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
 
-/// A loaded scene with its render settings (`glint.Scene` wraps it).
+/// A loaded scene with its render settings (`glint.Scene` wraps it), and
+/// where it came from, which grading's reference cache is keyed by.
 #[pyclass(module = "glint._glint", frozen)]
 struct Scene {
     description: SceneDescription,
+    origin: Origin,
+    overrides: glint_scene::Overrides,
+}
+
+/// Where a scene was read from.
+enum Origin {
+    File(PathBuf),
+    /// TOML text (a dict's, as written), and the name errors call it by.
+    Text {
+        name: String,
+        text: String,
+    },
+}
+
+impl Scene {
+    /// The scene as grading takes it: a file read as it is keys the cache as
+    /// `glint grade` does (by the file); otherwise by its text and the
+    /// settings that replaced the text's.
+    fn grade_scene(&self) -> PyResult<glint_grade::GradeScene> {
+        use glint_grade::GradeScene;
+        let description = self.description.clone();
+        let replaced = format!("\nreplaced: {:?}", self.overrides);
+        Ok(match &self.origin {
+            Origin::File(path) if self.overrides == Default::default() => {
+                GradeScene::from_file(path, description)
+            }
+            Origin::File(path) => {
+                let text = std::fs::read_to_string(path).map_err(|e| {
+                    pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", path.display()))
+                })?;
+                GradeScene::from_text(
+                    &path.display().to_string(),
+                    &(text + &replaced),
+                    description,
+                )
+            }
+            Origin::Text { name, text } => {
+                GradeScene::from_text(name, &format!("{text}{replaced}"), description)
+            }
+        })
+    }
 }
 
 #[pymethods]
@@ -175,7 +218,7 @@ fn load(py: Python<'_>, path: PathBuf, overrides: &Bound<'_, PyDict>) -> PyResul
     let description = py
         .detach(|| glint_scene::load(&path))
         .map_err(|e| scene_error(py, e))?;
-    prepared(py, description, &overrides)
+    prepared(py, description, Origin::File(path), overrides)
 }
 
 /// Parses scene text, or a dict of the file's tables, whose asset paths are
@@ -196,18 +239,24 @@ fn parse(
     let description = py
         .detach(|| glint_scene::parse_in(&text, name, &base_dir))
         .map_err(|e| scene_error(py, e))?;
-    prepared(py, description, &overrides)
+    let name = name.to_owned();
+    prepared(py, description, Origin::Text { name, text }, overrides)
 }
 
 /// The scene with `overrides` applied (prepared for them, checked).
 fn prepared(
     py: Python<'_>,
     mut description: SceneDescription,
-    overrides: &glint_scene::Overrides,
+    origin: Origin,
+    overrides: glint_scene::Overrides,
 ) -> PyResult<Scene> {
     py.detach(|| overrides.apply(&mut description))
         .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
-    Ok(Scene { description })
+    Ok(Scene {
+        description,
+        origin,
+        overrides,
+    })
 }
 
 /// Reads an image file of any format Glint reads: its linear pixels and
@@ -253,23 +302,13 @@ fn diff<'py>(
     reference: PyReadonlyArray3<'_, f32>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (test, reference) = (film_of(&test)?, film_of(&reference)?);
-    let (size, other) = (test.resolution(), reference.resolution());
+    let size = test.resolution();
     let c = py
         .detach(|| {
-            let test_view = glint_metrics::ImageView {
-                width: size.x,
-                height: size.y,
-                pixels: test.pixels(),
-            };
-            let reference_view = glint_metrics::ImageView {
-                width: other.x,
-                height: other.y,
-                pixels: reference.pixels(),
-            };
-            let region = glint_metrics::Region::full(size.x, size.y);
-            glint_metrics::try_compare(test_view, reference_view, region)
+            let (test, reference) = (ImageView::from(&test), ImageView::from(&reference));
+            glint_metrics::compare(test, reference, glint_metrics::Region::full(size.x, size.y))
         })
-        .map_err(pyo3::exceptions::PyValueError::new_err)?;
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
     let d = PyDict::new(py);
     d.set_item("rmse", c.rmse)?;
     d.set_item("rel_mse", c.rel_mse)?;
@@ -282,19 +321,30 @@ fn diff<'py>(
     Ok(d)
 }
 
+/// What `glint.grade` grades against: a scene file or a loaded scene.
+#[derive(FromPyObject)]
+enum SceneArg<'py> {
+    Loaded(Bound<'py, Scene>),
+    File(PathBuf),
+}
+
 /// `glint grade SCENE FILE... --format json` with these settings: the
 /// document as text.
 #[pyfunction]
 #[pyo3(signature = (scene, files, stated, alpha=0.01, block=None, cache=None))]
-fn grade_json(
-    py: Python<'_>,
-    scene: PathBuf,
+fn grade_json<'py>(
+    py: Python<'py>,
+    scene: SceneArg<'py>,
     files: Vec<PathBuf>,
     stated: grade::Stated,
     alpha: f64,
     block: Option<u32>,
     cache: Option<PathBuf>,
-) -> PyResult<GradedPy<'_>> {
+) -> PyResult<GradedPy<'py>> {
+    let scene = match scene {
+        SceneArg::File(path) => grade::Against::File(path),
+        SceneArg::Loaded(scene) => grade::Against::Loaded(Box::new(scene.get().grade_scene()?)),
+    };
     let graded = py.detach(|| grade::grade_json(scene, files, stated, (alpha, block, cache)))?;
     Ok(graded_py(py, graded))
 }

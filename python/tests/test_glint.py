@@ -260,6 +260,44 @@ def test_grade_is_the_clis_document(glint_bin, tmp_path):
         glint.grade(scene, good, pixel_sampler="halton")
 
 
+def test_grade_a_scene_from_memory_keys_the_cache_by_its_text(glint_bin, tmp_path):
+    path = SCENES / "cornell-set1.toml"
+    flags = ["--spp", "4", "--sampler", "random", "--light-samples", "4", "--light-sampler", "random"]
+    good, bad = tmp_path / "good.pfm", tmp_path / "bad.pfm"
+    cli(glint_bin, "render", str(path), *flags, "--resolution", "48x40", "--seed", "5", "-o", str(good))
+    glint.imwrite(bad, glint.imread(good) * np.float32(0.9))
+    stated = {"spp": 4, "pixel_sampler": "random", "light_samples": 4, "light_sampler": "random"}
+    by_file, by_text = tmp_path / "by-file", tmp_path / "by-text"
+
+    def cached(folder):
+        return {p.name: p.stat().st_mtime_ns for p in folder.iterdir()}
+
+    from_file = glint.grade(path, good, bad, cache=by_file, **stated)
+    # A Scene read from the file, nothing replaced, shares glint grade's cache.
+    files = cached(by_file)
+    again = glint.grade(glint.load(path), good, bad, cache=by_file, **stated)
+    assert cached(by_file) == files
+    assert again.to_dict() == from_file.to_dict()
+    # The same text from memory grades alike, under its own name and key.
+    text = path.read_text()
+    from_text = glint.grade(glint.load_string(text, base_dir=SCENES), good, bad, cache=by_text, **stated)
+    assert [s["verdict"] for s in from_text.submissions] == ["pass", "fail"]
+    assert {s["scene"] for s in from_text.submissions} == {"<string>"}
+    strip = lambda report: [{k: v for k, v in s.items() if k != "scene"} for s in report.submissions]
+    assert strip(from_text) == strip(from_file)
+    assert set(cached(by_text)).isdisjoint(files)
+    # Graded again from equal text, the references are read, not rendered.
+    texts = cached(by_text)
+    glint.grade(glint.load_string(text, base_dir=SCENES), good, cache=by_text, **stated)
+    assert cached(by_text) == texts
+    # Other text, or a replaced setting, is another scene: references of its own.
+    changed = text.replace("[camera]", "[camera]\n# a comment", 1)
+    glint.grade(glint.load_string(changed, base_dir=SCENES), good, cache=by_text, **stated)
+    glint.grade(glint.load_string(text, base_dir=SCENES, max_depth=2), good, cache=by_text, **stated)
+    added = set(cached(by_text)) - set(texts)
+    assert len(added) == 2 * len(texts), sorted(added)
+
+
 def test_explain_against_is_the_clis_comparison(glint_bin, tmp_path):
     path = SCENES / "cornell-set1.toml"
     flags = ["--spp", "4", "--resolution", "48x40"]

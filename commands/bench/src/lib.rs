@@ -59,6 +59,14 @@ pub enum BenchError {
     Other(String),
 }
 
+/// Measurements of images the bench itself made: sizes that do not fit are
+/// its own fault, not the user's.
+impl From<glint_metrics::MetricsError> for BenchError {
+    fn from(e: glint_metrics::MetricsError) -> Self {
+        BenchError::Other(e.to_string())
+    }
+}
+
 /// The region errors are measured over.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum RegionChoice {
@@ -235,14 +243,14 @@ pub fn run(
     progress(Progress::Step(
         "measuring errors (RMSE, relative MSE, FLIP)",
     ));
-    let rows = rows(config, &measurements, &reference, region);
+    let rows = rows(config, &measurements, &reference, region)?;
     let strategies = summaries(&names(config), &rows);
     let baseline = baseline(&names(config), &rows);
     let heatmap_step = config
         .heatmap_step
         .unwrap_or(usize::MAX)
         .min(steps(&measurements).saturating_sub(1));
-    let (heatmaps, heatmap_summary) = heatmaps(config, &measurements, &reference, heatmap_step);
+    let (heatmaps, heatmap_summary) = heatmaps(config, &measurements, &reference, heatmap_step)?;
     let smallest = rows.iter().map(|r| r.rel_mse).fold(f64::INFINITY, f64::min);
     let noise = reference.noise_rel_mse(region);
     let report = Report {
@@ -610,7 +618,7 @@ fn rendered_reference(
                     region,
                 )
             })
-            .fold(f64::INFINITY, f64::min);
+            .try_fold(f64::INFINITY, |a, b| b.map(|b| a.min(b)))?;
         // The measured error is on average the true error plus the noise.
         if noise * (reference::NOISE_MARGIN + 1.0) <= smallest {
             return finish_reference(&cache, &key, &fingerprint, reference, rendered);
@@ -649,16 +657,16 @@ fn rows(
     measurements: &[Measurement],
     reference: &Reference,
     region: Region,
-) -> Vec<Row> {
+) -> Result<Vec<Row>, BenchError> {
     let (w, h) = (reference.width, reference.height);
     let reference_view = view(&reference.mean, w, h);
     measurements
         .iter()
         .map(|m| {
             let test = view(&m.image, w, h);
-            let rel_mse = glint_metrics::rel_mse(test, reference_view, region);
+            let rel_mse = glint_metrics::rel_mse(test, reference_view, region)?;
             let seconds = m.median_time().as_secs_f64();
-            Row {
+            Ok(Row {
                 strategy: config.strategies[m.strategy].name(),
                 spp: m.budget.spp,
                 light_samples: m.budget.light_samples,
@@ -672,11 +680,11 @@ fn rows(
                 camera_rays: m.stats.camera_rays,
                 shadow_rays: m.stats.shadow_rays,
                 reflection_rays: m.stats.reflection_rays,
-                rmse: glint_metrics::rmse(test, reference_view, region),
+                rmse: glint_metrics::rmse(test, reference_view, region)?,
                 rel_mse,
-                flip: glint_metrics::flip(test, reference_view).mean(region),
+                flip: glint_metrics::flip(test, reference_view)?.mean(region)?,
                 efficiency: 1.0 / (rel_mse * seconds),
-            }
+            })
         })
         .collect()
 }
@@ -779,17 +787,15 @@ fn heatmaps(
     measurements: &[Measurement],
     reference: &Reference,
     step: usize,
-) -> (Vec<Heatmap>, HeatmapSummary) {
+) -> Result<(Vec<Heatmap>, HeatmapSummary), BenchError> {
     let (w, h) = (reference.width, reference.height);
     let maps: Vec<(usize, glint_metrics::ErrorMap)> = (0..config.strategies.len())
         .filter_map(|s| {
             let m = measurements.iter().filter(|m| m.strategy == s).nth(step)?;
-            Some((
-                s,
-                glint_metrics::rel_mse_map(view(&m.image, w, h), view(&reference.mean, w, h)),
-            ))
+            let map = glint_metrics::rel_mse_map(view(&m.image, w, h), view(&reference.mean, w, h));
+            Some(map.map(|map| (s, map)))
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
     let mut all: Vec<f32> = maps
         .iter()
         .flat_map(|(_, m)| m.values.iter().copied())
@@ -803,17 +809,19 @@ fn heatmaps(
         .unwrap_or(1.0);
     let files: Vec<Heatmap> = maps
         .iter()
-        .map(|(s, map)| Heatmap {
-            file: format!("heatmap-{}.png", config.strategies[*s].file_stem()),
-            pixels: glint_metrics::heatmap(map, scale),
+        .map(|(s, map)| {
+            Ok(Heatmap {
+                file: format!("heatmap-{}.png", config.strategies[*s].file_stem()),
+                pixels: glint_metrics::heatmap(map, scale)?,
+            })
         })
-        .collect();
+        .collect::<Result<_, BenchError>>()?;
     let summary = HeatmapSummary {
         step,
         scale,
         files: files.iter().map(|h| h.file.clone()).collect(),
     };
-    (files, summary)
+    Ok((files, summary))
 }
 
 #[cfg(doctest)]

@@ -442,7 +442,7 @@ fn probe(
     base: &Path,
 ) -> Result<(Vec<Located>, Loaded, Vec<Probe>), GradeError> {
     let entries = with_presets(entries, scenes, base)?;
-    let loaded = load_scenes(&entries);
+    let loaded = load_scenes(&entries, scenes);
     let probes: Vec<Probe> = entries
         .par_iter()
         .map(|(entry, found)| {
@@ -469,8 +469,11 @@ type Probe = Result<(PathBuf, UVec2, Option<JpegEncoding>), String>;
 /// load fails only its rows.
 type Loaded = BTreeMap<PathBuf, Result<Arc<GradeScene>, String>>;
 
-fn load_scenes(entries: &[Located]) -> Loaded {
+fn load_scenes(entries: &[Located], scenes: &Scenes) -> Loaded {
     let mut loaded = Loaded::new();
+    if let Scenes::Loaded(scene) = scenes {
+        loaded.insert(scene.path.clone(), Ok(scene.clone()));
+    }
     for (_, found) in entries {
         let Ok(path) = found else { continue };
         loaded.entry(path.clone()).or_insert_with(|| {

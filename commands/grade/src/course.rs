@@ -3,11 +3,12 @@
 //! `[scenes.NAME]` a scene file and the settings the course renders it with).
 
 use crate::hypothesis::StatedSettings;
-use crate::GradeError;
+use crate::{GradeError, GradeScene};
 use glint_integrator::SamplePattern;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// How scene names become scene files and preset settings.
 #[derive(Clone, Debug)]
@@ -16,6 +17,8 @@ pub enum Scenes {
     Folder(PathBuf),
     /// A course index.
     Course(Course),
+    /// One scene already loaded (from memory, say): every name means it.
+    Loaded(Arc<GradeScene>),
 }
 
 /// A course index: its scenes by name.
@@ -37,12 +40,12 @@ pub struct CourseScene {
 
 impl Scenes {
     /// The scene file `name` means, and the settings it presets: a path to a
-    /// `.toml` file is taken as it is (relative to `base`).
+    /// `.toml` file is taken as it is (relative to `base`); a loaded scene is
+    /// every name's.
     pub fn resolve(&self, name: &str, base: &Path) -> Result<(PathBuf, StatedSettings), String> {
-        if name.ends_with(".toml") {
-            return Ok((base.join(name), StatedSettings::default()));
-        }
         match self {
+            Scenes::Loaded(scene) => Ok((scene.path.clone(), StatedSettings::default())),
+            _ if name.ends_with(".toml") => Ok((base.join(name), StatedSettings::default())),
             Scenes::Folder(dir) => {
                 Ok((dir.join(format!("{name}.toml")), StatedSettings::default()))
             }

@@ -20,26 +20,52 @@ use std::time::{Duration, Instant};
 /// The object index of a pixel whose centre sees no object.
 pub const BACKGROUND: u32 = u32::MAX;
 
-/// A scene to grade against: its description and every file it was read
-/// from (the cache's key hashes them).
+/// A scene to grade against: its description and what the reference
+/// cache's key hashes, which is every file it was read from or, for a scene
+/// from memory, its text and its assets.
+#[derive(Debug)]
 pub struct GradeScene {
+    /// The scene file, or what names a scene from memory in reports.
     pub path: PathBuf,
     pub description: SceneDescription,
-    /// The scene file and its assets.
+    /// The scene file (unless from memory) and its assets.
     pub inputs: Vec<PathBuf>,
+    /// A scene from memory: the BLAKE3 hash of its text, hashed by the
+    /// cache's key in place of a scene file.
+    pub text_hash: Option<String>,
 }
 
 impl GradeScene {
+    /// A scene from memory, named `name`, read as `description` from `text`:
+    /// everything that made the description beside its assets (the scene's
+    /// text and whatever replaced its settings), so that equal texts share
+    /// cached references and any change in them does not.
+    pub fn from_text(name: &str, text: &str, description: SceneDescription) -> GradeScene {
+        GradeScene {
+            path: PathBuf::from(name),
+            inputs: description.assets.clone(),
+            text_hash: Some(blake3::hash(text.as_bytes()).to_hex().to_string()),
+            description,
+        }
+    }
+
     pub fn load(path: &Path) -> Result<GradeScene, GradeError> {
         let description = glint_scene::load(path).map_err(|e| GradeError::Input(e.to_string()))?;
+        Ok(GradeScene::from_file(path, description))
+    }
+
+    /// The scene file at `path`, already read as `description` (nothing
+    /// replaced in it: the cache's key hashes the file as it is).
+    pub fn from_file(path: &Path, description: SceneDescription) -> GradeScene {
         let inputs = std::iter::once(path.to_owned())
             .chain(description.assets.iter().cloned())
             .collect();
-        Ok(GradeScene {
+        GradeScene {
             path: path.to_owned(),
             description,
             inputs,
-        })
+            text_hash: None,
+        }
     }
 
     /// The scene's own render settings (its `[render]` table).
@@ -319,8 +345,12 @@ impl Job<'_> {
     ) -> Result<[Estimate; K], GradeError> {
         let (w, h) = (self.resolution.x, self.resolution.y);
         let fingerprint = |k: usize| {
+            let text = match &self.scene.text_hash {
+                Some(hash) => format!(", scene text {hash}"),
+                None => String::new(),
+            };
             format!(
-                "glint-grade {name} reference{tag}, transform {k} of {K}, rounds={rounds} {}",
+                "glint-grade {name} reference{tag}, transform {k} of {K}, rounds={rounds}{text} {}",
                 glint_bench::reference::settings_fingerprint(settings, w, h)
             )
         };

@@ -1,7 +1,9 @@
 //! [`compare`]: every metric of a test image against a reference at once.
 
+use crate::difference::comparable;
 use crate::{
-    channel_means, flip, max_difference, rel_mse, rmse, ErrorMap, ImageView, MaxDifference, Region,
+    channel_means, flip, max_difference, rel_mse, rmse, ErrorMap, ImageView, MaxDifference,
+    MetricsError, Region,
 };
 use glam::DVec3;
 
@@ -26,68 +28,44 @@ pub struct Comparison {
 /// map is computed on the whole images (its filters see past the region's edge)
 /// and averaged over the region.
 ///
-/// # Panics
-/// If the images differ in size, or the region is empty or outside them.
-pub fn compare(test: ImageView, reference: ImageView, region: Region) -> Comparison {
-    compare_with_flip_map(test, reference, region, &flip(test, reference))
-}
-
-/// [`compare`] where the inputs may not fit: the same comparison, or why
-/// not (images of other sizes, a view whose pixels do not fill its size, an
-/// empty region or one outside the images), for callers whose sizes come
-/// from a user (the Python package's arrays).
-pub fn try_compare(
+/// # Errors
+/// If the images differ in size, a view's pixels do not fill it, or the
+/// region is empty or outside them.
+pub fn compare(
     test: ImageView,
     reference: ImageView,
     region: Region,
-) -> Result<Comparison, String> {
-    for (name, view) in [("test", &test), ("reference", &reference)] {
-        let (w, h) = (u64::from(view.width), u64::from(view.height));
-        if view.pixels.len() as u64 != w * h {
-            return Err(format!(
-                "the {name} image is {w}x{h} but holds {} pixels",
-                view.pixels.len()
-            ));
-        }
-    }
-    if (test.width, test.height) != (reference.width, reference.height) {
-        return Err(format!(
-            "the images differ in size: {}x{} and {}x{}",
-            test.width, test.height, reference.width, reference.height
-        ));
-    }
-    region.check(test.width, test.height)?;
-    Ok(compare(test, reference, region))
+) -> Result<Comparison, MetricsError> {
+    comparable(&test, &reference, region)?;
+    compare_with_flip_map(test, reference, region, &flip(test, reference)?)
 }
 
 /// [`compare`] with a FLIP map already computed (`flip(test, reference)`), for a
 /// caller that also wants the map itself, e.g. for a heat map.
 ///
-/// # Panics
+/// # Errors
 /// As [`compare`], and if the map's size is not the images'.
 pub fn compare_with_flip_map(
     test: ImageView,
     reference: ImageView,
     region: Region,
     flip_map: &ErrorMap,
-) -> Comparison {
-    crate::difference::assert_comparable(&test, &reference, region);
-    assert!(
-        flip_map.width == test.width && flip_map.height == test.height,
-        "the FLIP map is {}x{}, the images {}x{}",
-        flip_map.width,
-        flip_map.height,
-        test.width,
-        test.height
-    );
-    Comparison {
-        means_test: channel_means(test, region),
-        means_reference: channel_means(reference, region),
-        rmse: rmse(test, reference, region),
-        rel_mse: rel_mse(test, reference, region),
-        flip: flip_map.mean(region),
-        max_difference: max_difference(test, reference, region),
+) -> Result<Comparison, MetricsError> {
+    comparable(&test, &reference, region)?;
+    if (flip_map.width, flip_map.height) != (test.width, test.height) {
+        return Err(MetricsError::SizeMismatch {
+            test: (flip_map.width, flip_map.height),
+            reference: (test.width, test.height),
+        });
     }
+    Ok(Comparison {
+        means_test: channel_means(test, region)?,
+        means_reference: channel_means(reference, region)?,
+        rmse: rmse(test, reference, region)?,
+        rel_mse: rel_mse(test, reference, region)?,
+        flip: flip_map.mean(region)?,
+        max_difference: max_difference(test, reference, region)?,
+    })
 }
 
 #[cfg(test)]
@@ -96,28 +74,35 @@ mod tests {
     use glam::Vec3;
 
     #[test]
-    fn try_compare_refuses_what_compare_panics_on() {
+    fn compare_refuses_images_that_do_not_fit() {
         let four = [Vec3::ONE; 4];
         let six = [Vec3::ONE; 6];
-        let (a, b) = (ImageView::new(2, 2, &four), ImageView::new(3, 2, &six));
+        let (a, b) = (
+            ImageView::new(2, 2, &four).unwrap(),
+            ImageView::new(3, 2, &six).unwrap(),
+        );
         let whole = Region::full(2, 2);
-        let err = try_compare(a, b, whole).unwrap_err();
-        assert!(err.contains("differ in size: 2x2 and 3x2"), "{err}");
+        let err = compare(a, b, whole).unwrap_err().to_string();
+        assert_eq!(err, "the images differ in size: 2x2 and 3x2");
         let short = ImageView {
             width: 3,
             height: 3,
             pixels: &six,
         };
-        assert!(try_compare(short, short, whole)
-            .unwrap_err()
-            .contains("holds 6 pixels"));
+        let err = compare(short, short, whole).unwrap_err().to_string();
+        assert_eq!(err, "an image of 3x3 pixels needs 9 values, it has 6");
         let outside = Region {
             x0: 0,
             y0: 0,
             x1: 3,
             y1: 2,
         };
-        assert!(try_compare(a, a, outside).is_err());
-        assert_eq!(try_compare(a, a, whole).unwrap(), compare(a, a, whole));
+        assert!(matches!(
+            compare(a, a, outside),
+            Err(MetricsError::Region(_))
+        ));
+        let map = flip(a, a).unwrap();
+        assert!(compare_with_flip_map(b, b, Region::full(3, 2), &map).is_err());
+        assert_eq!(compare(a, a, whole).unwrap().rmse, 0.0);
     }
 }

@@ -1,7 +1,7 @@
 //! The per-channel difference every metric is built on, and the checks every
 //! metric makes on its arguments.
 
-use crate::{ImageView, Region};
+use crate::{ImageView, MetricsError, Region};
 
 /// `x − r` in f64, except that two identical values (the same bits: equal
 /// numbers, the same infinity, the same NaN) differ by exactly 0. So identical
@@ -15,24 +15,27 @@ pub(crate) fn channel_difference(x: f32, r: f32) -> f64 {
     }
 }
 
-/// Panics unless both images have consistent pixel buffers of the same size.
-pub(crate) fn assert_same_size(test: &ImageView, reference: &ImageView) {
-    test.assert_consistent();
-    reference.assert_consistent();
-    assert!(
-        test.width == reference.width && test.height == reference.height,
-        "the test image is {}x{} but the reference is {}x{}: images must be the same size",
-        test.width,
-        test.height,
-        reference.width,
-        reference.height
-    );
+/// `Ok` when both images have full pixel buffers of the same size.
+pub(crate) fn same_size(test: &ImageView, reference: &ImageView) -> Result<(), MetricsError> {
+    test.check()?;
+    reference.check()?;
+    match (test.width, test.height) == (reference.width, reference.height) {
+        true => Ok(()),
+        false => Err(MetricsError::SizeMismatch {
+            test: (test.width, test.height),
+            reference: (reference.width, reference.height),
+        }),
+    }
 }
 
-/// Panics unless the images are the same size and `region` lies inside them.
-pub(crate) fn assert_comparable(test: &ImageView, reference: &ImageView, region: Region) {
-    assert_same_size(test, reference);
-    region.assert_inside(test.width, test.height);
+/// `Ok` when the images are the same size and `region` lies inside them.
+pub(crate) fn comparable(
+    test: &ImageView,
+    reference: &ImageView,
+    region: Region,
+) -> Result<(), MetricsError> {
+    same_size(test, reference)?;
+    region.inside(test.width, test.height)
 }
 
 /// The mean over the region's pixels and the three channels of
@@ -42,8 +45,8 @@ pub(crate) fn mean_over_channels(
     reference: ImageView,
     region: Region,
     term: impl Fn(f32, f32) -> f64,
-) -> f64 {
-    assert_comparable(&test, &reference, region);
+) -> Result<f64, MetricsError> {
+    comparable(&test, &reference, region)?;
     let mut total = 0.0;
     for y in region.rows() {
         let (t, r) = (
@@ -57,5 +60,5 @@ pub(crate) fn mean_over_channels(
             .sum();
         total += row;
     }
-    total / (3 * region.pixel_count()) as f64
+    Ok(total / (3 * region.pixel_count()) as f64)
 }

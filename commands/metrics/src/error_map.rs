@@ -1,6 +1,7 @@
 //! [`ErrorMap`]: one error value per pixel, and its statistics over a region.
 
-use crate::Region;
+use crate::error::check_length;
+use crate::{MetricsError, Region};
 
 /// One error value per pixel (FLIP, relative squared error, …), row-major from
 /// the top-left pixel.
@@ -23,40 +24,42 @@ impl ErrorMap {
         self.values[y as usize * self.width as usize + x as usize]
     }
 
-    fn region_rows(&self, region: Region) -> impl Iterator<Item = &[f32]> + '_ {
-        assert_eq!(
-            self.values.len() as u64,
-            self.width as u64 * self.height as u64,
-            "an ErrorMap of {}x{} needs {} values",
-            self.width,
-            self.height,
-            self.width as u64 * self.height as u64
-        );
-        region.assert_inside(self.width, self.height);
+    /// `Ok` when the values fill the map's size.
+    pub(crate) fn check(&self) -> Result<(), MetricsError> {
+        check_length("an error map", self.width, self.height, self.values.len())
+    }
+
+    fn region_rows(
+        &self,
+        region: Region,
+    ) -> Result<impl Iterator<Item = &[f32]> + '_, MetricsError> {
+        self.check()?;
+        region.inside(self.width, self.height)?;
         let w = self.width as usize;
-        region
+        Ok(region
             .rows()
-            .map(move |y| &self.values[y as usize * w..][region.columns()])
+            .map(move |y| &self.values[y as usize * w..][region.columns()]))
     }
 
     /// The mean of the values in `region`, in f64 (NaN if any is NaN).
     ///
-    /// # Panics
+    /// # Errors
     /// If the region is empty or outside the map.
-    pub fn mean(&self, region: Region) -> f64 {
+    pub fn mean(&self, region: Region) -> Result<f64, MetricsError> {
         let total: f64 = self
-            .region_rows(region)
+            .region_rows(region)?
             .map(|row| row.iter().map(|&v| v as f64).sum::<f64>())
             .sum();
-        total / region.pixel_count() as f64
+        Ok(total / region.pixel_count() as f64)
     }
 
     /// The largest value in `region` (NaN if any is NaN).
     ///
-    /// # Panics
+    /// # Errors
     /// If the region is empty or outside the map.
-    pub fn max(&self, region: Region) -> f32 {
-        self.region_rows(region)
+    pub fn max(&self, region: Region) -> Result<f32, MetricsError> {
+        Ok(self
+            .region_rows(region)?
             .flatten()
             .fold(f32::NEG_INFINITY, |best, &v| {
                 if v.is_nan() || best.is_nan() {
@@ -64,6 +67,6 @@ impl ErrorMap {
                 } else {
                     best.max(v)
                 }
-            })
+            }))
     }
 }

@@ -1,7 +1,7 @@
 //! LDR-FLIP (Andersson et al. 2020), through NVIDIA's own implementation.
 
-use crate::difference::assert_same_size;
-use crate::{ErrorMap, ImageView};
+use crate::difference::same_size;
+use crate::{ErrorMap, ImageView, MetricsError};
 use glint_camera::linear_to_srgb8;
 
 /// The observer's pixels per degree of visual angle FLIP is evaluated at: the
@@ -38,24 +38,21 @@ fn to_flip_image(image: &ImageView) -> nv_flip::FlipImageRgb8 {
 /// Its [`ErrorMap::mean`] over the whole image is the "Mean" the official FLIP
 /// tool prints for the two images saved as PNG.
 ///
-/// # Panics
+/// # Errors
 /// If the images differ in size, or either is empty.
-pub fn flip(test: ImageView, reference: ImageView) -> ErrorMap {
-    assert_same_size(&test, &reference);
-    assert!(
-        test.width > 0 && test.height > 0,
-        "FLIP needs non-empty images, got {}x{}",
-        test.width,
-        test.height
-    );
+pub fn flip(test: ImageView, reference: ImageView) -> Result<ErrorMap, MetricsError> {
+    same_size(&test, &reference)?;
+    if test.width == 0 || test.height == 0 {
+        return Err(MetricsError::Empty(test.width, test.height));
+    }
     let map = nv_flip::flip(
         to_flip_image(&reference),
         to_flip_image(&test),
         FLIP_PIXELS_PER_DEGREE,
     );
-    ErrorMap {
+    Ok(ErrorMap {
         width: test.width,
         height: test.height,
         values: map.to_vec(),
-    }
+    })
 }

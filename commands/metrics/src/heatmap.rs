@@ -1,7 +1,7 @@
 //! Heat maps: an [`ErrorMap`] colored with the magma color map, and writing one
 //! as a PNG.
 
-use crate::ErrorMap;
+use crate::{ErrorMap, MetricsError};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -21,15 +21,16 @@ pub fn magma() -> &'static [[u8; 3]; 256] {
 /// worth seeing). Use `scale = 1` for FLIP, whose values lie in [0, 1]. Rows
 /// from the top, as in the map.
 ///
-/// # Panics
-/// If `scale` is not positive and finite.
-pub fn heatmap(map: &ErrorMap, scale: f32) -> Vec<[u8; 3]> {
-    assert!(
-        scale.is_finite() && scale > 0.0,
-        "a heat map needs a positive, finite scale, got {scale}"
-    );
+/// # Errors
+/// If `scale` is not positive and finite, or the map's values do not fill it.
+pub fn heatmap(map: &ErrorMap, scale: f32) -> Result<Vec<[u8; 3]>, MetricsError> {
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(MetricsError::Scale(scale));
+    }
+    map.check()?;
     let lut = magma();
-    map.values
+    Ok(map
+        .values
         .iter()
         .map(|&v| {
             let t = if v.is_nan() {
@@ -39,28 +40,21 @@ pub fn heatmap(map: &ErrorMap, scale: f32) -> Vec<[u8; 3]> {
             };
             lut[(t * 255.0).round() as usize]
         })
-        .collect()
+        .collect())
 }
 
 /// Writes `rgb` (`width × height` colors, rows from the top) as an 8-bit RGB PNG
 /// at `path`. The image goes to a temporary file beside `path` that is renamed
 /// over it once complete, so a failed write never leaves a partial file and
 /// never destroys what was at `path`; a replaced file keeps its permissions.
-/// Errors name the file.
-///
-/// # Panics
-/// If `rgb` does not hold `width × height` colors.
+/// Errors name the file; `rgb` not holding `width × height` colors is one.
 pub fn save_heatmap(path: &Path, width: u32, height: u32, rgb: &[[u8; 3]]) -> Result<(), String> {
-    assert_eq!(
-        rgb.len() as u64,
-        width as u64 * height as u64,
-        "a {width}x{height} heat map needs {} colors",
-        width as u64 * height as u64
-    );
     let fail =
         |e: &dyn std::fmt::Display| format!("{}: cannot write the heat map: {e}", path.display());
+    crate::error::check_length("a heat map", width, height, rgb.len()).map_err(|e| fail(&e))?;
     let bytes: Vec<u8> = rgb.iter().flatten().copied().collect();
-    let image = image::RgbImage::from_raw(width, height, bytes).expect("length checked above");
+    let image = image::RgbImage::from_raw(width, height, bytes)
+        .ok_or_else(|| fail(&"its colors do not fill it"))?;
     glint_camera::write_atomically(
         path,
         |e| fail(&e),

@@ -1,5 +1,7 @@
 //! [`ImageView`]: borrowed linear RGB pixels with their size.
 
+use crate::error::check_length;
+use crate::MetricsError;
 use glam::Vec3;
 use glint_camera::Film;
 
@@ -13,18 +15,17 @@ pub struct ImageView<'a> {
 }
 
 impl<'a> ImageView<'a> {
-    /// A view of `pixels` as a `width × height` image.
-    ///
-    /// # Panics
-    /// If `pixels` does not hold exactly `width × height` values.
-    pub fn new(width: u32, height: u32, pixels: &'a [Vec3]) -> Self {
+    /// A view of `pixels` as a `width × height` image, or
+    /// [`MetricsError::Length`] unless it holds exactly `width × height`
+    /// values.
+    pub fn new(width: u32, height: u32, pixels: &'a [Vec3]) -> Result<Self, MetricsError> {
         let view = Self {
             width,
             height,
             pixels,
         };
-        view.assert_consistent();
-        view
+        view.check()?;
+        Ok(view)
     }
 
     /// The pixel in column `x`, row `y` (from the top).
@@ -44,22 +45,21 @@ impl<'a> ImageView<'a> {
         &self.pixels[y as usize * w..(y as usize + 1) * w]
     }
 
-    pub(crate) fn assert_consistent(&self) {
-        assert_eq!(
-            self.pixels.len() as u64,
-            self.width as u64 * self.height as u64,
-            "an ImageView of {}x{} pixels needs {} values, it has {}",
-            self.width,
-            self.height,
-            self.width as u64 * self.height as u64,
-            self.pixels.len()
-        );
+    /// `Ok` when the pixels fill the view's size (its fields are public, so
+    /// every measurement checks).
+    pub(crate) fn check(&self) -> Result<(), MetricsError> {
+        check_length("an image", self.width, self.height, self.pixels.len())
     }
 }
 
 impl<'a> From<&'a Film> for ImageView<'a> {
     fn from(film: &'a Film) -> Self {
         let r = film.resolution();
-        Self::new(r.x, r.y, film.pixels())
+        // A film always holds one value per pixel.
+        Self {
+            width: r.x,
+            height: r.y,
+            pixels: film.pixels(),
+        }
     }
 }

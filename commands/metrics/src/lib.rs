@@ -15,9 +15,10 @@
 //!   pixel weighing the same; [`Region::full`] is the whole image. Per-pixel maps
 //!   ([`flip`], [`rel_mse_map`]) cover the whole image; [`ErrorMap::mean`] and
 //!   [`ErrorMap::max`] restrict them to a region.
-//! - **Sizes**: every function panics if the two images differ in size or the
-//!   region is empty or outside them. Callers check first ([`Region::check`],
-//!   comparing sizes), as `glint diff` does to turn a mismatch into an input error.
+//! - **Sizes**: every function returns a [`MetricsError`] (and never panics)
+//!   if the two images differ in size, a buffer does not fill its stated
+//!   size, or the region is empty or outside them; callers whose sizes come
+//!   from users report it as an input error, as `glint diff` does.
 //! - **Results** are `f64`, summed per row in `f64`.
 //! - **Non-finite values are never hidden.** A channel whose two values are
 //!   identical (the same bits, which includes the same infinity or NaN) differs
@@ -47,6 +48,7 @@
 
 mod compare;
 mod difference;
+mod error;
 mod error_map;
 mod flip;
 mod heatmap;
@@ -57,7 +59,8 @@ mod mse;
 mod region;
 mod rel_mse;
 
-pub use compare::{compare, compare_with_flip_map, try_compare, Comparison};
+pub use compare::{compare, compare_with_flip_map, Comparison};
+pub use error::MetricsError;
 pub use error_map::ErrorMap;
 pub use flip::{flip, FLIP_PIXELS_PER_DEGREE};
 pub use heatmap::{heatmap, magma, save_heatmap};

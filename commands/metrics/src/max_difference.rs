@@ -1,7 +1,7 @@
 //! [`max_difference`]: the largest single difference, and where it is.
 
-use crate::difference::{assert_comparable, channel_difference};
-use crate::{ImageView, Region};
+use crate::difference::{channel_difference, comparable};
+use crate::{ImageView, MetricsError, Region};
 
 /// The largest absolute difference of one channel of one pixel.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,10 +41,14 @@ fn beats(d: f64, best: f64) -> bool {
 /// (rows from the top, then columns, then R, G, B) wins. Identical images give
 /// value 0 at the region's first pixel, channel 0.
 ///
-/// # Panics
+/// # Errors
 /// If the images differ in size, or the region is empty or outside them.
-pub fn max_difference(test: ImageView, reference: ImageView, region: Region) -> MaxDifference {
-    assert_comparable(&test, &reference, region);
+pub fn max_difference(
+    test: ImageView,
+    reference: ImageView,
+    region: Region,
+) -> Result<MaxDifference, MetricsError> {
+    comparable(&test, &reference, region)?;
     let mut best = (0.0f64, region.x0, region.y0, 0usize);
     for y in region.rows() {
         let (t, r) = (test.row(y), reference.row(y));
@@ -58,10 +62,10 @@ pub fn max_difference(test: ImageView, reference: ImageView, region: Region) -> 
             }
         }
     }
-    MaxDifference {
+    Ok(MaxDifference {
         value: best.0 as f32,
         x: best.1,
         y: best.2,
         channel: best.3,
-    }
+    })
 }

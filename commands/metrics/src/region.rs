@@ -1,5 +1,7 @@
 //! [`Region`]: the rectangle of pixels a measurement covers.
 
+use crate::MetricsError;
+
 /// A rectangle of pixels, half-open: columns `x0..x1`, rows `y0..y1` (rows from
 /// the top). Every measurement over a region averages (or takes the largest)
 /// over exactly these pixels.
@@ -62,8 +64,8 @@ impl Region {
     }
 
     /// Checks that the region is non-empty and lies inside a `width × height`
-    /// image (`x1 ≤ width`, `y1 ≤ height`). Every measurement panics on a region
-    /// that fails this check.
+    /// image (`x1 ≤ width`, `y1 ≤ height`). Every measurement refuses a region
+    /// that fails this check ([`MetricsError::Region`]).
     pub fn check(&self, width: u32, height: u32) -> Result<(), String> {
         self.check_non_empty()?;
         if self.x1 > width || self.y1 > height {
@@ -112,11 +114,9 @@ impl Region {
         Region { x0, y0, x1, y1 }
     }
 
-    /// Panics with the check's message unless the region fits `width × height`.
-    pub(crate) fn assert_inside(&self, width: u32, height: u32) {
-        if let Err(message) = self.check(width, height) {
-            panic!("{message}");
-        }
+    /// [`Region::check`] as a [`MetricsError`].
+    pub(crate) fn inside(&self, width: u32, height: u32) -> Result<(), MetricsError> {
+        self.check(width, height).map_err(MetricsError::Region)
     }
 
     /// The rows of the region.

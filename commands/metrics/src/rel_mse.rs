@@ -2,8 +2,8 @@
 //! squared value, so that dark and bright parts of an image weigh alike, as
 //! pbrt-v4's `imgtool diff --metric MRSE` computes it (`Image::MRSE`).
 
-use crate::difference::{assert_same_size, channel_difference, mean_over_channels};
-use crate::{ErrorMap, ImageView, Region};
+use crate::difference::{channel_difference, mean_over_channels, same_size};
+use crate::{ErrorMap, ImageView, MetricsError, Region};
 
 /// The constant added to `r` in the denominator `(r + 0.01)²`, so that black
 /// reference pixels do not divide by zero.
@@ -28,9 +28,9 @@ fn term(x: f32, r: f32) -> f64 {
 /// Identical values (the same bits) contribute 0; a NaN or infinity that the
 /// other image does not share makes the result NaN or infinite.
 ///
-/// # Panics
+/// # Errors
 /// If the images differ in size, or the region is empty or outside them.
-pub fn rel_mse(test: ImageView, reference: ImageView, region: Region) -> f64 {
+pub fn rel_mse(test: ImageView, reference: ImageView, region: Region) -> Result<f64, MetricsError> {
     mean_over_channels(test, reference, region, term)
 }
 
@@ -38,19 +38,19 @@ pub fn rel_mse(test: ImageView, reference: ImageView, region: Region) -> f64 {
 /// of `(x − r)² / (r + 0.01)²`. Its [`ErrorMap::mean`] over a region is
 /// [`rel_mse`] over that region (up to rounding, as the map holds f32).
 ///
-/// # Panics
+/// # Errors
 /// If the images differ in size.
-pub fn rel_mse_map(test: ImageView, reference: ImageView) -> ErrorMap {
-    assert_same_size(&test, &reference);
+pub fn rel_mse_map(test: ImageView, reference: ImageView) -> Result<ErrorMap, MetricsError> {
+    same_size(&test, &reference)?;
     let values = test
         .pixels
         .iter()
         .zip(reference.pixels)
         .map(|(t, r)| ((term(t.x, r.x) + term(t.y, r.y) + term(t.z, r.z)) / 3.0) as f32)
         .collect();
-    ErrorMap {
+    Ok(ErrorMap {
         width: test.width,
         height: test.height,
         values,
-    }
+    })
 }

@@ -370,21 +370,12 @@ fn json_document(
 /// The 99th percentile of the finite values of `map` in `region`, or 1 if it is
 /// not positive (no error at all): a scale that fireflies do not flatten.
 fn percentile_99(map: &ErrorMap, region: Region) -> f32 {
-    let mut values: Vec<f32> = (region.y0..region.y1)
-        .flat_map(|y| {
-            let start = y as usize * map.width as usize;
-            map.values[start + region.x0 as usize..start + region.x1 as usize]
-                .iter()
-                .copied()
-        })
-        .filter(|v| v.is_finite())
-        .collect();
-    values.sort_by(f32::total_cmp);
-    values
-        .get(values.len().saturating_sub(1) * 99 / 100)
-        .copied()
-        .filter(|v| *v > 0.0)
-        .unwrap_or(1.0)
+    glint_metrics::heatmap_scale((region.y0..region.y1).flat_map(|y| {
+        let start = y as usize * map.width as usize;
+        map.values[start + region.x0 as usize..start + region.x1 as usize]
+            .iter()
+            .copied()
+    }))
 }
 
 /// A number for the table: about six significant digits, plain between 1e-4 and

@@ -8,7 +8,7 @@ use glint_integrator::SamplePattern;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// The settings a class's submissions state, by `glint grade`'s flag names.
 #[derive(FromPyObject)]
@@ -111,7 +111,7 @@ fn stated_settings(stated: Stated) -> PyResult<StatedSettings> {
 /// was graded.
 pub(crate) struct Graded {
     pub(crate) json: String,
-    pub(crate) heatmaps: Vec<Option<(glam::UVec2, Vec<u8>)>>,
+    pub(crate) heatmaps: Vec<Option<glint_grade::document::Heatmap>>,
 }
 
 /// The class path for `entries`: its document and heat maps.
@@ -129,24 +129,14 @@ fn report_json(
         test: TestOptions { alpha, block },
         cache: Cache { dir: cache },
     };
-    let heatmaps = Mutex::new(vec![None; entries.len()]);
-    let keep_heatmap =
-        |i: usize, row: &class::Row, s: &glint_grade::Submission, g: &class::Group| {
-            if let class::Outcome::Graded(grade) = &row.outcome {
-                let pixels = glint_grade::heatmap::heatmap(grade, &s.film, &g.references.objects);
-                heatmaps.lock().expect("no panic holds it")[i] =
-                    Some((s.film.resolution(), pixels));
-            }
-            Ok(())
-        };
-    let grades = class::grade_class(entries, scenes, base, &options, &Quiet, &keep_heatmap)
-        .map_err(input)?;
-    let rows = glint_grade::report::rows(&grades);
-    let json = serde_json::to_string_pretty(&glint_grade::report::json(&rows))
+    let graded =
+        glint_grade::document::grade_with_heatmaps(entries, (scenes, base), &options, &Quiet)
+            .map_err(input)?;
+    let json = serde_json::to_string_pretty(&graded.document)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(Graded {
         json: json + "\n",
-        heatmaps: heatmaps.into_inner().expect("no panic holds it"),
+        heatmaps: graded.heatmaps,
     })
 }
 

@@ -377,11 +377,19 @@ fn graded_py(py: Python<'_>, graded: grade::Graded) -> GradedPy<'_> {
         .heatmaps
         .into_iter()
         .map(|map| {
-            map.map(|(size, rgb)| {
-                numpy::ndarray::Array3::from_shape_vec((size.y as usize, size.x as usize, 3), rgb)
+            map.map(
+                |glint_grade::document::Heatmap {
+                     resolution: size,
+                     rgb,
+                 }| {
+                    numpy::ndarray::Array3::from_shape_vec(
+                        (size.y as usize, size.x as usize, 3),
+                        rgb,
+                    )
                     .expect("a heat map fills its image")
                     .into_pyarray(py)
-            })
+                },
+            )
         })
         .collect();
     (graded.json, heatmaps)

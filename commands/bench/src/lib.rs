@@ -796,17 +796,8 @@ fn heatmaps(
             Some(map.map(|map| (s, map)))
         })
         .collect::<Result<_, _>>()?;
-    let mut all: Vec<f32> = maps
-        .iter()
-        .flat_map(|(_, m)| m.values.iter().copied())
-        .filter(|v| v.is_finite())
-        .collect();
-    all.sort_by(f32::total_cmp);
-    let scale = all
-        .get(all.len().saturating_sub(1) * 99 / 100)
-        .copied()
-        .filter(|v| *v > 0.0)
-        .unwrap_or(1.0);
+    let scale =
+        glint_metrics::heatmap_scale(maps.iter().flat_map(|(_, m)| m.values.iter().copied()));
     let files: Vec<Heatmap> = maps
         .iter()
         .map(|(s, map)| {

@@ -27,6 +27,7 @@
 
 pub mod class;
 pub mod course;
+pub mod document;
 pub mod heatmap;
 pub mod html;
 pub mod hypothesis;

@@ -63,7 +63,7 @@ pub use compare::{compare, compare_with_flip_map, Comparison};
 pub use error::MetricsError;
 pub use error_map::ErrorMap;
 pub use flip::{flip, FLIP_PIXELS_PER_DEGREE};
-pub use heatmap::{heatmap, magma, save_heatmap};
+pub use heatmap::{heatmap, heatmap_png, heatmap_scale, magma, save_heatmap};
 pub use image_view::ImageView;
 pub use max_difference::{max_difference, MaxDifference};
 pub use means::{channel_means, non_finite_count};

@@ -81,6 +81,27 @@ fn parse_pixel(text: &str) -> Result<(u32, u32), String> {
 
 pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
     let description = args.scene.load()?;
+    let Explained { text, parted } = explained(args, &description)?;
+    print(&text);
+    match parted {
+        None => Ok(()),
+        Some(message) => Err(Failure::Verdict(Some(message))),
+    }
+}
+
+/// What `glint explain` prints, and with `--against`, where the student's
+/// document parts from Glint's, if it does.
+pub(crate) struct Explained {
+    pub(crate) text: String,
+    pub(crate) parted: Option<String>,
+}
+
+/// `args` answered for the scene `description` (its file loaded with
+/// `args`' settings): the text, JSON or comparison the command prints.
+pub(crate) fn explained(
+    args: &ExplainArgs,
+    description: &glint_scene::SceneDescription,
+) -> Result<Explained, Failure> {
     let selection = match args.all_samples {
         true => SampleSelection::All,
         false => SampleSelection::One(args.sample),
@@ -105,8 +126,14 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
         }
         false => explanation.text(args.stage),
     };
-    print(&text);
-    Ok(())
+    Ok(Explained { text, parted: None })
+}
+
+impl ExplainArgs {
+    /// The scene and the settings the flags replace.
+    pub(crate) fn scene(&self) -> &SceneArgs {
+        &self.scene
+    }
 }
 
 /// Prints `text` on stdout; a reader that stops early (`| head`) is not an
@@ -115,9 +142,13 @@ fn print(text: &str) {
     crate::output::say(text);
 }
 
-/// `--against`: the student's document at `path` against Glint's; the
-/// report on stdout, exit status 1 where they part.
-fn compare(explanation: &Explanation, path: &Path, args: &ExplainArgs) -> Result<(), Failure> {
+/// `--against`: the student's document at `path` against Glint's: the
+/// report, and where they part.
+fn compare(
+    explanation: &Explanation,
+    path: &Path,
+    args: &ExplainArgs,
+) -> Result<Explained, Failure> {
     let name = path.display();
     let text = glint_scene::read_text(path, glint_scene::MAX_DOCUMENT_BYTES, "a document")
         .map_err(|e| Failure::Input(format!("{name}: cannot read the document: {e}")))?;
@@ -125,19 +156,19 @@ fn compare(explanation: &Explanation, path: &Path, args: &ExplainArgs) -> Result
         .map_err(|e| Failure::Input(format!("{name}{}", against::located(&e))))?;
     let comparison = against::compare(&student, &explanation.json(None), args.stage)
         .map_err(|e| Failure::Input(format!("{name}: {e}")))?;
-    print(&match args.json {
+    let text = match args.json {
         true => {
             serde_json::to_string_pretty(&comparison.json()).expect("JSON of numbers and strings")
                 + "\n"
         }
         false => comparison.text(&name.to_string()),
-    });
-    match comparison.first() {
-        None => Ok(()),
-        Some(d) => Err(Failure::Verdict(Some(format!(
+    };
+    let parted = comparison.first().map(|d| {
+        format!(
             "{name} parts from Glint in the {} stage, at {}",
             d.stage.heading(),
             d.path
-        )))),
-    }
+        )
+    });
+    Ok(Explained { text, parted })
 }

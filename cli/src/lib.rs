@@ -32,6 +32,7 @@ mod output;
 mod render;
 mod stats;
 mod stress;
+mod view;
 
 use clap::builder::TypedValueParser;
 use clap::error::{ContextKind, ContextValue};
@@ -84,6 +85,9 @@ enum Command {
     /// statistical test that tells a bug from noise: one scene's images or a
     /// whole class (table, CSV, JSON, HTML report with heat maps)
     Grade(grade::GradeArgs),
+    /// A local web inspector: images with exposure, A/B flips and heat maps,
+    /// a scene rendered progressively, and every stage of a clicked pixel
+    View(view::ViewArgs),
 }
 
 /// A failure and the exit status it maps to.
@@ -134,6 +138,7 @@ pub fn run(program: Option<PathBuf>, args: Vec<OsString>) -> u8 {
         Command::Export(args) => export::export(args),
         Command::Explain(args) => explain::explain(args),
         Command::Grade(args) => grade::grade(args),
+        Command::View(args) => view::view(args),
     })
     .unwrap_or(Err(Failure::Panicked));
     // A command that judges must tell Glint's own failures from its verdict.

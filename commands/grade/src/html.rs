@@ -201,8 +201,15 @@ fn cell(index: usize, row: &ReportRow) -> String {
         ),
         None => String::new(),
     };
+    let view = match &row.view {
+        Some(command) => format!(
+            "<details class=\"view\"><summary title=\"the command that opens this submission in glint view, at its strongest rejected block\">view</summary><code>{}</code></details>",
+            escape(command)
+        ),
+        None => String::new(),
+    };
     format!(
-        "<td data-sort=\"{}\" class=\"{v}\"><span class=\"verdict\">{v}</span>{images}<div class=\"note\">{}</div><div class=\"file\" title=\"{}\">{}</div></td>",
+        "<td data-sort=\"{}\" class=\"{v}\"><span class=\"verdict\">{v}</span>{images}<div class=\"note\">{}</div><div class=\"file\" title=\"{}\">{}</div>{view}</td>",
         row.sort_key,
         escape(&row.summary),
         escape(&row.format),

@@ -129,11 +129,50 @@ pub struct ReportRow {
     /// The reference set it is judged against, where its scene and
     /// resolution could be read: the report's `images/reference-G.png`.
     pub reference: Option<usize>,
+    /// The command that opens the submission in `glint view` at its
+    /// strongest rejected block, where it failed.
+    #[serde(default)]
+    pub view: Option<String>,
 }
 
 /// The rows of a class's grades as the report shows them.
 pub fn rows(grades: &ClassGrades) -> Vec<ReportRow> {
-    grades.rows.iter().map(ReportRow::new).collect()
+    let view = |row: &Row| {
+        let scene = &grades.groups.get(row.group?)?.scene.path;
+        view_command(row, scene)
+    };
+    (grades.rows.iter())
+        .map(|row| ReportRow {
+            view: view(row),
+            ..ReportRow::new(row)
+        })
+        .collect()
+}
+
+/// `glint view SCENE FILE --region X0,Y0,X1,Y1` for a failed submission:
+/// its strongest rejected block (or the whole image where only objects
+/// were rejected).
+fn view_command(row: &Row, scene: &std::path::Path) -> Option<String> {
+    let Outcome::Graded(grade) = &row.outcome else {
+        return None;
+    };
+    if grade.passed || grade.unreadable.is_some() {
+        return None;
+    }
+    let block = grade.rejected.iter().find_map(|r| match r.place {
+        crate::Place::Block { x0, y0, x1, y1 } => Some(format!(" --region {x0},{y0},{x1},{y1}")),
+        crate::Place::Object { .. } => None,
+    });
+    let quoted = |text: &str| match text.contains([' ', '\'', '"']) {
+        true => format!("'{}'", text.replace('\'', "'\\''")),
+        false => text.to_owned(),
+    };
+    Some(format!(
+        "glint view {} {}{}",
+        quoted(&scene.display().to_string()),
+        quoted(&row.file),
+        block.unwrap_or_default()
+    ))
 }
 
 impl ReportRow {
@@ -154,6 +193,7 @@ impl ReportRow {
             json,
             sort_key: sort_key(row).to_string(),
             reference: row.group,
+            view: None,
         }
     }
 

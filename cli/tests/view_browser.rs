@@ -180,7 +180,7 @@ fn the_page_shows_a_clicked_pixels_stages_and_flips_between_images() {
     assert_ne!(student_code, rendered, "the two images differ at the pixel");
     session.script("const e = document.getElementById('exposure'); e.value = '-3'; e.oninput();");
     std::thread::sleep(Duration::from_millis(300));
-    let darker = shot(&session, dir.path(), "view-exposure.png", (x, y));
+    let darker = shot(&session, dir.path(), "exposure.png", (x, y));
     assert!(
         darker.iter().zip(flipped).all(|(d, f)| *d + 20 < f),
         "{darker:?} against {flipped:?}"
@@ -205,7 +205,8 @@ fn wait_for(session: &Session, script: &str, expected: &str) {
 }
 
 /// The screenshot's colour at the centre of image pixel `(x, y)`; the
-/// screenshot kept in `$GLINT_VIEW_SCREENSHOTS` where set.
+/// screenshot kept in `$GLINT_VIEW_SCREENSHOTS` (an absolute path) where set
+/// and its name is docs/view.md's (`view-…`).
 fn shot(session: &Session, dir: &Path, name: &str, (x, y): (u32, u32)) -> [u8; 3] {
     let png = base64_decode(
         session
@@ -213,7 +214,8 @@ fn shot(session: &Session, dir: &Path, name: &str, (x, y): (u32, u32)) -> [u8; 3
             .as_str()
             .unwrap(),
     );
-    if let Some(keep) = std::env::var_os("GLINT_VIEW_SCREENSHOTS") {
+    let keep = std::env::var_os("GLINT_VIEW_SCREENSHOTS").filter(|_| name.starts_with("view-"));
+    if let Some(keep) = keep {
         std::fs::write(Path::new(&keep).join(name), &png).unwrap();
     }
     std::fs::write(dir.join(name), &png).unwrap();

@@ -405,6 +405,9 @@ impl Staging {
             .parent()
             .filter(|p| !p.as_os_str().is_empty())
             .unwrap_or(Path::new("."));
+        // Watched before the folder exists: a signal between the two would
+        // otherwise end the process the default way and leave the folder.
+        let signals = watch_signals()?;
         let dir = tempfile::Builder::new()
             .prefix(".glint-report-")
             .tempdir_in(parent)
@@ -415,7 +418,7 @@ impl Staging {
                 ))
             })?;
         let placing = std::sync::Arc::new(std::sync::Mutex::new(()));
-        remove_on_signal(dir.path(), std::sync::Arc::clone(&placing))?;
+        remove_on_signal(signals, dir.path(), std::sync::Arc::clone(&placing))?;
         Ok(Staging {
             dir,
             target: target.to_owned(),
@@ -459,17 +462,22 @@ impl Staging {
     }
 }
 
-/// Ends the process on SIGINT or SIGTERM with the signal's status, after
-/// removing `dir` (unless it was put in place meanwhile, which `placing`
-/// guards).
+/// SIGINT and SIGTERM caught from now on (kept until handled).
+fn watch_signals() -> Result<signal_hook::iterator::Signals, Failure> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
+        .map_err(|e| Failure::Other(format!("cannot watch for signals: {e}")))
+}
+
+/// Ends the process on the first of `signals` with the signal's status,
+/// after removing `dir` (unless it was put in place meanwhile, which
+/// `placing` guards).
 fn remove_on_signal(
+    mut signals: signal_hook::iterator::Signals,
     dir: &Path,
     placing: std::sync::Arc<std::sync::Mutex<()>>,
 ) -> Result<(), Failure> {
-    use signal_hook::consts::{SIGINT, SIGTERM};
     let dir = dir.to_owned();
-    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
-        .map_err(|e| Failure::Other(format!("cannot watch for signals: {e}")))?;
     std::thread::Builder::new()
         .name("signals".into())
         .spawn(move || {

@@ -63,11 +63,11 @@ class Image(np.ndarray):
         return _image_array(array).view(cls)
 
     def _repr_png_(self) -> bytes:
-        return bytes(_glint.encode(_to_raw(self), "png"))
+        return bytes(_glint.encode(_image_array(self), "png"))
 
     def to_bytes(self, format: str = "png") -> bytes:
         """The image as a ``png``, ``exr`` or ``pfm`` file would hold it."""
-        return bytes(_glint.encode(_to_raw(self), format))
+        return bytes(_glint.encode(_image_array(self), format))
 
 
 def _image_array(array: Any) -> np.ndarray:
@@ -81,20 +81,6 @@ def _image_array(array: Any) -> np.ndarray:
     if a.shape[0] == 0 or a.shape[1] == 0:
         raise ValueError(f"an image has at least one pixel; this array's shape is {a.shape}")
     return np.ascontiguousarray(a).view(np.ndarray)
-
-
-def _to_raw(array: Any) -> Tuple[bytes, int, int]:
-    """An image as the extension module takes it: its float32 values' bytes
-    (native order, rows from the top), its height and width."""
-    a = _image_array(array)
-    return a.tobytes(), a.shape[0], a.shape[1]
-
-
-def _from_raw(raw: Tuple[bytearray, int, int], dtype: Any = np.float32) -> np.ndarray:
-    """What the extension module hands back: a ``(height, width, 3)`` array
-    over its bytearray, without a copy."""
-    data, height, width = raw
-    return np.frombuffer(data, dtype=dtype).reshape(height, width, 3)
 
 
 class Scene:
@@ -139,7 +125,7 @@ class Scene:
             array = self._inner.render(crop=crop, aov=aov, threads=threads, progress=callback)
         finally:
             close()
-        return _from_raw(array).view(Image)
+        return array.view(Image)
 
     def explain(
         self,
@@ -235,8 +221,8 @@ def imread(path: PathLike) -> Image:
     """Reads an image of any format Glint reads (PNG, JPEG, BMP, TGA, PPM,
     Radiance HDR, OpenEXR, PFM) as linear RGB; ``.format`` says what it was
     read as."""
-    raw, description = _glint.imread(os.fspath(path))
-    image = _from_raw(raw).view(Image)
+    array, description = _glint.imread(os.fspath(path))
+    image = array.view(Image)
     image.format = description  # type: ignore[attr-defined]
     return image
 
@@ -245,14 +231,14 @@ def imwrite(path: PathLike, image: Any) -> None:
     """Writes a float32 ``(h, w, 3)`` linear image: ``.png`` as 8-bit sRGB,
     ``.exr`` or ``.pfm`` as 32-bit float; atomically (a failed write leaves
     what was at ``path``)."""
-    _glint.imwrite(os.fspath(path), _to_raw(image))
+    _glint.imwrite(os.fspath(path), _image_array(image))
 
 
 def diff(test: Any, reference: Any) -> Dict[str, Any]:
     """``glint diff``'s measures of ``test`` against ``reference``: ``rmse``,
     ``rel_mse``, ``flip`` (mean), ``max_difference`` and its pixel, and each
     image's channel means."""
-    return _glint.diff(_to_raw(test), _to_raw(reference))
+    return _glint.diff(_image_array(test), _image_array(reference))
 
 
 class GradeReport:
@@ -262,9 +248,8 @@ class GradeReport:
     ``--heatmap`` picture as a uint8 ``(h, w, 3)`` array, else None), and
     ``to_dict()``, the document ``glint grade --format json`` prints."""
 
-    def __init__(self, graded: Tuple[str, "list[Optional[Tuple[bytearray, int, int]]]"]) -> None:
-        text, heatmaps = graded
-        self.heatmaps = [None if raw is None else _from_raw(raw, np.uint8) for raw in heatmaps]
+    def __init__(self, graded: Tuple[str, "list[Optional[np.ndarray]]"]) -> None:
+        text, self.heatmaps = graded
         self._document = json.loads(text)
 
     @property

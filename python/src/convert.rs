@@ -1,4 +1,4 @@
-//! Values across the boundary: films and images' bytes, dicts of settings and
+//! Values across the boundary: films and numpy arrays, dicts of settings and
 //! overrides, dicts of scene tables and TOML.
 
 use glam::{UVec2, Vec3};
@@ -6,56 +6,46 @@ use glint_camera::Film;
 use glint_integrator::{AreaSampling, EnvironmentSampling, SamplePattern, TextureLevel};
 use glint_scene::Overrides;
 use glint_texture::TextureFilter;
+use numpy::ndarray::Array3;
+use numpy::{IntoPyArray, PyArray3, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyByteArray, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
-/// An image as it crosses to Python: its values' bytes (native-endian,
-/// rows from the top, three channels) in a `bytearray` numpy wraps without a
-/// copy (`glint._from_raw`), and its height and width. No numpy crate: the
-/// package builds sooner without it, and the bytes are what numpy holds.
-pub(crate) type Raw<'py> = (Bound<'py, PyByteArray>, usize, usize);
-
-/// The film as [`Raw`] float32 values.
-pub(crate) fn array_of(py: Python<'_>, film: Film) -> PyResult<Raw<'_>> {
+/// The film as a `(height, width, 3)` float32 array: its pixels flattened
+/// once into the buffer the array takes over.
+pub(crate) fn array_of(py: Python<'_>, film: Film) -> Bound<'_, PyArray3<f32>> {
     let size = film.resolution();
-    let pixels = film.pixels();
-    let bytes = PyByteArray::new_with(py, pixels.len() * 12, |out| {
-        for (chunk, p) in out.chunks_exact_mut(12).zip(pixels) {
-            for (bytes, v) in chunk.chunks_exact_mut(4).zip(p.to_array()) {
-                bytes.copy_from_slice(&v.to_ne_bytes());
-            }
-        }
-        Ok(())
-    })?;
-    Ok((bytes, size.y as usize, size.x as usize))
+    let (w, h) = (size.x as usize, size.y as usize);
+    let values: Vec<f32> = film
+        .into_pixels()
+        .into_iter()
+        .flat_map(|p| p.to_array())
+        .collect();
+    Array3::from_shape_vec((h, w, 3), values)
+        .expect("a film's pixels fill its resolution")
+        .into_pyarray(py)
 }
 
-/// RGB8 codes as [`Raw`] uint8 values.
-pub(crate) fn codes_of<'py>(py: Python<'py>, size: UVec2, rgb: &[u8]) -> Raw<'py> {
-    (PyByteArray::new(py, rgb), size.y as usize, size.x as usize)
-}
-
-/// A float32 image's bytes (`glint._to_raw`: a C-contiguous `(height,
-/// width, 3)` array's, checked for dtype and shape there) as a film.
-pub(crate) fn film_of((bytes, height, width): (&[u8], usize, usize)) -> PyResult<Film> {
-    if bytes.len() != height * width * 12 {
+/// A `(height, width, 3)` float32 array as a film (the Python side makes it
+/// C-contiguous and checks its dtype and shape first).
+pub(crate) fn film_of(image: &PyReadonlyArray3<'_, f32>) -> PyResult<Film> {
+    let shape = image.shape();
+    if shape[2] != 3 {
         return Err(PyValueError::new_err(format!(
-            "an image of {height}x{width} pixels needs {} bytes, these are {}",
-            height * width * 12,
-            bytes.len()
+            "an image is (height, width, 3): this array's shape is {shape:?}"
         )));
     }
-    let pixels = bytes
-        .chunks_exact(12)
-        .map(|c| {
-            let v = |k: usize| f32::from_ne_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
-            Vec3::new(v(0), v(4), v(8))
-        })
+    let values = image
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("the image array is not C-contiguous"))?;
+    let pixels = values
+        .chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
         .collect();
-    let size = UVec2::new(width as u32, height as u32);
+    let size = UVec2::new(shape[1] as u32, shape[0] as u32);
     Film::from_pixels(size, pixels)
-        .ok_or_else(|| PyValueError::new_err("the image's size does not match its pixels"))
+        .ok_or_else(|| PyValueError::new_err("the image array's size does not match its shape"))
 }
 
 /// The keys [`overrides_of`] takes, in the order the CLI's help lists them.

@@ -2,7 +2,7 @@
 //! package (`python/glint`), a thin layer over the crates.
 //!
 //! # Conventions
-//! - Images cross as the bytes of numpy arrays (`convert::Raw`) of shape `(height, width, 3)`, `float32`,
+//! - Images cross as numpy arrays of shape `(height, width, 3)`, `float32`,
 //!   C-contiguous, linear RGB radiance, row 0 at the top (the film's order).
 //! - Scenes load through [`glint_scene::Overrides`], the code `glint render`'s
 //!   flags go through, so a keyword and a flag of the same name do the same.
@@ -19,12 +19,13 @@ mod errors;
 mod grade;
 mod render;
 
-use convert::{array_of, codes_of, film_of, overrides_of, toml_of, Raw};
+use convert::{array_of, film_of, overrides_of, toml_of};
 use errors::{glint_error, not_found, scene_error};
 use glint_camera::{Film, ImageFormat};
 use glint_integrator::{Crop, RenderSettings};
 use glint_metrics::ImageView;
 use glint_scene::SceneDescription;
+use numpy::{PyArray3, PyReadonlyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
@@ -126,7 +127,7 @@ impl Scene {
         aov: Option<&str>,
         threads: Option<usize>,
         progress: Option<Bound<'py, PyAny>>,
-    ) -> PyResult<Raw<'py>> {
+    ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         let mut settings = self.description.settings.clone();
         if let Some(name) = aov {
             let aov = glint_integrator::Aov::from_name(name).ok_or_else(|| {
@@ -141,7 +142,7 @@ impl Scene {
         let crop = crop.map(|(x0, y0, x1, y1)| Crop { x0, y0, x1, y1 });
         let scene = &self.description.scene;
         let film = render::render(py, scene, &settings, crop, progress.as_ref())?;
-        array_of(py, film)
+        Ok(array_of(py, film))
     }
 
     /// `glint explain SCENE --pixel X,Y --json` with the same settings: the
@@ -261,7 +262,7 @@ fn prepared(
 /// Reads an image file of any format Glint reads: its linear pixels and
 /// what it was read as ("PNG, 8-bit RGB", ...).
 #[pyfunction]
-fn imread<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(Raw<'py>, String)> {
+fn imread<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(Bound<'py, PyArray3<f32>>, String)> {
     if !path.exists() {
         return Err(not_found(&path));
     }
@@ -269,22 +270,22 @@ fn imread<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(Raw<'py>, String)> {
         .detach(|| Film::read(&path))
         .map_err(|e| glint_error(py, &e.to_string()))?;
     let description = file.description();
-    Ok((array_of(py, file.film)?, description))
+    Ok((array_of(py, file.film), description))
 }
 
 /// Writes `image` to `path` in the format its extension names (.png as
 /// 8-bit sRGB, .exr or .pfm as linear 32-bit float), atomically.
 #[pyfunction]
-fn imwrite(py: Python<'_>, path: PathBuf, image: (&[u8], usize, usize)) -> PyResult<()> {
-    let film = film_of(image)?;
+fn imwrite(py: Python<'_>, path: PathBuf, image: PyReadonlyArray3<'_, f32>) -> PyResult<()> {
+    let film = film_of(&image)?;
     py.detach(|| film.save(&path))
         .map_err(|e| glint_error(py, &e.to_string()))
 }
 
 /// `image` encoded as a file of `format` ("png", "exr", "pfm") would hold it.
 #[pyfunction]
-fn encode(py: Python<'_>, image: (&[u8], usize, usize), format: &str) -> PyResult<Vec<u8>> {
-    let film = film_of(image)?;
+fn encode(py: Python<'_>, image: PyReadonlyArray3<'_, f32>, format: &str) -> PyResult<Vec<u8>> {
+    let film = film_of(&image)?;
     let format = ImageFormat::from_path(Path::new(&format!("image.{format}")))
         .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
     py.detach(|| film.to_bytes(format))
@@ -297,10 +298,10 @@ fn encode(py: Python<'_>, image: (&[u8], usize, usize), format: &str) -> PyResul
 #[pyfunction]
 fn diff<'py>(
     py: Python<'py>,
-    test: (&[u8], usize, usize),
-    reference: (&[u8], usize, usize),
+    test: PyReadonlyArray3<'_, f32>,
+    reference: PyReadonlyArray3<'_, f32>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (test, reference) = (film_of(test)?, film_of(reference)?);
+    let (test, reference) = (film_of(&test)?, film_of(&reference)?);
     let size = test.resolution();
     let c = py
         .detach(|| {
@@ -367,12 +368,29 @@ fn grade_class_json(
 }
 
 /// A graded class for Python: the document's text and each submission's
-/// heat map as [`Raw`] uint8 codes (None where not graded).
-type GradedPy<'py> = (String, Vec<Option<Raw<'py>>>);
+/// heat map as a `(height, width, 3)` uint8 array (None where not graded).
+type GradedPy<'py> = (String, Vec<Option<Bound<'py, numpy::PyArray3<u8>>>>);
 
 fn graded_py(py: Python<'_>, graded: grade::Graded) -> GradedPy<'_> {
-    let heatmaps = (graded.heatmaps.into_iter())
-        .map(|map| map.map(|m| codes_of(py, m.resolution, &m.rgb)))
+    use numpy::IntoPyArray;
+    let heatmaps = graded
+        .heatmaps
+        .into_iter()
+        .map(|map| {
+            map.map(
+                |glint_grade::document::Heatmap {
+                     resolution: size,
+                     rgb,
+                 }| {
+                    numpy::ndarray::Array3::from_shape_vec(
+                        (size.y as usize, size.x as usize, 3),
+                        rgb,
+                    )
+                    .expect("a heat map fills its image")
+                    .into_pyarray(py)
+                },
+            )
+        })
         .collect();
     (graded.json, heatmaps)
 }

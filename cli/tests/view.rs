@@ -384,26 +384,10 @@ fn send_sigint(pid: u32) {
 fn a_failed_submission_in_the_report_says_how_to_view_its_rejected_block() {
     let dir = tempfile::tempdir().unwrap();
     let manifest = common::small_class(dir.path());
-    let o = glint(
-        &[
-            "grade",
-            "--class",
-            manifest.to_str().unwrap(),
-            "--spp",
-            "4",
-            "--sampler",
-            "random",
-            "--light-samples",
-            "4",
-            "--light-sampler",
-            "random",
-            "--report",
-            "report",
-            "--scenes",
-            "scenes",
-        ],
-        dir.path(),
-    );
+    let mut args = vec!["grade", "--class", manifest.to_str().unwrap()];
+    args.extend(["--report", "report", "--scenes", "scenes"]);
+    args.extend_from_slice(&common::CORRECT[..8]);
+    let o = glint(&args, dir.path());
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let html = std::fs::read_to_string(dir.path().join("report/index.html")).unwrap();
     // Bo's Set 2 is a render of Set 1: failed, with its command.

@@ -40,7 +40,7 @@ pub(crate) struct ViewArgs {
 
     /// Open framing this block of the first image (half-open, rows from the
     /// top), its centre pixel explained: what `glint grade --report` gives
-    /// for a failed submission's strongest rejected block
+    /// for each of a failed submission's rejected regions
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = glint_metrics::Region::parse)]
     region: Option<glint_metrics::Region>,
 }

@@ -399,10 +399,20 @@ fn a_failed_submission_in_the_report_says_how_to_view_its_rejected_block() {
         command.contains("set2.toml") && command.contains("class/bo/set2.png"),
         "{command}"
     );
+    // Every rejected region (blocks and objects) has its command, framing
+    // pixels of the 32 × 32 submission.
+    let commands: Vec<&str> = (html.split("<code>").skip(1))
+        .map(|c| &c[..c.find("</code>").unwrap()])
+        .filter(|c| c.starts_with("glint view "))
+        .collect();
+    assert!(commands.len() > 1, "{commands:?}");
+    for command in &commands {
+        let region = command.split("--region ").nth(1).expect(command);
+        let [x0, y0, x1, y1] =
+            [0, 1, 2, 3].map(|i| region.split(',').nth(i).unwrap().parse::<u32>().unwrap());
+        assert!(x0 < x1 && x1 <= 32 && y0 < y1 && y1 <= 32, "{command}");
+    }
     let region = command.split("--region ").nth(1).expect(command);
-    let [x0, y0, x1, y1] =
-        [0, 1, 2, 3].map(|i| region.split(',').nth(i).unwrap().parse::<u32>().unwrap());
-    assert!(x0 < x1 && x1 <= 32 && y0 < y1 && y1 <= 32, "{command}");
     // The command opens the view framing that block.
     let image = dir.path().join("class/bo/set2.png");
     let viewer = Viewer::start(&[

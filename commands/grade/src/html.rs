@@ -201,12 +201,22 @@ fn cell(index: usize, row: &ReportRow) -> String {
         ),
         None => String::new(),
     };
-    let view = match &row.view {
-        Some(command) => format!(
-            "<details class=\"view\"><summary title=\"the command that opens this submission in glint view, at its strongest rejected block\">view</summary><code>{}</code></details>",
-            escape(command)
-        ),
-        None => String::new(),
+    let view = match row.views.is_empty() {
+        true => String::new(),
+        false => {
+            let items: String = (row.views.iter())
+                .map(|v| {
+                    format!(
+                        "<li>{}: <code>{}</code></li>",
+                        escape(&v.region),
+                        escape(&v.command)
+                    )
+                })
+                .collect();
+            format!(
+                "<details class=\"view\"><summary title=\"the commands that open this submission in glint view, framing each rejected region\">view</summary><ul>{items}</ul></details>"
+            )
+        }
     };
     format!(
         "<td data-sort=\"{}\" class=\"{v}\"><span class=\"verdict\">{v}</span>{images}<div class=\"note\">{}</div><div class=\"file\" title=\"{}\">{}</div>{view}</td>",

@@ -383,7 +383,7 @@ mod tests {
             json: serde_json::Value::Null,
             sort_key: String::new(),
             reference: None,
-            view: None,
+            views: Vec::new(),
         }
     }
 }

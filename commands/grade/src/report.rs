@@ -129,50 +129,84 @@ pub struct ReportRow {
     /// The reference set it is judged against, where its scene and
     /// resolution could be read: the report's `images/reference-G.png`.
     pub reference: Option<usize>,
-    /// The command that opens the submission in `glint view` at its
-    /// strongest rejected block, where it failed.
+    /// For a failed submission, each rejected region (at most
+    /// [`VIEWS_KEPT`], the strongest first) and the `glint view` command that
+    /// opens the submission framing it.
     #[serde(default)]
-    pub view: Option<String>,
+    pub views: Vec<View>,
 }
 
 /// The rows of a class's grades as the report shows them.
 pub fn rows(grades: &ClassGrades) -> Vec<ReportRow> {
-    let view = |row: &Row| {
-        let scene = &grades.groups.get(row.group?)?.scene.path;
-        view_command(row, scene)
+    let views = |row: &Row| match grades.groups.get(row.group.unwrap_or(usize::MAX)) {
+        Some(group) => views(row, group),
+        None => Vec::new(),
     };
     (grades.rows.iter())
         .map(|row| ReportRow {
-            view: view(row),
+            views: views(row),
             ..ReportRow::new(row)
         })
         .collect()
 }
 
-/// `glint view SCENE FILE --region X0,Y0,X1,Y1` for a failed submission:
-/// its strongest rejected block (or the whole image where only objects
-/// were rejected).
-fn view_command(row: &Row, scene: &std::path::Path) -> Option<String> {
+/// The most rejected regions a report row offers to open in `glint view`.
+pub const VIEWS_KEPT: usize = 8;
+
+/// A rejected region and the command that opens its submission in `glint
+/// view` framing it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct View {
+    pub region: String,
+    pub command: String,
+}
+
+/// `glint view SCENE FILE --region X0,Y0,X1,Y1` for each rejected region of
+/// a failed submission: a block as it is, an object by the box around the
+/// pixels whose centres see it.
+fn views(row: &Row, group: &crate::class::Group) -> Vec<View> {
     let Outcome::Graded(grade) = &row.outcome else {
-        return None;
+        return Vec::new();
     };
     if grade.passed || grade.unreadable.is_some() {
-        return None;
+        return Vec::new();
     }
-    let block = grade.rejected.iter().find_map(|r| match r.place {
-        crate::Place::Block { x0, y0, x1, y1 } => Some(format!(" --region {x0},{y0},{x1},{y1}")),
-        crate::Place::Object { .. } => None,
-    });
+    let references = &group.references;
     let quoted = |text: &str| match text.contains([' ', '\'', '"']) {
         true => format!("'{}'", text.replace('\'', "'\\''")),
         false => text.to_owned(),
     };
-    Some(format!(
-        "glint view {} {}{}",
-        quoted(&scene.display().to_string()),
-        quoted(&row.file),
-        block.unwrap_or_default()
-    ))
+    let scene = quoted(&group.scene.path.display().to_string());
+    let file = quoted(&row.file);
+    (grade.rejected.iter().take(VIEWS_KEPT))
+        .filter_map(|r| {
+            let [x0, y0, x1, y1] = match r.place {
+                crate::Place::Block { x0, y0, x1, y1 } => [x0, y0, x1, y1],
+                crate::Place::Object { object } => {
+                    let object = object.unwrap_or(crate::reference::BACKGROUND);
+                    bounds(&references.objects, references.resolution.x, object)?
+                }
+            };
+            Some(View {
+                region: r.region.clone(),
+                command: format!("glint view {scene} {file} --region {x0},{y0},{x1},{y1}"),
+            })
+        })
+        .collect()
+}
+
+/// The half-open box around the pixels of `objects` (one per pixel, rows of
+/// `width`) that hold `object`.
+fn bounds(objects: &[u32], width: u32, object: u32) -> Option<[u32; 4]> {
+    let mut found = None::<[u32; 4]>;
+    for (i, _) in objects.iter().enumerate().filter(|(_, &o)| o == object) {
+        let (x, y) = (i as u32 % width, i as u32 / width);
+        found = Some(match found {
+            None => [x, y, x + 1, y + 1],
+            Some([x0, y0, x1, y1]) => [x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1)],
+        });
+    }
+    found
 }
 
 impl ReportRow {
@@ -193,7 +227,7 @@ impl ReportRow {
             json,
             sort_key: sort_key(row).to_string(),
             reference: row.group,
-            view: None,
+            views: Vec::new(),
         }
     }
 

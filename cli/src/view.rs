@@ -156,25 +156,28 @@ struct ExplainFlags {
 }
 
 impl CliBackend {
-    /// `path` then `flags` as `--NAME=VALUE` (`--NAME` for a switch given
-    /// no value), so that no value is ever read as another flag.
-    fn argv(path: &Path, flags: &Flags) -> Result<Vec<String>, String> {
-        let mut argv = vec![path.display().to_string()];
+    /// `flags` as `--NAME=VALUE` (`--NAME` for a switch given no value), so
+    /// that no value is ever read as another flag; then `--` and `path`, so
+    /// that no file name is either.
+    fn argv(path: &Path, flags: &Flags) -> Result<Vec<std::ffi::OsString>, String> {
+        let mut argv: Vec<std::ffi::OsString> = Vec::new();
         for (name, value) in flags {
             if RESERVED.contains(&name.as_str()) {
                 return Err(format!("--{name} is not given through the view"));
             }
             argv.push(match value.as_str() {
-                "" => format!("--{name}"),
-                value => format!("--{name}={value}"),
+                "" => format!("--{name}").into(),
+                value => format!("--{name}={value}").into(),
             });
         }
+        argv.push("--".into());
+        argv.push(path.into());
         Ok(argv)
     }
 
     fn loaded(&self, args: &SceneArgs) -> Result<Arc<SceneDescription>, String> {
         let overrides = args.overrides();
-        let mut loaded = self.loaded.lock().map_err(|_| "a load failed".to_owned())?;
+        let mut loaded = (self.loaded.lock()).unwrap_or_else(std::sync::PoisonError::into_inner);
         if let Some((_, scene)) = loaded.iter().find(|(o, _)| *o == overrides) {
             return Ok(scene.clone());
         }
@@ -202,13 +205,15 @@ impl Backend for CliBackend {
 
     fn explain(&self, flags: &Flags, against: bool) -> Result<String, String> {
         let mut argv = Self::argv(self.path()?, flags)?;
-        argv.push("--json".into());
+        argv.insert(0, "--json".into());
         if against {
             let student = self
                 .against
                 .as_ref()
                 .ok_or("no student's document was given")?;
-            argv.push(format!("--against={}", student.display()));
+            let mut flag = std::ffi::OsString::from("--against=");
+            flag.push(student);
+            argv.insert(0, flag);
         }
         let parsed = ExplainFlags::try_parse_from(argv).map_err(clap_message)?;
         let scene = self.loaded(parsed.explain.scene())?;

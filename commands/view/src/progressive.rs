@@ -6,10 +6,10 @@
 use crate::query::Flags;
 use crate::Backend;
 use glint_camera::Film;
-use glint_integrator::{render_with, Aov, RenderControl, RenderSettings};
+use glint_integrator::{render_with, Aov, RenderControl, RenderSettings, SamplePattern};
 use glint_scene::SceneDescription;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 /// The render in progress, if any.
 #[derive(Default)]
@@ -18,8 +18,15 @@ pub(crate) struct Renders {
 }
 
 struct Job {
+    /// The flags, sorted: the same settings in another order are the same job.
     flags: Flags,
     progress: Arc<Progress>,
+}
+
+/// The lock's value, even if a panic held it before (every value here is
+/// whole between statements).
+fn locked<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
 /// What a job has made so far, shared with its thread.
@@ -44,38 +51,38 @@ impl Renders {
     /// running: `None` until its first step is done; an error for flags the
     /// command line refuses, or a render that failed.
     pub fn latest(&self, flags: &Flags, backend: &dyn Backend) -> Result<Option<Step>, String> {
-        let mut current = self
-            .current
-            .lock()
-            .map_err(|_| "a render failed".to_owned())?;
-        if current.as_ref().is_none_or(|job| job.flags != *flags) {
-            if let Some(old) = current.take() {
-                old.progress.stop.store(true, Ordering::Relaxed);
+        let mut sorted = flags.clone();
+        sorted.sort();
+        let mut current = locked(&self.current);
+        let progress = match current.as_ref() {
+            Some(job) if job.flags == sorted => job.progress.clone(),
+            _ => {
+                if let Some(old) = current.take() {
+                    old.progress.stop.store(true, Ordering::Relaxed);
+                }
+                let (scene, settings) = prepared(flags, backend)?;
+                let progress = Arc::new(Progress::default());
+                let shared = progress.clone();
+                std::thread::spawn(move || {
+                    let ran = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                        run(&scene, settings, &shared)
+                    }));
+                    if ran.is_err() {
+                        *locked(&shared.error) = Some("the render failed".into());
+                    }
+                });
+                *current = Some(Job {
+                    flags: sorted,
+                    progress: progress.clone(),
+                });
+                progress
             }
-            let (scene, settings) = prepared(flags, backend)?;
-            let progress = Arc::new(Progress::default());
-            let shared = progress.clone();
-            std::thread::spawn(move || run(&scene, settings, &shared));
-            *current = Some(Job {
-                flags: flags.clone(),
-                progress,
-            });
-        }
-        let progress = current.as_ref().expect("started above").progress.clone();
+        };
         drop(current);
-        if let Some(error) = progress
-            .error
-            .lock()
-            .map_err(|_| "a render failed")?
-            .clone()
-        {
+        if let Some(error) = locked(&progress.error).clone() {
             return Err(error);
         }
-        let latest = progress
-            .latest
-            .lock()
-            .map_err(|_| "a render failed")?
-            .clone();
+        let latest = locked(&progress.latest).clone();
         Ok(latest)
     }
 }
@@ -83,8 +90,8 @@ impl Renders {
 impl Renders {
     /// The newest step of whatever render ran last.
     pub fn newest(&self) -> Option<Step> {
-        let current = self.current.lock().ok()?;
-        let latest = current.as_ref()?.progress.latest.lock().ok()?.clone();
+        let current = locked(&self.current);
+        let latest = locked(&current.as_ref()?.progress.latest).clone();
         latest
     }
 }
@@ -113,16 +120,20 @@ fn prepared(
     Ok((scene, settings))
 }
 
-/// The counts each step renders with: powers of two below `target`, then
-/// `target`; an AOV (the same at every count) only `target`.
-pub(crate) fn ladder(target: u32, aov: bool) -> Vec<u32> {
-    let below = (0..).map(|k| 1u32 << k).take_while(|&n| n < target && !aov);
+/// The counts each step renders with: powers of two below `target` that
+/// the pixel pattern takes (a grid only squares), then `target`; an AOV
+/// (the same at every count) only `target`.
+pub(crate) fn ladder(target: u32, aov: bool, pattern: SamplePattern) -> Vec<u32> {
+    let below = (0..)
+        .map(|k| 1u32 << k)
+        .take_while(|&n| n < target && !aov)
+        .filter(|&n| pattern.supports(n));
     below.chain(std::iter::once(target)).collect()
 }
 
 fn run(scene: &SceneDescription, mut settings: RenderSettings, progress: &Progress) {
     let target = settings.spp;
-    for spp in ladder(target, settings.aov.is_some()) {
+    for spp in ladder(target, settings.aov.is_some(), settings.pixel_pattern) {
         settings.spp = spp;
         let control = RenderControl {
             stop: Some(&progress.stop),
@@ -136,14 +147,10 @@ fn run(scene: &SceneDescription, mut settings: RenderSettings, progress: &Progre
                     spp,
                     target,
                 };
-                if let Ok(mut latest) = progress.latest.lock() {
-                    *latest = Some(step);
-                }
+                *locked(&progress.latest) = Some(step);
             }
             Err(e) => {
-                if let Ok(mut error) = progress.error.lock() {
-                    *error = Some(e.to_string());
-                }
+                *locked(&progress.error) = Some(e.to_string());
                 return;
             }
         }
@@ -153,12 +160,15 @@ fn run(scene: &SceneDescription, mut settings: RenderSettings, progress: &Progre
 #[cfg(test)]
 mod tests {
     use super::ladder;
+    use glint_integrator::SamplePattern::{Grid, Sobol};
 
     #[test]
     fn the_ladder_doubles_to_the_count_asked_for() {
-        assert_eq!(ladder(16, false), [1, 2, 4, 8, 16]);
-        assert_eq!(ladder(12, false), [1, 2, 4, 8, 12]);
-        assert_eq!(ladder(1, false), [1]);
-        assert_eq!(ladder(64, true), [64]);
+        assert_eq!(ladder(16, false, Sobol), [1, 2, 4, 8, 16]);
+        assert_eq!(ladder(12, false, Sobol), [1, 2, 4, 8, 12]);
+        assert_eq!(ladder(1, false, Sobol), [1]);
+        assert_eq!(ladder(64, true, Sobol), [64]);
+        // A grid takes only squares.
+        assert_eq!(ladder(64, false, Grid), [1, 4, 16, 64]);
     }
 }

@@ -561,12 +561,14 @@ fn entries(
     }
     let entries = class::entries_of_scene(scene, submissions, stated);
     // The scene and images are named on the command line: a bad one is bad
-    // input, found before any reference is rendered.
-    glint_grade::GradeScene::load(scene).map_err(failure)?;
+    // input, found before any reference is rendered. The scene is loaded
+    // once, here, and graded against as loaded.
+    let loaded = glint_grade::GradeScene::load(scene).map_err(failure)?;
     for file in submissions {
         glint_grade::Submission::load(file).map_err(Failure::Input)?;
     }
-    Ok((entries, Scenes::Folder(PathBuf::new()), PathBuf::new()))
+    let scenes = Scenes::Loaded(std::sync::Arc::new(loaded));
+    Ok((entries, scenes, PathBuf::new()))
 }
 
 /// The course index: `course/course.toml` in the current folder, else in

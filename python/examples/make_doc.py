@@ -94,12 +94,13 @@ def write_atomically(path: pathlib.Path, data: bytes) -> None:
 
 def main() -> int:
     page, pictures = markdown(executed())
-    for stale in DOCS.glob(PICTURE.format("*")):
-        if stale.name not in pictures:
-            stale.unlink()
     for name, data in pictures.items():
         write_atomically(DOCS / name, data)
     write_atomically(PAGE, page.encode())
+    # Only once the new page is in place: pictures it no longer shows.
+    for stale in DOCS.glob(PICTURE.format("*")):
+        if stale.name not in pictures:
+            stale.unlink()
     print(f"wrote {PAGE} and {len(pictures)} pictures")
     return 0
 

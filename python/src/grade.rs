@@ -45,14 +45,12 @@ pub(crate) fn grade_json(
     test: (f64, Option<u32>, Option<PathBuf>),
 ) -> PyResult<Graded> {
     let stated = stated_settings(stated)?;
-    let (path, scenes) = match scene {
-        Against::File(path) => {
-            GradeScene::load(&path).map_err(input)?;
-            (path, Scenes::Folder(PathBuf::new()))
-        }
-        Against::Loaded(scene) => (scene.path.clone(), Scenes::Loaded(Arc::new(*scene))),
+    let scene = match scene {
+        Against::File(path) => GradeScene::load(&path).map_err(input)?,
+        Against::Loaded(scene) => *scene,
     };
-    let entries = class::entries_of_scene(&path, &files, &stated);
+    let entries = class::entries_of_scene(&scene.path, &files, &stated);
+    let scenes = Scenes::Loaded(Arc::new(scene));
     for entry in &entries {
         glint_grade::Submission::load(&entry.file).map_err(PyValueError::new_err)?;
     }

@@ -31,7 +31,7 @@ fn bad(message: String) -> Reply {
 /// An image named on the command line, read once.
 pub(crate) struct Image {
     path: PathBuf,
-    film: Film,
+    film: Arc<Film>,
     format: String,
 }
 
@@ -48,7 +48,7 @@ impl Images {
             Ok(Image {
                 path: path.clone(),
                 format: file.description(),
-                film: file.film,
+                film: Arc::new(file.film),
             })
         };
         paths.iter().map(read).collect::<Result<_, _>>().map(Images)
@@ -309,7 +309,7 @@ impl State {
                     .ok_or_else(|| bad("no render yet".into()))?;
                 Ok(latest.film)
             }
-            id => Ok(Arc::new(self.numbered(id)?.film.clone())),
+            id => Ok(self.numbered(id)?.film.clone()),
         }
     }
 }

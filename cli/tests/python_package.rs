@@ -26,9 +26,16 @@ fn the_python_package_passes_its_pytest_suite() {
         bin.display(),
         std::env::var("PATH").unwrap_or_default()
     );
-    // The dev profile: its dependencies are the test build's, already built.
+    // The dev profile (pyproject.toml names the wheel's): its dependencies
+    // are the test build's, already built.
     let build = Command::new(bin.join("maturin"))
-        .args(["develop", "--manifest-path", "python/Cargo.toml"])
+        .args([
+            "develop",
+            "--profile",
+            "dev",
+            "--manifest-path",
+            "python/Cargo.toml",
+        ])
         .current_dir(repo())
         .env("VIRTUAL_ENV", bin.parent().unwrap())
         .env("PATH", &path)

@@ -95,6 +95,16 @@ pub(crate) struct GradeArgs {
     #[arg(long)]
     no_cache: bool,
 
+    /// List the classic mistakes a failing submission is tested against
+    /// (id, stage, how Glint renders it, what it is) and exit
+    #[arg(long, exclusive = true)]
+    mistakes: bool,
+
+    /// Do not test failing submissions against the classic mistakes (which
+    /// renders each mistake once per scene, resolution and settings)
+    #[arg(long)]
+    no_mistakes: bool,
+
     /// What to print: table (and, for one submission, every rejected region),
     /// csv or json
     #[arg(long, value_name = "FORMAT", value_enum, default_value_t = Format::Table)]
@@ -211,6 +221,10 @@ pub(crate) fn grade(args: &GradeArgs) -> Result<(), Failure> {
     if args.stages {
         return crate::grade_stages::run(&args.stage_args()?);
     }
+    if args.mistakes {
+        crate::output::say(&glint_grade::report::catalogue());
+        return Ok(());
+    }
     let Some(threads) = args.threads else {
         return grade_or_merge(args);
     };
@@ -242,6 +256,7 @@ fn grade_or_merge(args: &GradeArgs) -> Result<(), Failure> {
             block: args.block,
         },
         cache: cache(args)?,
+        mistakes: !args.no_mistakes,
     };
     let bar = GradeProgress::new();
     if args.references_only {

@@ -125,7 +125,7 @@ def build(corpus, quick):
                            corpus.trace(scene, 128, *settings, s, mistakes=(m,)), mistake=m)
 
 
-def grade_class(corpus, rows, name="manifest"):
+def grade_class(corpus, rows, name="manifest", cache=None):
     """Grades `rows` as one class with `glint grade --class` (each row's
     settings stated or not) against the corpus's reference cache: each
     submission's JSON by student, and the seconds it took."""
@@ -138,7 +138,7 @@ def grade_class(corpus, rows, name="manifest"):
             w.writerow([r["student"], str(SCENES[r["scene"]]), r["file"], *stated, r["kind"]])
     start = time.time()
     out = subprocess.run([corpus.glint, "grade", "--class", str(manifest), "--format", "json",
-                          "--cache", str(corpus.out / "cache")], capture_output=True, text=True)
+                          "--cache", str(cache or corpus.out / "cache")], capture_output=True, text=True)
     if out.returncode not in (0, 1):
         sys.exit(f"glint grade failed ({out.returncode}): {out.stderr}")
     elapsed = time.time() - start

@@ -126,6 +126,7 @@ fn report_json(
     let options = ClassOptions {
         test: TestOptions { alpha, block },
         cache: Cache { dir: cache },
+        mistakes: true,
     };
     let graded =
         glint_grade::document::grade_with_heatmaps(entries, (scenes, base), &options, &Quiet)

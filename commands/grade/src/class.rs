@@ -9,7 +9,7 @@ use crate::reference::{references, with_jpeg, Cache, GradeScene, References};
 use crate::submission::Submission;
 use crate::test::TestOptions;
 use crate::text::shorten;
-use crate::{grade_image, GradeError, ImageGrade};
+use crate::{grade_image, mistakes, GradeError, ImageGrade};
 use glam::UVec2;
 use glint_integrator::SamplePattern;
 use rayon::prelude::*;
@@ -262,6 +262,9 @@ impl Columns {
 pub struct ClassOptions {
     pub test: TestOptions,
     pub cache: Cache,
+    /// Whether a failing submission is tested against the classic
+    /// mistakes ([`crate::mistakes`]).
+    pub mistakes: bool,
 }
 
 /// What becomes of one submission.
@@ -369,7 +372,58 @@ pub fn grade_class(
             row
         })
         .collect::<Result<_, GradeError>>()?;
+    let mut rows = rows;
+    if options.mistakes {
+        diagnose_failures(&mut rows, &groups, options, progress)?;
+    }
     Ok(ClassGrades { rows, groups })
+}
+
+/// Tests each failing row against the classic mistakes, rendered once per
+/// reference set that has a failing row.
+fn diagnose_failures(
+    rows: &mut [Row],
+    groups: &[Group],
+    options: &ClassOptions,
+    progress: &dyn Progress,
+) -> Result<(), GradeError> {
+    for (g, group) in groups.iter().enumerate() {
+        let failing: Vec<usize> = (0..rows.len())
+            .filter(|&i| rows[i].group == Some(g) && failed(&rows[i]))
+            .collect();
+        if failing.is_empty() {
+            continue;
+        }
+        let rendering = |what: &str| progress.rendering(what);
+        let mutants = mistakes::render_mutants(
+            &group.scene,
+            &group.references,
+            &group.stated,
+            &options.cache,
+            &rendering,
+        )?;
+        let found: Vec<Vec<mistakes::LikelyMistake>> = failing
+            .par_iter()
+            .map(|&i| match Submission::load(Path::new(&rows[i].file)) {
+                // A JPEG's mutants would go through its encoding: not yet.
+                Ok(s) if s.jpeg.is_none() && s.resolution() == group.references.resolution => {
+                    mistakes::diagnose(&group.scene, &group.references, &mutants, &s, &options.test)
+                }
+                _ => Vec::new(),
+            })
+            .collect();
+        for (i, found) in failing.into_iter().zip(found) {
+            if let Outcome::Graded(grade) = &mut rows[i].outcome {
+                grade.likely_mistakes = found;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether `row` was graded and failed.
+fn failed(row: &Row) -> bool {
+    matches!(&row.outcome, Outcome::Graded(g) if !g.passed && g.unreadable.is_none())
 }
 
 /// Renders the references `entries` need into the cache (or finds them

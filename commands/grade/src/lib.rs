@@ -32,6 +32,7 @@ pub mod heatmap;
 pub mod html;
 pub mod hypothesis;
 pub mod jpeg;
+pub mod mistakes;
 pub mod output;
 pub mod parts;
 pub mod reference;
@@ -90,6 +91,10 @@ pub struct ImageGrade {
     pub largest_accepted_z: f64,
     /// The submission's per-pixel noise (standard deviation, linear).
     pub noise: f64,
+    /// For a failing submission, the classic mistakes it was tested
+    /// against, ranked, the consistent first ([`mistakes`]); empty for a
+    /// pass, or when they were not asked for.
+    pub likely_mistakes: Vec<mistakes::LikelyMistake>,
     /// The full outcome, for heat maps (not serialised).
     #[serde(skip)]
     pub outcome: Outcome,
@@ -153,6 +158,7 @@ pub fn grade_image(
         rejected: Vec::new(),
         largest_accepted_z: 0.0,
         noise: 0.0,
+        likely_mistakes: Vec::new(),
         outcome: Outcome {
             findings: Vec::new(),
             alpha: options.alpha,

@@ -254,6 +254,39 @@ pub fn with_jpeg(
     Ok(())
 }
 
+/// The sample reference's rounds rendered again (the same seeds, so the
+/// same rounds), each pixel passed through `f`: `E[f(X_s)]` and the variance
+/// of that mean, cached apart under `tag`.
+pub fn samples_through(
+    scene: &GradeScene,
+    refs: &References,
+    tag: &str,
+    f: &(dyn Fn(Vec3) -> Vec3 + Sync),
+    cache: &Cache,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<Estimate, GradeError> {
+    let rendered = at_resolution(scene, refs.resolution)?;
+    let job = Job {
+        scene,
+        rendered: &rendered,
+        resolution: refs.resolution,
+        cache,
+        progress,
+    };
+    let through = |pixels: &[Vec3], out: &mut Vec<Vec3>| {
+        out.extend(pixels.iter().map(|&p| f(p)));
+        Ok(())
+    };
+    let [samples] = job.estimates(
+        "sample",
+        tag,
+        [&through],
+        &refs.plan.samples,
+        refs.plan.sample_rounds,
+    )?;
+    Ok(samples)
+}
+
 /// [`JpegEncoding::dc_rounding`] of the mean reference `M` under the sample
 /// reference's noise (clamped, as an 8-bit file stores it) and `M`'s own,
 /// in codes.

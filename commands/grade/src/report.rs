@@ -73,10 +73,44 @@ pub fn summary(row: &Row) -> String {
                 1 => String::new(),
                 n => format!("; {} more", n - 1),
             };
-            format!("{}{more}", finding_phrase(&g.rejected[0]))
+            let why = mistakes_phrase(g).map_or(String::new(), |m| format!("; {m}"));
+            format!("{}{more}{why}", finding_phrase(&g.rejected[0]))
         }
         Outcome::Unreadable { message } => message.clone(),
     }
+}
+
+/// What a failing grade's mistakes say: "consistent with: every light sample
+/// at the light's centre: hard shadows (light-centre)" (up to three), or "no
+/// known mistake fits"; `None` where none was tested.
+pub fn mistakes_phrase(grade: &ImageGrade) -> Option<String> {
+    if grade.passed || grade.likely_mistakes.is_empty() {
+        return None;
+    }
+    let fits: Vec<String> = (grade.likely_mistakes.iter())
+        .filter(|m| m.consistent)
+        .take(3)
+        .map(|m| format!("{} ({})", m.description, m.id))
+        .collect();
+    Some(match fits.is_empty() {
+        true => "no known mistake fits".into(),
+        false => format!("consistent with: {}", fits.join("; ")),
+    })
+}
+
+/// The catalogue of mistakes as `glint grade --mistakes` lists it.
+pub fn catalogue() -> String {
+    let mut out = String::new();
+    for m in crate::mistakes::CATALOGUE {
+        out += &format!(
+            "{:<22} {:<13} {:<13} {}\n",
+            m.id,
+            m.stage.name(),
+            m.how.rendered_as(),
+            m.description
+        );
+    }
+    out
 }
 
 /// z with one decimal; a difference where there is no noise at all (a
@@ -348,6 +382,9 @@ pub fn details(grade: &ImageGrade, limit: usize) -> String {
             significant(grade.noise)
         );
         return out;
+    }
+    if let Some(why) = mistakes_phrase(grade) {
+        out += &format!("  {why}\n");
     }
     for f in grade.rejected.iter().take(limit) {
         out += &format!("  {} ({} pixels)\n", finding_phrase(f), f.pixels);

@@ -246,6 +246,8 @@ impl State {
                 block: None,
             },
             cache: glint_grade::Cache { dir: None },
+            // The page shows where a submission fails, not why.
+            mistakes: false,
         };
         let graded = glint_grade::document::grade_with_heatmaps(
             &entries,

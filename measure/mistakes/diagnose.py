@@ -1,0 +1,163 @@
+#!/usr/bin/env python3
+"""Measures how well `glint grade` names the mistake behind a failing image,
+on submissions made by the independent tracer (measure/corpus/tracer.py):
+each of its mistakes at several settings, and correct renders.
+
+    measure/corpus/.venv/bin/python measure/mistakes/diagnose.py [--glint target/release/glint]
+        [--out target/corpus-mistakes] [--cache target/corpus/cache] [--quick] [--no-512]
+
+For each mistake the tracer makes, the failing submissions' `likely_mistakes`
+(glint grade --format json) are read for where the true mistake ranks: first,
+among the first three, or "no known mistake fits" for a mistake Glint's
+catalogue does not have. Writes OUT/results.json and prints the table of
+docs/grading.md. Images and Glint's reference cache stay, so a second run only
+grades. The tracer makes the submissions; Glint does all the rest.
+"""
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "corpus"))
+from measure import Corpus, grade_class  # noqa: E402
+
+# The tracer's name for each mistake -> Glint's catalogue id (None: not in it).
+IDS = {
+    "flipped-view": "view-sign",
+    "sphere-u-sign": "sphere-u-sign",
+    "no-shadow-offset": "no-shadow-offset",
+    "no-shadows": "no-shadows",
+    "no-srgb": "no-srgb",
+    "gamma-22": "gamma-2.2",
+    "truncate-8bit": None,
+    "summed-light-samples": "sum-light-samples",
+    "horizontal-fov": "fov-horizontal",
+    "fov-no-half": "fov-not-halved",
+    "pixel-corners": "pixel-corner",
+    "unnormalised-normals": "normal-not-normalised",
+    "blinn-half-vector": "blinn",
+    "checker-doubled": "checker-double",
+    "sphere-v-from-y": None,
+    "no-ambient": "no-ambient",
+    "ambient-per-sample": None,
+    "ambient-in-shadow-only": None,
+    "flipped-image": "flip-vertical",
+    "light-centre": "light-centre",
+    "light-twice-size": "light-twice-size",
+    "light-blocks-shadow": "light-blocks-itself",
+    "invisible-light": "light-invisible",
+    "two-sided-light": "two-sided-light",
+    "distance-falloff": None,
+    "no-clamp-dots": None,
+    "specular-white": None,
+    "shared-samples": None,
+}
+
+SETTINGS_128 = [(1, "random", 1, "random"), (4, "stratified", 4, "stratified"),
+                (16, "random", 16, "random"), (64, "stratified", 1, "random")]
+SETTINGS_512 = [(1, "random", 1, "random"), (16, "stratified", 16, "stratified")]
+
+
+def catalogue(glint):
+    """Glint's mistakes: id -> how it is rendered."""
+    import subprocess
+    out = subprocess.run([glint, "grade", "--mistakes"], check=True, capture_output=True, text=True)
+    found = {}
+    for line in out.stdout.splitlines():
+        parts = line.split()
+        how = "not rendered" if "not rendered" in line else "noise only" if "noise only" in line else parts[2]
+        found[parts[0]] = how
+    return found
+
+
+def build(corpus, quick, with_512):
+    seed = iter(range(500000, 900000))
+    mistakes = list(IDS) if not quick else ["no-ambient", "light-centre", "specular-white", "flipped-image"]
+    scenes = ("set1", "set2", "set3") if not quick else ("set1",)
+    for m in mistakes:
+        for scene in scenes:
+            for settings in SETTINGS_128 if not quick else SETTINGS_128[1:2]:
+                path = corpus.trace(scene, 128, *settings, next(seed), mistakes=(m,))
+                corpus.add("mistake", scene, 128, settings, path, mistake=m)
+        if with_512:
+            for settings in SETTINGS_512:
+                path = corpus.trace("set1", 512, *settings, next(seed), mistakes=(m,))
+                corpus.add("mistake", "set1", 512, settings, path, mistake=m)
+    for scene in scenes:
+        for settings in SETTINGS_128:
+            corpus.add("correct", scene, 128, settings, corpus.trace(scene, 128, *settings, next(seed)))
+
+
+def rank_of(true_id, likely):
+    """1-based rank of `true_id` among the consistent mistakes, or None."""
+    consistent = [m["id"] for m in likely if m["consistent"]]
+    return consistent.index(true_id) + 1 if true_id in consistent else None
+
+
+def summarise(corpus, rendered):
+    rows = {}
+    for r in corpus.rows:
+        key = r["mistake"] or "(correct)"
+        s = rows.setdefault(key, dict(n=0, failed=0, first=0, top3=0, none_fits=0, given=0, wrong_first=[]))
+        s["n"] += 1
+        g = r["graded"]
+        if g["verdict"] != "fail":
+            s["given"] += bool(g.get("likely_mistakes"))
+            continue
+        s["failed"] += 1
+        likely = g.get("likely_mistakes", [])
+        true_id = IDS.get(r["mistake"]) if r["mistake"] else None
+        rank = rank_of(true_id, likely) if true_id else None
+        s["first"] += rank == 1
+        s["top3"] += rank is not None and rank <= 3
+        fits = [m["id"] for m in likely if m["consistent"]]
+        s["none_fits"] += not fits
+        if fits and rank != 1:
+            s["wrong_first"].append(fits[0])
+    for key, s in rows.items():
+        true_id = IDS.get(key)
+        s["id"] = true_id
+        s["rendered"] = rendered.get(true_id, "") if true_id else "not in the catalogue"
+    return rows
+
+
+def table(rows):
+    lines = ["| tracer's mistake | Glint's id (rendered as) | failing / made | ranked first | in the first three | no known mistake fits |",
+             "|---|---|---|---|---|---|"]
+    for key, s in rows.items():
+        f = s["failed"] or 1
+        pct = lambda k: f"{100 * s[k] / f:.0f}%" if s["failed"] else "–"
+        ident = f"`{s['id']}` ({s['rendered']})" if s["id"] else s["rendered"]
+        lines.append(f"| `{key}` | {ident} | {s['failed']} / {s['n']} | {pct('first')} | {pct('top3')} | {pct('none_fits')} |")
+    return "\n".join(lines)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    repo = HERE.parent.parent
+    ap.add_argument("--glint", default=str(repo / "target/release/glint"))
+    ap.add_argument("--out", default=str(repo / "target/corpus-mistakes"))
+    ap.add_argument("--cache", default=str(repo / "target/corpus/cache"))
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--no-512", action="store_true", help="only the 128² submissions")
+    args = ap.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    corpus = Corpus(out, args.glint, sys.executable)
+    start = time.time()
+    build(corpus, args.quick, not args.no_512)
+    made = time.time() - start
+    graded, elapsed = grade_class(corpus, corpus.rows, cache=Path(args.cache))
+    for r in corpus.rows:
+        r["graded"] = graded[r["student"]]
+    rows = summarise(corpus, catalogue(args.glint))
+    (out / "results.json").write_text(json.dumps(dict(rows=rows, grade_seconds=elapsed, trace_seconds=made), indent=1))
+    print(table(rows))
+    print(f"\n{len(corpus.rows)} submissions; grading (mutants included) took {elapsed:.0f} s")
+
+
+if __name__ == "__main__":
+    main()

@@ -50,6 +50,12 @@ pub(crate) struct ExplainArgs {
     /// docs/checking-your-ray-tracer.md)
     #[arg(long, value_name = "STUDENT.json")]
     against: Option<PathBuf>,
+
+    /// Explain the pixel as a ray tracer with this classic mistake renders
+    /// it (an id of glint grade --mistakes that Glint renders as a change to
+    /// the scene), so that the first number that goes wrong shows
+    #[arg(long, value_name = "ID")]
+    mistake: Option<String>,
 }
 
 /// `--stage`'s parser: the names in pipeline order, each with the heading
@@ -80,13 +86,64 @@ fn parse_pixel(text: &str) -> Result<(u32, u32), String> {
 }
 
 pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
-    let description = args.scene.load()?;
+    let description = match &args.mistake {
+        Some(id) => with_mistake(args, id)?,
+        None => args.scene.load()?,
+    };
     let Explained { text, parted } = explained(args, &description)?;
     print(&text);
     match parted {
         None => Ok(()),
         Some(message) => Err(Failure::Verdict(Some(message))),
     }
+}
+
+/// The scene of `args` as a tracer with mistake `id` sees it: its file
+/// edited as `glint grade` renders the mistake, then the flags' settings.
+fn with_mistake(args: &ExplainArgs, id: &str) -> Result<glint_scene::SceneDescription, Failure> {
+    use glint_grade::mistakes::{self, How};
+    let mistake = mistakes::find(id).ok_or_else(|| {
+        Failure::Input(format!(
+            "--mistake: no mistake is called \"{}\" (glint grade --mistakes lists them)",
+            glint_grade::text::shorten(id)
+        ))
+    })?;
+    let (How::Scene(edit) | How::Lights(edit)) = mistake.how else {
+        return Err(Failure::Input(format!(
+            "--mistake {id}: {}; glint explain shows only mistakes Glint renders as a change to the scene (glint grade --mistakes says how each is rendered)",
+            match mistake.how {
+                How::Film(_) => "it changes what the file stores, after every stage of the pixel",
+                How::NoiseOnly => "it changes only the noise",
+                _ => "this version does not render it",
+            }
+        )));
+    };
+    let correct = args.scene.load()?;
+    let path = &args.scene().scene;
+    let text = glint_scene::read_text(path, glint_scene::MAX_SCENE_BYTES, "a scene file")
+        .map_err(Failure::Input)?;
+    let size = correct.scene.camera.resolution();
+    let context = mistakes::edit::Context {
+        aspect: f64::from(size.x) / f64::from(size.y),
+        light_samples: Some(correct.settings.light_samples),
+    };
+    let edited = mistakes::edited_text(&text, &[edit], &context)
+        .map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?
+        .ok_or_else(|| {
+            Failure::Input(format!(
+                "--mistake {id}: it changes nothing in {} at these settings",
+                path.display()
+            ))
+        })?;
+    let name = format!("{} with {id}", path.display());
+    let base = path.parent().unwrap_or(Path::new(""));
+    let mut description = glint_scene::parse_in(&edited, &name, base)
+        .map_err(|e| Failure::Other(format!("{id}: the edited scene: {e}")))?;
+    args.scene
+        .overrides()
+        .apply(&mut description)
+        .map_err(|e| Failure::Input(e.to_string()))?;
+    Ok(description)
 }
 
 /// What `glint explain` prints, and with `--against`, where the student's

@@ -83,7 +83,7 @@ pub(crate) struct RenderArgs {
 #[derive(Args)]
 pub(crate) struct SceneArgs {
     /// The scene file (TOML; every key is described in docs/scene-format.md)
-    scene: PathBuf,
+    pub(crate) scene: PathBuf,
 
     /// Camera samples per pixel (overrides render.spp)
     #[arg(long, value_name = "N")]

@@ -127,9 +127,9 @@ fn open_browser(url: &str) {
     }
 }
 
-/// The flags a request may not give: they name files or change what is
-/// printed, which the server decides.
-const RESERVED: [&str; 2] = ["against", "json"];
+/// The flags a request may not give: they name files, or change what is
+/// printed or which scene is explained, which the server decides.
+const RESERVED: [&str; 3] = ["against", "json", "mistake"];
 /// Loaded scenes kept, by the settings they were loaded with.
 const SCENES_KEPT: usize = 4;
 

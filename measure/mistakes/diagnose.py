@@ -56,6 +56,11 @@ IDS = {
     "shared-samples": None,
 }
 
+# Pairs of the tracer's mistakes, each a combination Glint should name.
+PAIRS = [("no-ambient", "light-centre"), ("no-srgb", "blinn-half-vector"),
+         ("no-ambient", "two-sided-light"), ("fov-no-half", "no-ambient"),
+         ("gamma-22", "checker-doubled"), ("summed-light-samples", "light-twice-size")]
+
 SETTINGS_128 = [(1, "random", 1, "random"), (4, "stratified", 4, "stratified"),
                 (16, "random", 16, "random"), (64, "stratified", 1, "random")]
 SETTINGS_512 = [(1, "random", 1, "random"), (16, "stratified", 16, "stratified")]
@@ -86,15 +91,28 @@ def build(corpus, quick, with_512):
             for settings in SETTINGS_512:
                 path = corpus.trace("set1", 512, *settings, next(seed), mistakes=(m,))
                 corpus.add("mistake", "set1", 512, settings, path, mistake=m)
+    for pair in PAIRS if not quick else PAIRS[:1]:
+        for scene in scenes:
+            settings = SETTINGS_128[1]
+            path = corpus.trace(scene, 128, *settings, next(seed), mistakes=pair)
+            corpus.add("pair", scene, 128, settings, path, mistake="+".join(pair))
     for scene in scenes:
         for settings in SETTINGS_128:
             corpus.add("correct", scene, 128, settings, corpus.trace(scene, 128, *settings, next(seed)))
 
 
+def true_id_of(mistake):
+    """Glint's id for the tracer's mistake or pair of them (None: not in the catalogue)."""
+    ids = [IDS.get(m) for m in mistake.split("+")]
+    return "+".join(ids) if all(ids) else None
+
+
 def rank_of(true_id, likely):
-    """1-based rank of `true_id` among the consistent mistakes, or None."""
-    consistent = [m["id"] for m in likely if m["consistent"]]
-    return consistent.index(true_id) + 1 if true_id in consistent else None
+    """1-based rank of `true_id` (a pair in either order) among the consistent
+    mistakes, or None."""
+    want = set(true_id.split("+"))
+    consistent = [set(m["id"].split("+")) for m in likely if m["consistent"]]
+    return consistent.index(want) + 1 if want in consistent else None
 
 
 def summarise(corpus, rendered):
@@ -109,7 +127,7 @@ def summarise(corpus, rendered):
             continue
         s["failed"] += 1
         likely = g.get("likely_mistakes", [])
-        true_id = IDS.get(r["mistake"]) if r["mistake"] else None
+        true_id = true_id_of(r["mistake"]) if r["mistake"] else None
         rank = rank_of(true_id, likely) if true_id else None
         s["first"] += rank == 1
         s["top3"] += rank is not None and rank <= 3
@@ -118,9 +136,10 @@ def summarise(corpus, rendered):
         if fits and rank != 1:
             s["wrong_first"].append(fits[0])
     for key, s in rows.items():
-        true_id = IDS.get(key)
+        true_id = true_id_of(key) if key != "(correct)" else None
         s["id"] = true_id
-        s["rendered"] = rendered.get(true_id, "") if true_id else "not in the catalogue"
+        how = [rendered.get(i, "") for i in true_id.split("+")] if true_id else []
+        s["rendered"] = " + ".join(how) if true_id else "not in the catalogue"
     return rows
 
 

@@ -402,16 +402,24 @@ fn diagnose_failures(
             &options.cache,
             &rendering,
         )?;
+        let against = mistakes::Against {
+            scene: &group.scene,
+            references: &group.references,
+            stated: &group.stated,
+            mutants: &mutants,
+            cache: &options.cache,
+            progress: &rendering,
+        };
         let found: Vec<Vec<mistakes::LikelyMistake>> = failing
             .par_iter()
             .map(|&i| match Submission::load(Path::new(&rows[i].file)) {
                 // A JPEG's mutants would go through its encoding: not yet.
                 Ok(s) if s.jpeg.is_none() && s.resolution() == group.references.resolution => {
-                    mistakes::diagnose(&group.scene, &group.references, &mutants, &s, &options.test)
+                    mistakes::diagnose(&against, &s, &options.test)
                 }
-                _ => Vec::new(),
+                _ => Ok(Vec::new()),
             })
-            .collect();
+            .collect::<Result<_, GradeError>>()?;
         for (i, found) in failing.into_iter().zip(found) {
             if let Outcome::Graded(grade) = &mut rows[i].outcome {
                 grade.likely_mistakes = found;
@@ -426,8 +434,8 @@ fn failed(row: &Row) -> bool {
     matches!(&row.outcome, Outcome::Graded(g) if !g.passed && g.unreadable.is_none())
 }
 
-/// Renders the references `entries` need into the cache (or finds them
-/// there), and grades nothing: the first step of a class graded in parts,
+/// Renders the references `entries` need, and with `options.mistakes` their
+/// mistakes, into the cache (or finds them there), and grades nothing: the first step of a class graded in parts,
 /// whose parts then read them from the cache. Only the reference sets
 /// `wanted` takes (by their index in order of first use: a part's are I, I +
 /// N, …). Returns how many sets were rendered or found, and how many the
@@ -453,6 +461,15 @@ pub fn render_references(
     let row_groups: Vec<Option<usize>> =
         row_groups.iter().map(|g| g.and_then(|g| mine[g])).collect();
     through_jpeg(&mut groups, &probes, &row_groups, options, progress)?;
+    // Which submissions fail is not known yet: every set's mistakes are
+    // rendered, so that the parts find them all in the cache.
+    if options.mistakes {
+        let rendering = |what: &str| progress.rendering(what);
+        for group in &groups {
+            let (scene, refs) = (&group.scene, &group.references);
+            mistakes::render_mutants(scene, refs, &group.stated, &options.cache, &rendering)?;
+        }
+    }
     Ok((groups.len(), keys.len()))
 }
 

@@ -187,6 +187,7 @@ impl Outcome {
 /// Per pixel and channel, the band of the expected value, the variance of
 /// the references behind it, and the noise of one draw of the submission's
 /// estimator.
+#[derive(Clone)]
 pub struct Bands {
     pub lo: Vec<Vec3>,
     pub hi: Vec<Vec3>,

@@ -65,6 +65,14 @@ pub enum How {
 }
 
 impl How {
+    /// The scene edit that renders it, for a mistake rendered as a scene.
+    pub fn edit(&self) -> Option<super::edit::Edit> {
+        match self {
+            How::Scene(edit) | How::Lights(edit) => Some(*edit),
+            _ => None,
+        }
+    }
+
     /// The word `glint grade --mistakes` shows for it.
     pub fn rendered_as(&self) -> &'static str {
         match self {

@@ -85,33 +85,53 @@ fn context(refs: &References, stated: &StatedSettings) -> edit::Context {
     }
 }
 
-/// `scene` with `edit` applied to its file, or `None` when the edit changes
-/// nothing (or the scene has no file to edit: it came from memory).
+/// The scene text `text` with `edits` applied in turn, or `None` when one
+/// of them changes nothing.
+pub fn edited_text(
+    text: &str,
+    edits: &[edit::Edit],
+    context: &edit::Context,
+) -> Result<Option<String>, String> {
+    let mut table: toml::Table = text.parse().map_err(|e: toml::de::Error| e.to_string())?;
+    for edit in edits {
+        if !edit(&mut table, context) {
+            return Ok(None);
+        }
+    }
+    toml::to_string(&table).map(Some).map_err(|e| e.to_string())
+}
+
+/// `scene` with the edits of `mistakes` applied to its file, or `None` when
+/// one changes nothing (or the scene has no file to edit: it came from
+/// memory).
 pub fn edited_scene(
     scene: &GradeScene,
-    mistake: &Mistake,
-    edit: edit::Edit,
+    mistakes: &[&Mistake],
     context: &edit::Context,
 ) -> Result<Option<GradeScene>, GradeError> {
-    if scene.text_hash.is_some() {
+    let edits: Vec<edit::Edit> = mistakes.iter().filter_map(|m| m.how.edit()).collect();
+    if scene.text_hash.is_some() || edits.len() != mistakes.len() {
         return Ok(None);
     }
     let path = &scene.path;
     let text = std::fs::read_to_string(path)
         .map_err(|e| GradeError::Input(format!("{}: {e}", path.display())))?;
-    let mut table: toml::Table = text
-        .parse()
-        .map_err(|e| GradeError::Input(format!("{}: {e}", path.display())))?;
-    if !edit(&mut table, context) {
+    let Some(edited) = edited_text(&text, &edits, context)
+        .map_err(|e| GradeError::Input(format!("{}: {e}", path.display())))?
+    else {
         return Ok(None);
-    }
-    let edited = toml::to_string(&table)
-        .map_err(|e| GradeError::Internal(format!("{} edited: {e}", mistake.id)))?;
-    let name = format!("{} with {}", path.display(), mistake.id);
+    };
+    let ids = joined(mistakes, |m| m.id, "+");
+    let name = format!("{} with {ids}", path.display());
     let base = path.parent().unwrap_or(std::path::Path::new(""));
     let description = glint_scene::parse_in(&edited, &name, base)
-        .map_err(|e| GradeError::Internal(format!("{} edited: {e}", mistake.id)))?;
+        .map_err(|e| GradeError::Internal(format!("{ids} edited: {e}")))?;
     Ok(Some(GradeScene::from_text(&name, &edited, description)))
+}
+
+fn joined(mistakes: &[&Mistake], part: fn(&Mistake) -> &str, by: &str) -> String {
+    let parts: Vec<&str> = mistakes.iter().map(|m| part(m)).collect();
+    parts.join(by)
 }
 
 /// Renders (or reads from `cache`) every mistake of the catalogue that
@@ -127,8 +147,8 @@ pub fn render_mutants(
     let mut mutants = Vec::new();
     for mistake in CATALOGUE {
         let render = match mistake.how {
-            How::Scene(edit) | How::Lights(edit) => {
-                let Some(edited) = edited_scene(scene, mistake, edit, &context)? else {
+            How::Scene(_) | How::Lights(_) => {
+                let Some(edited) = edited_scene(scene, &[mistake], &context)? else {
                     continue;
                 };
                 let references = references(&edited, refs.resolution, &refs.plan, cache, progress)?;
@@ -139,14 +159,10 @@ pub fn render_mutants(
                 }
             }
             How::Film(FilmMistake::FlipVertical) => MutantRender::Flip,
-            How::Film(film) => {
-                let tag = format!(" with {}", mistake.id);
-                let f = move |p: Vec3| Vec3::from_array(p.to_array().map(|c| film.decoded(c)));
-                MutantRender::Encoding {
-                    mistake: film,
-                    samples: samples_through(scene, refs, &tag, &f, cache, progress)?,
-                }
-            }
+            How::Film(film) => MutantRender::Encoding {
+                mistake: film,
+                samples: through_film(scene, refs, film, mistake.id, cache, progress)?,
+            },
             How::NotRendered | How::NoiseOnly => continue,
         };
         mutants.push(Mutant { mistake, render });
@@ -154,51 +170,109 @@ pub fn render_mutants(
     Ok(Mutants { mutants })
 }
 
-/// The mistakes `submission` was tested against, ranked; the consistent
-/// first. `correct` are its bands under the correct render (`refs`, of
-/// `scene`).
-pub fn diagnose(
+/// The sample reference of `scene` (`refs`) through the encoding mistake
+/// `film` (named `id`), round by round.
+fn through_film(
     scene: &GradeScene,
     refs: &References,
-    mutants: &Mutants,
+    film: FilmMistake,
+    id: &str,
+    cache: &Cache,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<Estimate, GradeError> {
+    let tag = format!(" with {id}");
+    let f = move |p: Vec3| Vec3::from_array(p.to_array().map(|c| film.decoded(c)));
+    samples_through(scene, refs, &tag, &f, cache, progress)
+}
+
+/// What a submission's mistakes are tested against: the correct render of
+/// its scene and its mistakes, with what rendering a combination needs.
+pub struct Against<'a> {
+    pub scene: &'a GradeScene,
+    pub references: &'a References,
+    pub stated: &'a StatedSettings,
+    pub mutants: &'a Mutants,
+    pub cache: &'a Cache,
+    pub progress: &'a (dyn Fn(&str) + Sync),
+}
+
+/// Single mistakes tried in pairs with each other when none fits alone:
+/// the best fits (the best is also tried with every other).
+const PAIRED: usize = 4;
+
+/// The pairs of `ranked` (mutants, best fit first) that are tried: the best
+/// with each other one, and every pair of the first [`PAIRED`]. A second
+/// mistake hides behind the first's larger error, so its own rank says
+/// little; the best fit is most likely one of the two.
+fn pairs(ranked: &[(usize, f64)]) -> Vec<(usize, usize)> {
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    for (k, &(a, _)) in ranked.iter().enumerate() {
+        for (l, &(b, _)) in ranked.iter().enumerate().skip(k + 1) {
+            if k == 0 || l < PAIRED {
+                pairs.push((a, b));
+            }
+        }
+    }
+    pairs
+}
+
+/// The mistakes `submission` was tested against, ranked, the consistent
+/// first: each single mistake; when none fits, each with the image upside
+/// down, then pairs ([`pairs`]; rendered, or read from the cache).
+pub fn diagnose(
+    against: &Against,
     submission: &Submission,
     options: &TestOptions,
-) -> Vec<LikelyMistake> {
+) -> Result<Vec<LikelyMistake>, GradeError> {
+    let refs = against.references;
     let size = refs.resolution;
     let block = options
         .block
         .unwrap_or_else(|| test::block_side(size.x, size.y));
     let regions = test::regions(size.x, size.y, block, &refs.objects);
+    let test = (submission, regions.as_slice(), options);
     let correct = Bands::new(submission, refs, None);
-    let lights = near_lights(scene, refs);
-    let singles: Vec<(&Mistake, Bands)> = mutants
-        .mutants
-        .iter()
-        .filter_map(|m| Some((m.mistake, bands(m, &correct, refs, &lights, submission)?)))
+    let lights = near_lights(against.scene, refs);
+    let mutants = &against.mutants.mutants;
+    let singles: Vec<(usize, Bands)> = (0..mutants.len())
+        .filter_map(|i| Some((i, bands(&mutants[i], &correct, refs, &lights, submission)?)))
         .collect();
     let mut found: Vec<LikelyMistake> = singles
         .iter()
-        .map(|(m, b)| {
-            judged(
-                m.id.into(),
-                m.description.into(),
-                m.stage,
-                b,
-                (submission, &regions, options),
-            )
-        })
+        .map(|(i, b)| judged(&[mutants[*i].mistake], b, test))
         .collect();
     if !found.iter().any(|f| f.consistent) {
         let flip = find("flip-vertical").expect("in the catalogue");
-        for (m, b) in singles.iter().filter(|(m, _)| m.id != flip.id) {
-            let flipped = flipped(b, size.x, size.y);
-            found.push(judged(
-                format!("{}+{}", m.id, flip.id),
-                format!("{}; {}", m.description, flip.description),
-                m.stage,
-                &flipped,
-                (submission, &regions, options),
-            ));
+        for (i, b) in &singles {
+            if mutants[*i].mistake.id != flip.id {
+                let flipped = flipped(b, size.x, size.y);
+                found.push(judged(&[mutants[*i].mistake, flip], &flipped, test));
+            }
+        }
+    }
+    if !found.iter().any(|f| f.consistent) {
+        let mut best: Vec<(usize, f64)> = (singles.iter().zip(&found))
+            .filter(|((i, _), _)| !matches!(mutants[*i].render, MutantRender::Flip))
+            .map(|((i, _), f)| (*i, f.score))
+            .collect();
+        best.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let by_index: Vec<Option<&Bands>> = (0..mutants.len())
+            .map(|i| singles.iter().find(|(j, _)| *j == i).map(|(_, b)| b))
+            .collect();
+        let pair = Pair {
+            against,
+            submission,
+            lights: &lights,
+            singles: &by_index,
+        };
+        for (a, b) in pairs(&best) {
+            if let Some(bands) = pair.bands(a, b)? {
+                found.push(judged(
+                    &[mutants[a].mistake, mutants[b].mistake],
+                    &bands,
+                    test,
+                ));
+            }
         }
     }
     found.sort_by(|a, b| {
@@ -207,23 +281,107 @@ pub fn diagnose(
             .then(a.score.total_cmp(&b.score))
             .then(a.id.cmp(&b.id))
     });
-    found
+    Ok(found)
 }
 
-/// The test of `submission` against `bands`, as a finding about mistake `id`.
+/// Two mistakes rendered together.
+struct Pair<'a> {
+    against: &'a Against<'a>,
+    submission: &'a Submission,
+    lights: &'a [bool],
+    /// Each mutant's bands alone, by its index (`None` where it does not
+    /// apply).
+    singles: &'a [Option<&'a Bands>],
+}
+
+impl Pair<'_> {
+    /// The bands of mutants `a` and `b` together: two scene edits as one
+    /// edited scene, an edit and an encoding as the edited scene's sample
+    /// reference through it; `None` for two encodings. Where a lights'
+    /// mistake keeps the pixels near a light, they come from the other
+    /// mistake alone (or the correct render, when both are the lights').
+    fn bands(&self, a: usize, b: usize) -> Result<Option<Bands>, GradeError> {
+        let against = self.against;
+        let (refs, mutants) = (against.references, &against.mutants.mutants);
+        let (s, o) = match (&mutants[a].render, &mutants[b].render) {
+            (MutantRender::Scene { .. }, _) => (a, b),
+            (_, MutantRender::Scene { .. }) => (b, a),
+            _ => return Ok(None),
+        };
+        let MutantRender::Scene {
+            scene: edited,
+            references: edited_refs,
+            keep_lights,
+        } = &mutants[s].render
+        else {
+            unreachable!("matched above")
+        };
+        let (bands, objects, light_source) = match &mutants[o].render {
+            MutantRender::Scene {
+                keep_lights: also, ..
+            } => {
+                let context = context(refs, against.stated);
+                let both = [mutants[s].mistake, mutants[o].mistake];
+                let Some(both) = edited_scene(against.scene, &both, &context)? else {
+                    return Ok(None);
+                };
+                let both_refs = references(
+                    &both,
+                    refs.resolution,
+                    &refs.plan,
+                    against.cache,
+                    against.progress,
+                )?;
+                let bands = Bands::new(self.submission, &both_refs, None);
+                let source = match (*keep_lights, *also) {
+                    (true, true) => Some(Bands::new(self.submission, refs, None)),
+                    (true, false) => self.singles[o].cloned(),
+                    (false, true) => self.singles[s].cloned(),
+                    (false, false) => None,
+                };
+                (bands, both_refs.objects, source)
+            }
+            MutantRender::Encoding { mistake, .. } => {
+                if matches!(self.submission.encoding, SampleEncoding::Float { .. }) {
+                    return Ok(None);
+                }
+                let id = mutants[o].mistake.id;
+                let samples = through_film(
+                    edited,
+                    edited_refs,
+                    *mistake,
+                    id,
+                    against.cache,
+                    against.progress,
+                )?;
+                let bands = through_encoding(*mistake, &samples, edited_refs);
+                let source = keep_lights.then(|| self.singles[o].cloned()).flatten();
+                (bands, edited_refs.objects.clone(), source)
+            }
+            MutantRender::Flip => return Ok(None),
+        };
+        let mut bands = bands;
+        if let Some(source) = light_source {
+            let mask = near_objects(self.lights, &refs.objects, &objects, refs.resolution.x);
+            keep(&mut bands, &source, &mask);
+        }
+        Ok(Some(bands))
+    }
+}
+
+/// The test of `submission` against `bands`, as a finding about
+/// `mistakes` (one, or a combination).
 fn judged(
-    id: String,
-    description: String,
-    stage: Stage,
+    mistakes: &[&Mistake],
     bands: &Bands,
     (submission, regions, options): (&Submission, &[Region], &TestOptions),
 ) -> LikelyMistake {
     let outcome = test::test(submission, bands, regions, options);
     let n = outcome.findings.len().max(1) as f64;
     LikelyMistake {
-        id,
-        description,
-        stage: stage.name(),
+        id: joined(mistakes, |m| m.id, "+"),
+        description: joined(mistakes, |m| m.description, "; "),
+        stage: mistakes[0].stage.name(),
         consistent: outcome.passed(),
         largest_z: outcome
             .findings
@@ -355,5 +513,59 @@ fn keep(bands: &mut Bands, correct: &Bands, mask: &[bool]) {
         bands.hi[i] = correct.hi[i];
         bands.reference_variance[i] = correct.reference_variance[i];
         bands.noise[i] = correct.noise[i];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_best_fit_is_paired_with_every_other_and_the_first_four_with_each_other() {
+        let ranked: Vec<(usize, f64)> = (0..6).map(|i| (10 + i, i as f64)).collect();
+        let got = pairs(&ranked);
+        let mut want: Vec<(usize, usize)> = (11..16).map(|b| (10, b)).collect();
+        want.extend([(11, 12), (11, 13), (12, 13)]);
+        assert_eq!(got, want);
+        assert!(pairs(&ranked[..1]).is_empty());
+    }
+
+    #[test]
+    fn flipping_twice_gives_the_bands_back_and_the_light_mask_reaches_neighbours() {
+        let v = |k: f32| {
+            (0..6)
+                .map(|i| Vec3::splat(i as f32 + k))
+                .collect::<Vec<_>>()
+        };
+        let bands = Bands {
+            lo: v(0.0),
+            hi: v(1.0),
+            reference_variance: v(2.0),
+            noise: v(3.0),
+            noise_scale: None,
+            fit: NoiseFit::WithinBlocks,
+            precision: None,
+        };
+        let once = flipped(&bands, 3, 2);
+        assert_eq!(once.lo[0], bands.lo[3], "row 0 is the last row");
+        assert_eq!(flipped(&once, 3, 2).hi, bands.hi);
+        // Object 1 is a light, seen at pixel (0, 0) of a 3 × 2 image in the
+        // correct render and at (2, 1) in the mutant's.
+        let lights = [false, true];
+        let a = [1, 0, 0, 0, 0, 0];
+        let b = [0, 0, 0, 0, 0, 1];
+        let mask = near_objects(&lights, &a, &b, 3);
+        assert_eq!(mask, [true, true, true, true, true, true]);
+        let mask = near_objects(&lights, &a, &a, 3);
+        assert_eq!(mask, [true, true, false, true, true, false]);
+    }
+
+    #[test]
+    fn encoding_mistakes_decode_as_the_grader_reads_the_file() {
+        assert_eq!(FilmMistake::NoSrgb.decoded(1.0), 1.0);
+        assert!((FilmMistake::NoSrgb.decoded(0.5) - 0.214).abs() < 1e-3);
+        // pow(1/2.2) is near the sRGB curve: read back, near the value.
+        assert!((FilmMistake::Gamma22.decoded(0.5) - 0.5).abs() < 0.02);
+        assert_eq!(FilmMistake::NoSrgb.decoded(7.0), 1.0, "clamped");
     }
 }

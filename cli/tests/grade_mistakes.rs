@@ -1,0 +1,283 @@
+//! `glint grade` names the mistake behind a failing image: the catalogue
+//! (`--mistakes`), a failing submission's `likely_mistakes` (the true one
+//! first, or "no known mistake fits" for one not in the catalogue, nothing
+//! for a pass), the table's phrase, `--no-mistakes`, and `glint explain
+//! --mistake`. The submissions are Glint's renders of edited scenes with
+//! their own seeds; measure/mistakes/diagnose.py measures the same on an
+//! independent tracer's mistakes.
+
+mod common;
+
+use common::{assert_input_error, glint, scene, stderr, stdout};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// The settings the submissions are rendered with and stated to use.
+const STATED: [&str; 8] = [
+    "--spp",
+    "4",
+    "--sampler",
+    "stratified",
+    "--light-samples",
+    "4",
+    "--light-sampler",
+    "stratified",
+];
+
+/// Set 1 with `from` replaced by `to`, written into `dir` as `name`.
+fn edited_set1(dir: &Path, name: &str, from: &str, to: &str) -> String {
+    let text = std::fs::read_to_string(scene("cornell-set1")).unwrap();
+    let changed = text.replace(from, to);
+    assert_ne!(text, changed, "{from} is in the scene");
+    let path = dir.join(name);
+    std::fs::write(&path, changed).unwrap();
+    path.to_str().unwrap().to_owned()
+}
+
+/// `scene_file` rendered at 48 × 48 with [`STATED`] and its own seed.
+fn render(dir: &Path, scene_file: &str, name: &str, seed: &str) -> PathBuf {
+    let out = dir.join(name);
+    let mut args = vec![
+        "render",
+        scene_file,
+        "--resolution",
+        "48x48",
+        "--seed",
+        seed,
+    ];
+    args.extend_from_slice(&STATED);
+    args.extend_from_slice(&["-o", out.to_str().unwrap()]);
+    let o = glint(&args, dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    out
+}
+
+/// `glint grade SET1 FILES… --format json` under [`STATED`]: each
+/// submission's JSON.
+fn graded(dir: &Path, files: &[&Path], extra: &[&str]) -> Vec<Value> {
+    let set1 = scene("cornell-set1");
+    let cache = dir.join("cache");
+    let mut args = vec!["grade", set1.as_str(), "--cache", cache.to_str().unwrap()];
+    args.extend(files.iter().map(|f| f.to_str().unwrap()));
+    args.extend_from_slice(&STATED);
+    args.extend_from_slice(&["--format", "json"]);
+    args.extend_from_slice(extra);
+    let o = glint(&args, dir);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{}", stderr(&o));
+    let document: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    document["submissions"].as_array().unwrap().clone()
+}
+
+/// The ids of the consistent mistakes, best first.
+fn consistent(submission: &Value) -> Vec<String> {
+    submission["likely_mistakes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["consistent"] == Value::Bool(true))
+        .map(|m| m["id"].as_str().unwrap().to_owned())
+        .collect()
+}
+
+/// `image` with its rows in the opposite order.
+fn flipped(image: &Path, out: &Path) -> PathBuf {
+    let decoded = image::open(image).unwrap().flipv();
+    decoded.save(out).unwrap();
+    out.to_owned()
+}
+
+#[test]
+fn the_catalogue_lists_every_classic_mistake_with_its_stage_and_how_it_is_rendered() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = glint(&["grade", "--mistakes"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    let ids = [
+        "view-sign",
+        "sphere-u-sign",
+        "no-shadow-offset",
+        "no-shadows",
+        "no-srgb",
+        "sum-light-samples",
+        "fov-horizontal",
+        "fov-not-halved",
+        "pixel-corner",
+        "normal-not-normalised",
+        "blinn",
+        "checker-double",
+        "no-ambient",
+        "flip-vertical",
+        "light-centre",
+        "ks-as-kd",
+        "light-blocks-itself",
+        "ambient-without-kd",
+        "specular-cosine",
+        "light-colour-ignored",
+        "gamma-2.2",
+        "light-invisible",
+        "two-sided-light",
+        "no-lambert-cosine",
+        "light-twice-size",
+        "fixed-light-samples",
+    ];
+    for id in ids {
+        let line = text
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(id))
+            .unwrap_or_else(|| panic!("{id} missing from:\n{text}"));
+        let stage = line.split_whitespace().nth(1).unwrap();
+        assert!(
+            [
+                "camera",
+                "intersection",
+                "texture",
+                "lighting",
+                "shading",
+                "environment",
+                "film"
+            ]
+            .contains(&stage),
+            "{line}"
+        );
+    }
+    let o = glint(&["grade", "--mistakes", "--spp", "4"], dir.path());
+    assert_eq!(o.status.code(), Some(2), "--mistakes takes nothing else");
+}
+
+#[test]
+fn a_failing_submission_is_named_by_its_mistake_and_a_pass_by_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let set1 = scene("cornell-set1");
+    let no_ambient = edited_set1(
+        d,
+        "no-ambient.toml",
+        "ambient = [0.1, 0.1, 0.1]",
+        "ambient = [0, 0, 0]",
+    );
+    let fov = edited_set1(d, "fov.toml", "fov = 45 ", "fov = 90 ");
+    let good = render(d, &set1, "good.png", "11");
+    let upside_down = flipped(
+        &render(d, &set1, "upright.png", "12"),
+        &d.join("flipped.png"),
+    );
+    let files = [
+        good,
+        render(d, &no_ambient, "no-ambient.png", "13"),
+        render(d, &fov, "fov-not-halved.png", "14"),
+        upside_down,
+        // Two mistakes: no single one fits.
+        flipped(
+            &render(d, &no_ambient, "no-ambient-2.png", "15"),
+            &d.join("both.png"),
+        ),
+    ];
+    let paths: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
+    let grades = graded(d, &paths, &[]);
+    assert_eq!(grades[0]["verdict"], "pass");
+    assert_eq!(
+        grades[0]["likely_mistakes"],
+        Value::Array(vec![]),
+        "a pass is given no mistake"
+    );
+    for (grade, id) in grades[1..].iter().zip([
+        "no-ambient",
+        "fov-not-halved",
+        "flip-vertical",
+        "no-ambient+flip-vertical",
+    ]) {
+        assert_eq!(grade["verdict"], "fail", "{grade}");
+        assert_eq!(
+            consistent(grade).first().map(String::as_str),
+            Some(id),
+            "{grade:#}"
+        );
+        let first = &grade["likely_mistakes"][0];
+        assert!(first["description"].as_str().is_some_and(|d| !d.is_empty()));
+        assert!(
+            first["stage"].is_string() && first["largest_z"].is_number(),
+            "{first}"
+        );
+    }
+
+    // The table's line ends with the finding; --no-mistakes leaves it out.
+    let cache = d.join("cache");
+    let table = |extra: &[&str]| {
+        let mut args = vec!["grade", set1.as_str(), files[1].to_str().unwrap()];
+        args.extend_from_slice(&STATED);
+        args.extend_from_slice(&["--cache", cache.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        stdout(&glint(&args, d))
+    };
+    let text = table(&[]);
+    assert!(
+        text.contains("consistent with: ambient term left out (no-ambient)"),
+        "{text}"
+    );
+    let text = table(&["--no-mistakes"]);
+    assert!(
+        !text.contains("consistent with") && text.contains("FAIL"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_mistake_outside_the_catalogue_is_not_given_a_name() {
+    // Every material's specular colour white: no mistake Glint knows.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let text = std::fs::read_to_string(scene("cornell-set1")).unwrap();
+    let white = text.replace("shininess =", "specular = [1, 1, 1]\nshininess =");
+    let path = d.join("specular-white.toml");
+    std::fs::write(&path, white).unwrap();
+    let image = render(d, path.to_str().unwrap(), "white.png", "21");
+    let grades = graded(d, &[&image], &[]);
+    assert_eq!(grades[0]["verdict"], "fail");
+    assert!(consistent(&grades[0]).is_empty(), "{:#}", grades[0]);
+    assert!(
+        !grades[0]["likely_mistakes"].as_array().unwrap().is_empty(),
+        "they were tested"
+    );
+    let set1 = scene("cornell-set1");
+    let mut args = vec!["grade", set1.as_str(), image.to_str().unwrap()];
+    args.extend_from_slice(&STATED);
+    let cache = d.join("cache");
+    args.extend_from_slice(&["--cache", cache.to_str().unwrap()]);
+    assert!(stdout(&glint(&args, d)).contains("no known mistake fits"));
+}
+
+#[test]
+fn explain_shows_a_pixel_with_a_mistake_switched_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let set1 = scene("cornell-set1");
+    let explain = |extra: &[&str]| {
+        let mut args = vec![
+            "explain",
+            set1.as_str(),
+            "--pixel",
+            "30,60",
+            "--resolution",
+            "64x64",
+        ];
+        args.extend_from_slice(&["--stage", "light"]);
+        args.extend_from_slice(extra);
+        glint(&args, dir.path())
+    };
+    let correct = stdout(&explain(&[]));
+    assert!(correct.contains("ambient·kd (0.07"), "{correct}");
+    let o = explain(&["--mistake", "no-ambient"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("ambient·kd (0.0, 0.0, 0.0)"),
+        "{}",
+        stdout(&o)
+    );
+    for (id, says) in [
+        ("no-such-mistake", "glint grade --mistakes lists them"),
+        ("no-srgb", "what the file stores"),
+        ("view-sign", "does not render it"),
+        ("light-colour-ignored", "changes nothing"),
+    ] {
+        assert_input_error(&explain(&["--mistake", id]), says);
+    }
+}

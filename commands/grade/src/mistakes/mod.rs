@@ -148,8 +148,15 @@ pub fn render_mutants(
     for mistake in CATALOGUE {
         let render = match mistake.how {
             How::Scene(_) | How::Lights(_) => {
-                let Some(edited) = edited_scene(scene, &[mistake], &context)? else {
-                    continue;
+                let edited = match edited_scene(scene, &[mistake], &context) {
+                    Ok(Some(edited)) => edited,
+                    Ok(None) => continue,
+                    // A scene the edit made invalid is one mistake fewer,
+                    // not a grade that fails.
+                    Err(e) => {
+                        progress(&format!("{}: left out: {e}", mistake.id));
+                        continue;
+                    }
                 };
                 let references = references(&edited, refs.resolution, &refs.plan, cache, progress)?;
                 MutantRender::Scene {
@@ -196,6 +203,10 @@ pub struct Against<'a> {
     pub progress: &'a (dyn Fn(&str) + Sync),
 }
 
+/// Pairs are tried only when the best single mistake's mean z² is at most
+/// this share of the correct render's.
+const PAIRING_SHARE: f64 = 0.5;
+
 /// Single mistakes tried in pairs with each other when none fits alone:
 /// the best fits (the best is also tried with every other).
 const PAIRED: usize = 4;
@@ -218,7 +229,9 @@ fn pairs(ranked: &[(usize, f64)]) -> Vec<(usize, usize)> {
 
 /// The mistakes `submission` was tested against, ranked, the consistent
 /// first: each single mistake; when none fits, each with the image upside
-/// down, then pairs ([`pairs`]; rendered, or read from the cache).
+/// down, then, where the best single mistake explains at least half of
+/// what is wrong (by mean z², [`PAIRING_SHARE`]), pairs ([`pairs`];
+/// rendered, or read from the cache).
 pub fn diagnose(
     against: &Against,
     submission: &Submission,
@@ -250,12 +263,18 @@ pub fn diagnose(
             }
         }
     }
-    if !found.iter().any(|f| f.consistent) {
-        let mut best: Vec<(usize, f64)> = (singles.iter().zip(&found))
-            .filter(|((i, _), _)| !matches!(mutants[*i].render, MutantRender::Flip))
-            .map(|((i, _), f)| (*i, f.score))
-            .collect();
-        best.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let mut best: Vec<(usize, f64)> = (singles.iter().zip(&found))
+        .filter(|((i, _), _)| !matches!(mutants[*i].render, MutantRender::Flip))
+        .map(|((i, _), f)| (*i, f.score))
+        .collect();
+    best.sort_by(|a, b| a.1.total_cmp(&b.1));
+    // Pairs are rendered: only where one mistake explains most of what is
+    // wrong, so that a second may explain the rest.
+    let unexplained = judged(&[], &correct, test).score;
+    let half_explained = best
+        .first()
+        .is_some_and(|&(_, score)| score <= PAIRING_SHARE * unexplained);
+    if !found.iter().any(|f| f.consistent) && half_explained {
         let by_index: Vec<Option<&Bands>> = (0..mutants.len())
             .map(|i| singles.iter().find(|(j, _)| *j == i).map(|(_, b)| b))
             .collect();
@@ -322,7 +341,8 @@ impl Pair<'_> {
             } => {
                 let context = context(refs, against.stated);
                 let both = [mutants[s].mistake, mutants[o].mistake];
-                let Some(both) = edited_scene(against.scene, &both, &context)? else {
+                // An edit the other made invalid: a pair fewer.
+                let Ok(Some(both)) = edited_scene(against.scene, &both, &context) else {
                     return Ok(None);
                 };
                 let both_refs = references(
@@ -381,7 +401,7 @@ fn judged(
     LikelyMistake {
         id: joined(mistakes, |m| m.id, "+"),
         description: joined(mistakes, |m| m.description, "; "),
-        stage: mistakes[0].stage.name(),
+        stage: mistakes.first().map_or("", |m| m.stage.name()),
         consistent: outcome.passed(),
         largest_z: outcome
             .findings

@@ -286,6 +286,7 @@ def grade(
     alpha: float = 0.01,
     block: Optional[int] = None,
     cache: Optional[PathLike] = None,
+    mistakes: bool = False,
     **stated: Any,
 ) -> GradeReport:
     """Grades image files or float32 ``(h, w, 3)`` arrays against ``scene``
@@ -296,7 +297,9 @@ def grade(
     ``light_sampler``), at significance ``alpha``; references are cached in
     ``cache`` where given (a scene from memory by its text and replaced
     settings, a file by its bytes). An array is graded as the lossless PFM
-    file of its values."""
+    file of its values. With ``mistakes``, a failing submission is also
+    tested against the classic mistakes, as ``glint grade`` does by default
+    (``likely_mistakes``; each mistake is rendered once and cached)."""
     import tempfile
 
     with tempfile.TemporaryDirectory(prefix="glint-grade-") as folder:
@@ -311,7 +314,7 @@ def grade(
         if not files:
             raise ValueError("give the images to grade after the scene")
         against = scene._inner if isinstance(scene, Scene) else os.fspath(scene)
-        graded = _glint.grade_json(against, files, _stated(stated), alpha, block, _path(cache))
+        graded = _glint.grade_json(against, files, _stated(stated), alpha, block, _path(cache), mistakes)
     return GradeReport(graded)
 
 
@@ -322,6 +325,7 @@ def grade_class(
     alpha: float = 0.01,
     block: Optional[int] = None,
     cache: Optional[PathLike] = None,
+    mistakes: bool = False,
     **stated: Any,
 ) -> GradeReport:
     """Grades a class as ``glint grade --class`` does: ``submissions`` is a
@@ -330,7 +334,7 @@ def grade_class(
     the scenes ``NAME.toml`` in ``scenes`` (else beside it); the rest as
     :func:`grade`."""
     graded = _glint.grade_class_json(
-        os.fspath(submissions), _path(scenes), _stated(stated), alpha, block, _path(cache)
+        os.fspath(submissions), _path(scenes), _stated(stated), alpha, block, _path(cache), mistakes
     )
     return GradeReport(graded)
 

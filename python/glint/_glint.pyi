@@ -48,6 +48,7 @@ def grade_json(
     alpha: float = 0.01,
     block: Optional[int] = None,
     cache: Optional[str] = None,
+    mistakes: bool = False,
 ) -> Tuple[str, list[Optional[npt.NDArray[np.uint8]]]]: ...
 def grade_class_json(
     submissions: str,
@@ -56,4 +57,5 @@ def grade_class_json(
     alpha: float = 0.01,
     block: Optional[int] = None,
     cache: Optional[str] = None,
+    mistakes: bool = False,
 ) -> Tuple[str, list[Optional[npt.NDArray[np.uint8]]]]: ...

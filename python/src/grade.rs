@@ -36,13 +36,17 @@ pub(crate) enum Against {
     Loaded(Box<GradeScene>),
 }
 
-/// `glint grade SCENE FILE... --format json` with the stated settings,
-/// `alpha`, `block` and reference cache folder (none without).
+/// The test's `alpha`, `block`, reference cache folder (none without) and
+/// whether failing submissions are tested against the classic mistakes.
+pub(crate) type Test = (f64, Option<u32>, Option<PathBuf>, bool);
+
+/// `glint grade SCENE FILE... --format json` with the stated settings and
+/// the [`Test`]'s.
 pub(crate) fn grade_json(
     scene: Against,
     files: Vec<PathBuf>,
     stated: Stated,
-    test: (f64, Option<u32>, Option<PathBuf>),
+    test: Test,
 ) -> PyResult<Graded> {
     let stated = stated_settings(stated)?;
     let scene = match scene {
@@ -64,7 +68,7 @@ pub(crate) fn grade_class_json(
     class: PathBuf,
     scenes: Option<PathBuf>,
     stated: Stated,
-    test: (f64, Option<u32>, Option<PathBuf>),
+    test: Test,
 ) -> PyResult<Graded> {
     let stated = stated_settings(stated)?;
     let base = class
@@ -116,7 +120,7 @@ pub(crate) struct Graded {
 fn report_json(
     entries: &[class::Entry],
     (scenes, base): (&Scenes, &Path),
-    (alpha, block, cache): (f64, Option<u32>, Option<PathBuf>),
+    (alpha, block, cache, mistakes): Test,
 ) -> PyResult<Graded> {
     if !(alpha > 0.0 && alpha < 1.0) {
         return Err(PyValueError::new_err(format!(
@@ -126,7 +130,7 @@ fn report_json(
     let options = ClassOptions {
         test: TestOptions { alpha, block },
         cache: Cache { dir: cache },
-        mistakes: true,
+        mistakes,
     };
     let graded =
         glint_grade::document::grade_with_heatmaps(entries, (scenes, base), &options, &Quiet)

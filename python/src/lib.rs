@@ -331,7 +331,8 @@ enum SceneArg<'py> {
 /// `glint grade SCENE FILE... --format json` with these settings: the
 /// document as text.
 #[pyfunction]
-#[pyo3(signature = (scene, files, stated, alpha=0.01, block=None, cache=None))]
+#[pyo3(signature = (scene, files, stated, alpha=0.01, block=None, cache=None, mistakes=false))]
+#[allow(clippy::too_many_arguments)]
 fn grade_json<'py>(
     py: Python<'py>,
     scene: SceneArg<'py>,
@@ -340,19 +341,22 @@ fn grade_json<'py>(
     alpha: f64,
     block: Option<u32>,
     cache: Option<PathBuf>,
+    mistakes: bool,
 ) -> PyResult<GradedPy<'py>> {
     let scene = match scene {
         SceneArg::File(path) => grade::Against::File(path),
         SceneArg::Loaded(scene) => grade::Against::Loaded(Box::new(scene.get().grade_scene()?)),
     };
-    let graded = py.detach(|| grade::grade_json(scene, files, stated, (alpha, block, cache)))?;
+    let test = (alpha, block, cache, mistakes);
+    let graded = py.detach(|| grade::grade_json(scene, files, stated, test))?;
     Ok(graded_py(py, graded))
 }
 
 /// `glint grade --class CLASS [--scenes DIR] --format json` with these
 /// settings: the document as text.
 #[pyfunction]
-#[pyo3(signature = (class, scenes, stated, alpha=0.01, block=None, cache=None))]
+#[pyo3(signature = (class, scenes, stated, alpha=0.01, block=None, cache=None, mistakes=false))]
+#[allow(clippy::too_many_arguments)]
 fn grade_class_json(
     py: Python<'_>,
     class: PathBuf,
@@ -361,9 +365,10 @@ fn grade_class_json(
     alpha: f64,
     block: Option<u32>,
     cache: Option<PathBuf>,
+    mistakes: bool,
 ) -> PyResult<GradedPy<'_>> {
-    let graded =
-        py.detach(|| grade::grade_class_json(class, scenes, stated, (alpha, block, cache)))?;
+    let test = (alpha, block, cache, mistakes);
+    let graded = py.detach(|| grade::grade_class_json(class, scenes, stated, test))?;
     Ok(graded_py(py, graded))
 }
 

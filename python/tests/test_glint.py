@@ -196,7 +196,11 @@ def test_ctrl_c_raises_keyboard_interrupt_promptly():
         "print('rendering', flush=True)\n"
         "scene.render()\n"
     )
-    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # As from a terminal: a shell's background job inherits SIGINT ignored,
+    # and Python then installs no KeyboardInterrupt handler.
+    default_sigint = lambda: signal.signal(signal.SIGINT, signal.SIG_DFL)
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True, preexec_fn=default_sigint)
     assert child.stdout.readline().strip() == "rendering"
     time.sleep(0.5)
     sent = time.perf_counter()

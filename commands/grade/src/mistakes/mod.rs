@@ -245,7 +245,7 @@ pub fn diagnose(
     let regions = test::regions(size.x, size.y, block, &refs.objects);
     let test = (submission, regions.as_slice(), options);
     let correct = Bands::new(submission, refs, None);
-    let lights = near_lights(against.scene, refs);
+    let lights = lights_by_object(against.scene);
     let mutants = &against.mutants.mutants;
     let singles: Vec<(usize, Bands)> = (0..mutants.len())
         .filter_map(|i| Some((i, bands(&mutants[i], &correct, refs, &lights, submission)?)))
@@ -492,9 +492,8 @@ fn flipped(bands: &Bands, width: u32, height: u32) -> Bands {
 }
 
 /// Which objects are the scene's lights, by object index.
-fn near_lights(scene: &GradeScene, refs: &References) -> Vec<bool> {
-    let objects = refs.objects.iter().copied().max().map_or(0, |m| m as usize);
-    let mut lights = vec![false; scene.description.object_names.len().max(objects)];
+fn lights_by_object(scene: &GradeScene) -> Vec<bool> {
+    let mut lights = vec![false; scene.description.object_names.len()];
     for &i in &scene.description.scene.light_objects {
         if let Some(l) = lights.get_mut(i as usize) {
             *l = true;

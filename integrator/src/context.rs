@@ -38,6 +38,9 @@ pub struct SampleContext<T: Tracer = ()> {
     pub(crate) lane_points: Vec<Vec2>,
     /// The camera-sample lanes' Sobol points, hashed up front.
     pub(crate) sobol_lanes: Vec<PointLanes>,
+    /// The mistakes the one-ray reference integrator makes (never the lanes).
+    #[cfg(any(test, feature = "mistakes"))]
+    pub(crate) mistakes: crate::mistakes::Mistakes,
 }
 
 impl SampleContext {
@@ -62,6 +65,8 @@ impl<T: Tracer> SampleContext<T> {
             sequences: SequenceCache::default(),
             lane_points: Vec::new(),
             sobol_lanes: Vec::new(),
+            #[cfg(any(test, feature = "mistakes"))]
+            mistakes: crate::mistakes::Mistakes::NONE,
         }
     }
 

@@ -30,6 +30,9 @@
 //! - [`SamplePattern`] and [`sampling`]: the sample patterns (grid, random,
 //!   stratified, Owen-scrambled Sobol) and per-pixel streams;
 //!   [`Aov`]: buffers other than radiance.
+//! - With the `mistakes` feature, `mistakes::render_with_mistakes`: the
+//!   one-ray reference integrator with classic student mistakes switched on
+//!   (`glint grade` names a failing image's mistake with it).
 //! - [`report_level()`]: the MIP level the course report chooses (section 2.8),
 //!   `log2(L/W)`, with its `L` and `W`.
 
@@ -39,8 +42,10 @@ pub mod counters;
 mod direct;
 mod explain;
 mod light_samples;
+#[cfg(any(test, feature = "mistakes"))]
+pub mod mistakes;
 mod physical;
-#[cfg(test)]
+#[cfg(any(test, feature = "mistakes"))]
 mod reference;
 mod render;
 mod report_level;

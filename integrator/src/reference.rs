@@ -12,12 +12,13 @@ mod tests;
 use crate::context::SampleContext;
 use crate::direct::wave::mirror_ray;
 use crate::direct::PairAllocation;
+use crate::mistakes::{invisible_light, mistaken_direction, mistaken_uv, Mistake, Mistakes};
 use crate::sampling::{DimensionPair, SamplePoints};
 use crate::shading_point::ShadingPoint;
 use crate::texture_lookup::texture_footprint;
 use crate::{DirectIntegrator, Scene, SurfaceKind};
 use glam::Vec3;
-use glint_geometry::{Hit, Occluders, Ray, RayDifferential, RayTarget};
+use glint_geometry::{spawn_ray, Hit, Occluders, Ray, RayDifferential, RayTarget};
 use glint_lighting::{
     AreaLight, EnvironmentSampling, Light, PhongMaterial, ShadingModel, SphereLight,
 };
@@ -54,6 +55,10 @@ impl DirectIntegrator {
         let Some(hit) = hit else {
             return self.environment_seen(scene, ray, diff, ctx);
         };
+        if invisible_light(scene, &hit, ctx.mistakes) {
+            let through = spawn_ray(&hit, ray.direction);
+            return self.li_one_ray(scene, &through, diff, depth, ctx);
+        }
         let material = match scene.surface_of(&hit) {
             SurfaceKind::Emitter(light) => return light.emitted(),
             SurfaceKind::Material(m) => m,
@@ -80,9 +85,21 @@ impl DirectIntegrator {
 
     /// The shapes that may block `point`'s shadow rays to area light `index`:
     /// every shape but its own and the light's flat surfaces
-    /// ([`ShapeList::occluders_but`](glint_geometry::ShapeList::occluders_but)).
-    fn occluders(&self, scene: &Scene, point: &ShadingPoint, index: usize) -> Occluders {
-        (scene.shapes).occluders_but([point.hit.shape, scene.light_objects[index]])
+    /// ([`ShapeList::occluders_but`](glint_geometry::ShapeList::occluders_but));
+    /// its own too, with [`Mistake::NoShadowOffset`].
+    fn occluders(
+        &self,
+        scene: &Scene,
+        point: &ShadingPoint,
+        index: usize,
+        mistakes: Mistakes,
+    ) -> Occluders {
+        let light = scene.light_objects[index];
+        let own = match mistakes.has(Mistake::NoShadowOffset) {
+            true => light,
+            false => point.hit.shape,
+        };
+        (scene.shapes).occluders_but([own, light])
     }
 
     /// The environment's radiance along a ray that hits nothing (black without one).
@@ -107,7 +124,8 @@ impl DirectIntegrator {
             ShadingModel::Phong => diff.angular_width(ray.direction),
             ShadingModel::Physical => 0.0,
         };
-        env.radiance(ray.direction.normalize(), width)
+        let direction = mistaken_direction(env, ray.direction.normalize(), ctx.mistakes);
+        env.radiance(direction, width)
     }
 
     /// The light reflected at `hit` by its material (ambient, lights and
@@ -122,11 +140,13 @@ impl DirectIntegrator {
         if at.material.uses_footprint() {
             ctx.counters.footprints += 1;
         }
-        let tc = texture_footprint(scene, at.material, (at.hit, depth), at.ray, at.diff);
+        let hit = mistaken_uv(scene, at.hit, ctx.mistakes);
+        let tc = texture_footprint(scene, at.material, (&hit, depth), at.ray, at.diff);
         if ctx.detailed {
             ctx.textures.record(at.material, &tc);
         }
-        let point = ShadingPoint::new(at.hit, at.material, at.ray, &tc);
+        let mut point = ShadingPoint::new(&hit, at.material, at.ray, &tc);
+        point.mistaken(scene, ctx.mistakes);
         match scene.shading {
             ShadingModel::Phong => self.shade(scene, &point, depth, ctx),
             ShadingModel::Physical => self.shade_physical(scene, &point, depth, ctx),
@@ -192,7 +212,10 @@ impl DirectIntegrator {
         ctx: &mut SampleContext,
         mut light_term: impl FnMut(usize, &Light, &mut PairAllocation, &mut SampleContext) -> Vec3,
     ) -> Vec3 {
-        let mut radiance = scene.ambient * point.kd;
+        let mut radiance = match ctx.mistakes.has(Mistake::AmbientWithoutKd) {
+            true => scene.ambient,
+            false => scene.ambient * point.kd,
+        };
         let mut pairs = PairAllocation::new(depth);
         for (index, light) in scene.lights.iter().enumerate() {
             radiance += light_term(index, light, &mut pairs, ctx);
@@ -246,8 +269,11 @@ impl DirectIntegrator {
         pair: DimensionPair,
         ctx: &mut SampleContext,
     ) -> Vec3 {
+        if ctx.mistakes.has(Mistake::LightBlocksItself) {
+            return Vec3::ZERO;
+        }
         let samples = self.draw_light_points(pair, ctx);
-        let occluders = self.occluders(scene, point, index);
+        let occluders = self.occluders(scene, point, index, ctx.mistakes);
         ctx.counters.light_samples += samples.len() as u64;
         let sum = point.area_light_sum(scene, light, &samples, &occluders, ctx);
         ctx.light_points = samples;
@@ -273,10 +299,20 @@ impl DirectIntegrator {
         let mut samples = std::mem::take(&mut ctx.environment_points);
         ctx.fill_points(self.environment_pattern, pair, &mut samples);
         for u in samples.iter() {
-            let s = match self.environment_sampling {
+            let mut s = match self.environment_sampling {
                 EnvironmentSampling::Luminance => env.sample(point.n, u),
                 EnvironmentSampling::Cosine => env.sample_cosine(point.n, u),
             };
+            if !ctx.mistakes.is_empty() {
+                // A mistaken map's sample: the right map's, moved by the
+                // mistake's involution, or the cosine sample's radiance
+                // read where the mistaken tracer reads it.
+                let moved = mistaken_direction(env, s.direction, ctx.mistakes);
+                match self.environment_sampling {
+                    EnvironmentSampling::Luminance => s.direction = moved,
+                    EnvironmentSampling::Cosine => s.radiance = env.radiance(moved, 0.0),
+                }
+            }
             sum += point.environment_sample(scene, &s, ctx);
         }
         ctx.environment_points = samples;
@@ -335,7 +371,7 @@ impl DirectIntegrator {
         let sampler = light.sampler(x, self.area_sampling);
         let mis = self.mis && point.has_specular;
         let samples = self.draw_light_points(pair, ctx);
-        let occluders = self.occluders(scene, point, index);
+        let occluders = self.occluders(scene, point, index, ctx.mistakes);
         let mut sum = Vec3::ZERO;
         for u in samples.iter() {
             let s = sampler.sample(u);

@@ -283,8 +283,7 @@ pub(crate) struct PixelRenderer<'a> {
     scene: &'a Scene,
     settings: &'a RenderSettings,
     integrator: &'a DirectIntegrator,
-    /// Each of spp samples stands for 1/√spp of the pixel's width (pbrt-v4
-    /// scales differentials the same way, never below 1/8).
+    /// [`footprint_scale`] at the settings' spp.
     footprint_scale: f32,
     differentials: bool,
     /// The whole of a camera sample in lanes, from its ray to its radiance.
@@ -318,7 +317,7 @@ impl<'a> PixelRenderer<'a> {
             scene,
             settings,
             integrator,
-            footprint_scale: (1.0 / (settings.spp as f32).sqrt()).max(0.125),
+            footprint_scale: footprint_scale(settings.spp),
             differentials,
             all_in_lanes: settings.aov.is_none() && !differentials,
             span: Cell::new(None),
@@ -426,10 +425,7 @@ impl<'a> PixelRenderer<'a> {
 
     /// The positions in pixel `pixel` of its camera samples, from its pattern.
     fn fill_jitters(&self, pixel: u64, out: &mut [Vec2]) {
-        let settings = self.settings;
-        let mut rng = pixel_rng(settings.seed, pixel, PIXEL_STREAM);
-        let sobol = SobolPoints::pixel_positions(settings.seed, pixel);
-        settings.pixel_pattern.fill(&mut rng, sobol, out);
+        pixel_positions(self.settings, pixel, out);
     }
 
     /// The objects the camera rays through pixels `(x0..x0 + count, y)` may
@@ -544,6 +540,21 @@ impl<'a> PixelRenderer<'a> {
             }
         }
     }
+}
+
+/// The positions in pixel `pixel` (index `y · width + x`) of its camera
+/// samples, from the settings' pixel pattern and seed.
+pub(crate) fn pixel_positions(settings: &RenderSettings, pixel: u64, out: &mut [Vec2]) {
+    let mut rng = pixel_rng(settings.seed, pixel, PIXEL_STREAM);
+    let sobol = SobolPoints::pixel_positions(settings.seed, pixel);
+    settings.pixel_pattern.fill(&mut rng, sobol, out);
+}
+
+/// The width of a camera sample's footprint in pixels at `spp` samples:
+/// each stands for `1/√spp` of the pixel (pbrt-v4 scales differentials the
+/// same way), never below 1/8.
+pub(crate) fn footprint_scale(spp: u32) -> f32 {
+    (1.0 / (spp as f32).sqrt()).max(0.125)
 }
 
 /// The whole image of `size` as a window.

@@ -129,11 +129,13 @@ impl EnvironmentLight {
         self.scale
     }
 
-    fn to_map(&self, d: Vec3) -> Vec3 {
+    /// World direction `d` in the map's frame.
+    pub fn to_map(&self, d: Vec3) -> Vec3 {
         rotate_y(d, -self.rotation)
     }
 
-    fn to_world(&self, d: Vec3) -> Vec3 {
+    /// Map-frame direction `d` in the world's frame.
+    pub fn to_world(&self, d: Vec3) -> Vec3 {
         rotate_y(d, self.rotation)
     }
 

@@ -3,12 +3,13 @@
 //! in scalar code of its own (no lanes), for every sample count.
 
 use crate::context::SampleContext;
+use crate::mistakes::Mistake;
 use crate::physical::power_heuristic;
 use crate::sampling::SamplePoints;
 use crate::shading_point::ShadingPoint;
 use crate::{Scene, ShadingCounters, Skips};
 use glam::Vec3;
-use glint_geometry::{spawn_ray, spawn_ray_to, Occluders, RayTarget};
+use glint_geometry::{spawn_ray, spawn_ray_to, Occluders, Ray, RayTarget};
 use glint_lighting::{AreaLight, EnvironmentSample, PointLight};
 
 impl ShadingPoint<'_> {
@@ -48,7 +49,13 @@ impl ShadingPoint<'_> {
         let Some(value) = self.environment_sample_unshadowed(s, ctx) else {
             return Vec3::ZERO;
         };
-        let shadow_ray = spawn_ray(self.hit, s.direction);
+        if ctx.mistakes.has(Mistake::NoShadows) {
+            return value;
+        }
+        let shadow_ray = match ctx.mistakes.has(Mistake::NoShadowOffset) {
+            true => Ray::new(self.hit.point, s.direction),
+            false => spawn_ray(self.hit, s.direction),
+        };
         match scene.shapes.any_hit(&shadow_ray, f32::INFINITY) {
             true => Vec3::ZERO,
             false => value,
@@ -82,7 +89,9 @@ impl ShadingPoint<'_> {
             ctx.counters.light_skips.below_surface += 1;
             return Vec3::ZERO;
         }
-        let reflected = if self.has_specular {
+        let reflected = if let Some(mistaken) = self.mistaken_reflection(l, ctx.mistakes) {
+            mistaken
+        } else if self.has_specular {
             ctx.counters.specular_lobes += 1;
             self.material.reflect(self.kd, self.ks, self.n, l, self.v)
         } else {
@@ -92,7 +101,13 @@ impl ShadingPoint<'_> {
             ctx.counters.light_skips.zero_brdf += 1;
             return Vec3::ZERO;
         }
-        let shadow = spawn_ray_to(self.hit, target);
+        if ctx.mistakes.has(Mistake::NoShadows) {
+            return reflected;
+        }
+        let shadow = match ctx.mistakes.has(Mistake::NoShadowOffset) {
+            true => Ray::new(self.hit.point, target.point - self.hit.point),
+            false => spawn_ray_to(self.hit, target),
+        };
         ctx.counters.light_shadow_rays += 1;
         if scene.shapes.any_hit_among(occluders, &shadow, 1.0) {
             Vec3::ZERO

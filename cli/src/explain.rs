@@ -108,16 +108,19 @@ fn with_mistake(args: &ExplainArgs, id: &str) -> Result<glint_scene::SceneDescri
             glint_grade::text::shorten(id)
         ))
     })?;
-    let (How::Scene(edit) | How::Lights(edit)) = mistake.how else {
-        return Err(Failure::Input(format!(
-            "--mistake {id}: {}; glint explain shows only mistakes Glint renders as a change to the scene (glint grade --mistakes says how each is rendered)",
-            match mistake.how {
-                How::Film(_) => "it changes what the file stores, after every stage of the pixel",
-                How::NoiseOnly => "it changes only the noise",
-                _ => "this version does not render it",
-            }
-        )));
+    let why_not = match mistake.how {
+        How::Scene(edit) | How::Lights(edit) => Ok(edit),
+        How::Film(_) => Err("it changes what the file stores, after every stage of the pixel"),
+        How::NoiseOnly => Err("it changes only the noise"),
+        How::Integrator(_) => {
+            Err("Glint renders it in its one-ray integrator, which glint explain does not trace")
+        }
     };
+    let edit = why_not.map_err(|why| {
+        Failure::Input(format!(
+            "--mistake {id}: {why}; glint explain shows only mistakes Glint renders as a change to the scene (glint grade --mistakes says how each is rendered)"
+        ))
+    })?;
     let correct = args.scene.load()?;
     let path = &args.scene().scene;
     let text = glint_scene::read_text(path, glint_scene::MAX_SCENE_BYTES, "a scene file")

@@ -9,6 +9,8 @@
 mod common;
 
 use common::{assert_input_error, glint, scene, stderr, stdout};
+use glint_integrator::mistakes::{render_with_mistakes, Mistake as Swap, Mistakes};
+use glint_integrator::SamplePattern;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -119,6 +121,11 @@ fn the_catalogue_lists_every_classic_mistake_with_its_stage_and_how_it_is_render
         "no-lambert-cosine",
         "light-twice-size",
         "fixed-light-samples",
+        "uv-swapped",
+        "nearest-texel",
+        "mip-level-ln",
+        "cube-face-swapped",
+        "cube-face-mirrored",
     ];
     for id in ids {
         let line = text
@@ -138,6 +145,13 @@ fn the_catalogue_lists_every_classic_mistake_with_its_stage_and_how_it_is_render
             ]
             .contains(&stage),
             "{line}"
+        );
+    }
+    for line in text.lines() {
+        let how = line.split_whitespace().nth(2).unwrap_or_default();
+        assert!(
+            ["scene", "lights", "integrator", "film", "noise"].contains(&how),
+            "every mistake is rendered (or changes only the noise): {line}"
         );
     }
     let o = glint(&["grade", "--mistakes", "--spp", "4"], dir.path());
@@ -221,6 +235,85 @@ fn a_failing_submission_is_named_by_its_mistake_and_a_pass_by_none() {
     );
 }
 
+/// `scene_file` rendered at 48 × 48 under [`STATED`] with seed `seed` by
+/// the one-ray integrator with `mistakes` switched on, written to `name`.
+fn render_mistaken(
+    dir: &Path,
+    scene_file: &str,
+    mistakes: Mistakes,
+    name: &str,
+    seed: u64,
+) -> PathBuf {
+    let mut scene = glint_scene::load(Path::new(scene_file)).unwrap();
+    let size = glam::UVec2::new(48, 48);
+    scene.scene.camera = scene.scene.camera.with_resolution(size).unwrap();
+    let settings = glint_integrator::RenderSettings {
+        spp: 4,
+        pixel_pattern: SamplePattern::Stratified,
+        light_samples: 4,
+        light_pattern: SamplePattern::Stratified,
+        seed,
+        ..scene.settings
+    };
+    let film = render_with_mistakes(&scene.scene, &settings, mistakes).unwrap();
+    let out = dir.join(name);
+    film.save(&out).unwrap();
+    out
+}
+
+/// Mistakes Glint renders in its one-ray integrator, made by it with
+/// other seeds: each named first, alone and with a scene edit.
+#[test]
+fn a_stage_swapped_in_the_integrator_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let set1 = scene("cornell-set1");
+    let cases = [
+        (Swap::NoShadows, "no-shadows"),
+        (Swap::LightInvisible, "light-invisible"),
+        (Swap::ViewSign, "view-sign"),
+        (Swap::AmbientWithoutKd, "ambient-without-kd"),
+        (Swap::LightBlocksItself, "light-blocks-itself"),
+    ];
+    let one = |swap| Mistakes::NONE.with(swap);
+    let mut files: Vec<PathBuf> = (cases.iter().enumerate())
+        .map(|(i, &(swap, id))| {
+            render_mistaken(d, &set1, one(swap), &format!("{id}.png"), 31 + i as u64)
+        })
+        .collect();
+    // A pair: no shadows in a tracer that also leaves out the ambient term.
+    let no_ambient = edited_set1(
+        d,
+        "no-ambient.toml",
+        "ambient = [0.1, 0.1, 0.1]",
+        "ambient = [0, 0, 0]",
+    );
+    files.push(render_mistaken(
+        d,
+        &no_ambient,
+        one(Swap::NoShadows),
+        "both.png",
+        41,
+    ));
+    let paths: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
+    let grades = graded(d, &paths, &[]);
+    let ids = cases
+        .iter()
+        .map(|(_, id)| *id)
+        .chain(["no-shadows+no-ambient"]);
+    for (grade, id) in grades.iter().zip(ids) {
+        assert_eq!(grade["verdict"], "fail", "{id}: {grade}");
+        let named = consistent(grade);
+        let first = named.first().map(String::as_str);
+        // A pair is named in either order.
+        let reversed = id.split('+').rev().collect::<Vec<_>>().join("+");
+        assert!(
+            first == Some(id) || first == Some(&reversed),
+            "{id}: {grade:#}"
+        );
+    }
+}
+
 #[test]
 fn a_mistake_outside_the_catalogue_is_not_given_a_name() {
     // Every material's specular colour white: no mistake Glint knows.
@@ -275,7 +368,7 @@ fn explain_shows_a_pixel_with_a_mistake_switched_on() {
     for (id, says) in [
         ("no-such-mistake", "glint grade --mistakes lists them"),
         ("no-srgb", "what the file stores"),
-        ("view-sign", "does not render it"),
+        ("view-sign", "one-ray integrator"),
         ("light-colour-ignored", "changes nothing"),
     ] {
         assert_input_error(&explain(&["--mistake", id]), says);

@@ -17,8 +17,8 @@ use crate::{DirectIntegrator, Scene, ShadingModel, SurfaceKind};
 use glam::{Vec2, Vec3};
 use glint_camera::Film;
 use glint_geometry::{Hit, ObjectRef, Ray, RayDifferential, Shape};
-use glint_lighting::{EnvironmentLight, Light};
-use glint_texture::Environment;
+use glint_lighting::{EnvironmentLight, Light, PhongMaterial};
+use glint_texture::{Environment, TexCoord};
 use rayon::prelude::*;
 
 /// One mistake the reference integrator can make.
@@ -38,6 +38,9 @@ pub enum Mistake {
     SphereUSign,
     /// `u` and `v` swapped before every texture lookup.
     UvSwapped,
+    /// The trilinear MIP level `ln(w·m)` for `log2(w·m)` (footprint `w`,
+    /// texture side `m`): `ln 2` times the right level, too sharp.
+    MipLevelLn,
     /// `ambient` for `ambient · kd`.
     AmbientWithoutKd,
     /// Every light sample counts as visible.
@@ -59,6 +62,25 @@ pub enum Mistake {
 }
 
 impl Mistake {
+    /// Every mistake, in the order of its bit.
+    pub const ALL: [Mistake; 15] = [
+        Mistake::PixelCorner,
+        Mistake::NoShadowOffset,
+        Mistake::NormalNotNormalised,
+        Mistake::SphereUSign,
+        Mistake::UvSwapped,
+        Mistake::MipLevelLn,
+        Mistake::AmbientWithoutKd,
+        Mistake::NoShadows,
+        Mistake::LightBlocksItself,
+        Mistake::LightInvisible,
+        Mistake::ViewSign,
+        Mistake::SpecularCosine,
+        Mistake::NoLambertCosine,
+        Mistake::CubeFaceSwapped,
+        Mistake::CubeFaceMirrored,
+    ];
+
     fn bit(self) -> u32 {
         1 << self as u32
     }
@@ -85,6 +107,7 @@ impl Mistake {
             NormalNotNormalised => spheres(),
             SphereUSign => spheres() && scene.materials.iter().any(|m| m.reads_uv()),
             UvSwapped => scene.materials.iter().any(|m| m.reads_uv()),
+            MipLevelLn => scene.materials.iter().any(|m| m.uses_footprint()),
             AmbientWithoutKd => scene.ambient != Vec3::ZERO,
             LightBlocksItself | LightInvisible => area_lights(),
             ViewSign | SpecularCosine | NoLambertCosine => true,
@@ -94,8 +117,17 @@ impl Mistake {
 }
 
 /// A set of [`Mistake`]s.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Default, PartialEq, Eq, Hash)]
 pub struct Mistakes(u32);
+
+impl std::fmt::Debug for Mistakes {
+    /// The mistakes by name (`[NoShadows, ViewSign]`): what `glint grade`'s
+    /// reference cache keys hash.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let each = Mistake::ALL.into_iter().filter(|&m| self.has(m));
+        f.debug_list().entries(each).finish()
+    }
+}
 
 impl Mistakes {
     /// No mistake: the reference integrator as it is.
@@ -111,6 +143,10 @@ impl Mistakes {
 
     pub fn is_empty(self) -> bool {
         self.0 == 0
+    }
+
+    pub fn union(self, other: Mistakes) -> Mistakes {
+        Mistakes(self.0 | other.0)
     }
 
     /// Whether any of them changes a shading point's reflection of a light.
@@ -215,6 +251,27 @@ pub(crate) fn mistaken_uv(scene: &Scene, hit: &Hit, mistakes: Mistakes) -> Hit {
         (hit.dndu, hit.dndv) = (hit.dndv, hit.dndu);
     }
     hit
+}
+
+/// The texture lookup `tc` of `material` as a tracer that takes the MIP
+/// level from the natural logarithm makes it: the footprint shrunk by
+/// `2^(L·(ln 2 − 1))` so that the right level `L` of its diffuse texture
+/// becomes `L·ln 2` (the last level standing for any past it).
+pub(crate) fn mistaken_footprint(
+    material: &PhongMaterial,
+    tc: TexCoord,
+    mistakes: Mistakes,
+) -> TexCoord {
+    if !mistakes.has(Mistake::MipLevelLn) {
+        return tc;
+    }
+    let level = material.diffuse_mip_level(&tc);
+    let shrink = (level * (std::f32::consts::LN_2 - 1.0)).exp2();
+    TexCoord {
+        duvdx: tc.duvdx * shrink,
+        duvdy: tc.duvdy * shrink,
+        ..tc
+    }
 }
 
 /// The radius of the sphere `hit` is on, if it is on one.
@@ -395,23 +452,6 @@ mod tests {
         }
     }
 
-    const EVERY: [Mistake; 14] = [
-        Mistake::PixelCorner,
-        Mistake::NoShadowOffset,
-        Mistake::NormalNotNormalised,
-        Mistake::SphereUSign,
-        Mistake::UvSwapped,
-        Mistake::AmbientWithoutKd,
-        Mistake::NoShadows,
-        Mistake::LightBlocksItself,
-        Mistake::LightInvisible,
-        Mistake::ViewSign,
-        Mistake::SpecularCosine,
-        Mistake::NoLambertCosine,
-        Mistake::CubeFaceSwapped,
-        Mistake::CubeFaceMirrored,
-    ];
-
     /// Each mistake that applies changes the image, the same way for any
     /// thread count; light lost to a blocker never comes back and light
     /// that no shadow ray stops is never less.
@@ -421,13 +461,15 @@ mod tests {
         let settings = settings(4, SamplePattern::Stratified, 4);
         let right = render_with_mistakes(&scene, &settings, Mistakes::NONE).unwrap();
         let (right, mut applied) = (right.pixels(), 0);
-        for mistake in EVERY {
+        for mistake in Mistake::ALL {
             let cube = matches!(
                 mistake,
                 Mistake::CubeFaceSwapped | Mistake::CubeFaceMirrored
             );
-            assert_eq!(mistake.applies_to(&scene), !cube, "{mistake:?}");
-            if cube {
+            // The checkerboards are read at points: no footprint, no level.
+            let unread = cube || mistake == Mistake::MipLevelLn;
+            assert_eq!(mistake.applies_to(&scene), !unread, "{mistake:?}");
+            if unread {
                 continue;
             }
             applied += 1;

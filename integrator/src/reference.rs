@@ -12,7 +12,9 @@ mod tests;
 use crate::context::SampleContext;
 use crate::direct::wave::mirror_ray;
 use crate::direct::PairAllocation;
-use crate::mistakes::{invisible_light, mistaken_direction, mistaken_uv, Mistake, Mistakes};
+use crate::mistakes::{
+    invisible_light, mistaken_direction, mistaken_footprint, mistaken_uv, Mistake, Mistakes,
+};
 use crate::sampling::{DimensionPair, SamplePoints};
 use crate::shading_point::ShadingPoint;
 use crate::texture_lookup::texture_footprint;
@@ -142,6 +144,7 @@ impl DirectIntegrator {
         }
         let hit = mistaken_uv(scene, at.hit, ctx.mistakes);
         let tc = texture_footprint(scene, at.material, (&hit, depth), at.ray, at.diff);
+        let tc = mistaken_footprint(at.material, tc, ctx.mistakes);
         if ctx.detailed {
             ctx.textures.record(at.material, &tc);
         }

@@ -12,6 +12,7 @@ use crate::jpeg::{DcRounding, JpegEncoding};
 use crate::GradeError;
 use glam::{UVec2, Vec3};
 use glint_bench::reference::{cache_key, round_seed, CachePaths, Origin, RoundSums};
+use glint_integrator::mistakes::{render_with_mistakes, Mistakes};
 use glint_integrator::RenderSettings;
 use glint_scene::SceneDescription;
 use std::path::{Path, PathBuf};
@@ -33,6 +34,9 @@ pub struct GradeScene {
     /// A scene from memory: the BLAKE3 hash of its text, hashed by the
     /// cache's key in place of a scene file.
     pub text_hash: Option<String>,
+    /// The mistakes its references are rendered with (by the one-ray
+    /// integrator; none for the correct references).
+    pub mistakes: Mistakes,
 }
 
 impl GradeScene {
@@ -46,6 +50,7 @@ impl GradeScene {
             inputs: description.assets.clone(),
             text_hash: Some(blake3::hash(text.as_bytes()).to_hex().to_string()),
             description,
+            mistakes: Mistakes::NONE,
         }
     }
 
@@ -65,6 +70,19 @@ impl GradeScene {
             description,
             inputs,
             text_hash: None,
+            mistakes: Mistakes::NONE,
+        }
+    }
+
+    /// The scene rendered by the one-ray integrator with `mistakes` (on top
+    /// of its own), named `name`.
+    pub fn with_mistakes(&self, name: &str, mistakes: Mistakes) -> GradeScene {
+        GradeScene {
+            path: PathBuf::from(name),
+            description: self.description.clone(),
+            inputs: self.inputs.clone(),
+            text_hash: self.text_hash.clone(),
+            mistakes: mistakes.union(self.mistakes),
         }
     }
 
@@ -382,8 +400,12 @@ impl Job<'_> {
                 Some(hash) => format!(", scene text {hash}"),
                 None => String::new(),
             };
+            let mistakes = match self.scene.mistakes.is_empty() {
+                true => String::new(),
+                false => format!(", one-ray integrator with {:?}", self.scene.mistakes),
+            };
             format!(
-                "glint-grade {name} reference{tag}, transform {k} of {K}, rounds={rounds}{text} {}",
+                "glint-grade {name} reference{tag}, transform {k} of {K}, rounds={rounds}{text}{mistakes} {}",
                 glint_bench::reference::settings_fingerprint(settings, w, h)
             )
         };
@@ -430,11 +452,10 @@ impl Job<'_> {
             ));
             let mut round_settings = settings.clone();
             round_settings.seed = round_seed(seed_of(name), round);
-            let output = glint_integrator::render(self.rendered, &round_settings, &|_, _| {})
-                .map_err(|e| GradeError::Internal(format!("reference render: {e}")))?;
+            let film = self.render(&round_settings)?;
             for (sum, transform) in sums.iter_mut().zip(transforms) {
                 buffer.clear();
-                transform(output.film.pixels(), &mut buffer).map_err(GradeError::Internal)?;
+                transform(film.pixels(), &mut buffer).map_err(GradeError::Internal)?;
                 sum.add(&buffer);
             }
         }
@@ -462,6 +483,17 @@ impl Job<'_> {
             });
         }
         Ok(estimates.try_into().expect("K estimates"))
+    }
+
+    /// One round's film: the render's, or the one-ray integrator's with
+    /// the scene's mistakes.
+    fn render(&self, settings: &RenderSettings) -> Result<glint_camera::Film, GradeError> {
+        let mistakes = self.scene.mistakes;
+        match mistakes.is_empty() {
+            true => glint_integrator::render(self.rendered, settings, &|_, _| {}).map(|o| o.film),
+            false => render_with_mistakes(self.rendered, settings, mistakes),
+        }
+        .map_err(|e| GradeError::Internal(format!("reference render: {e}")))
     }
 }
 

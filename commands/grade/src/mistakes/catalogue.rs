@@ -1,9 +1,10 @@
 //! The classic mistakes, each with the stage it belongs to and how Glint
-//! renders it: a change to the scene (rendered as any scene is), a change to
-//! what the file stores (applied to the references), or not rendered by this
-//! version.
+//! renders it: a change to the scene (rendered as any scene is), a stage
+//! swapped in the one-ray reference integrator, or a change to what the
+//! file stores (applied to the references).
 
 use super::edit;
+use glint_integrator::mistakes::Mistake as Swap;
 use serde::Serialize;
 
 /// A classic mistake of a student's ray tracer.
@@ -54,11 +55,11 @@ pub enum How {
     /// light reaches surfaces: rendered as [`How::Scene`], with the pixels
     /// that see a light (and their neighbours) kept from the correct render.
     Lights(edit::Edit),
+    /// A stage swapped for the wrong one in the one-ray reference
+    /// integrator ([`glint_integrator::mistakes`]), which renders it.
+    Integrator(Swap),
     /// What the file stores, changed after rendering.
     Film(FilmMistake),
-    /// A stage swapped inside the integrator, which this version does not
-    /// render.
-    NotRendered,
     /// The expected image stays as it is, only the noise changes: no test
     /// of the mean can tell it.
     NoiseOnly,
@@ -73,13 +74,21 @@ impl How {
         }
     }
 
+    /// The stage the one-ray integrator swaps, for a mistake it renders.
+    pub fn swap(&self) -> Option<Swap> {
+        match self {
+            How::Integrator(swap) => Some(*swap),
+            _ => None,
+        }
+    }
+
     /// The word `glint grade --mistakes` shows for it.
     pub fn rendered_as(&self) -> &'static str {
         match self {
             How::Scene(_) => "scene",
             How::Lights(_) => "lights",
+            How::Integrator(_) => "integrator",
             How::Film(_) => "film",
-            How::NotRendered => "not rendered",
             How::NoiseOnly => "noise only",
         }
     }
@@ -118,7 +127,7 @@ const fn mistake(id: &'static str, stage: Stage, how: How, description: &'static
     }
 }
 
-use How::{Film, Lights, NoiseOnly, NotRendered, Scene};
+use How::{Film, Integrator, Lights, NoiseOnly, Scene};
 use Stage::{Camera, Environment, Intersection, Lighting, Shading, Texture};
 
 /// Every mistake Glint knows, in the order `glint grade --mistakes` lists
@@ -129,29 +138,29 @@ pub const CATALOGUE: &[Mistake] = &[
         "fov taken as the horizontal field of view (nothing changes on a square image)"),
     mistake("fov-not-halved", Camera, Scene(edit::fov_not_halved),
         "film half height f·tan(fov) instead of f·tan(fov/2): zoomed out"),
-    mistake("pixel-corner", Camera, NotRendered,
+    mistake("pixel-corner", Camera, Integrator(Swap::PixelCorner),
         "rays through the pixels' corners (no +0.5)"),
-    mistake("no-shadow-offset", Intersection, NotRendered,
+    mistake("no-shadow-offset", Intersection, Integrator(Swap::NoShadowOffset),
         "shadow rays start exactly at the hit point: shadow acne"),
-    mistake("normal-not-normalised", Intersection, NotRendered,
+    mistake("normal-not-normalised", Intersection, Integrator(Swap::NormalNotNormalised),
         "sphere normal p − c not divided by the radius"),
-    mistake("sphere-u-sign", Texture, NotRendered,
+    mistake("sphere-u-sign", Texture, Integrator(Swap::SphereUSign),
         "sphere u angle with the wrong sign (atan2(z, x) for atan2(−z, x))"),
     mistake("checker-double", Texture, Scene(edit::checker_double),
         "checkerboard frequency doubled (2N × 2N checks)"),
-    mistake("uv-swapped", Texture, NotRendered,
+    mistake("uv-swapped", Texture, Integrator(Swap::UvSwapped),
         "u and v swapped in the texture lookup"),
-    mistake("nearest-texel", Texture, NotRendered,
-        "the nearest texel instead of bilinear filtering"),
-    mistake("mip-level-ln", Texture, NotRendered,
+    mistake("nearest-texel", Texture, Scene(edit::nearest_texel),
+        "the nearest texel instead of a filtered lookup (bilinear, MIP-mapped)"),
+    mistake("mip-level-ln", Texture, Integrator(Swap::MipLevelLn),
         "the MIP level from the natural logarithm of the footprint instead of log2"),
     mistake("no-ambient", Lighting, Scene(edit::no_ambient),
         "ambient term left out"),
-    mistake("ambient-without-kd", Lighting, NotRendered,
+    mistake("ambient-without-kd", Lighting, Integrator(Swap::AmbientWithoutKd),
         "the ambient colour alone, not ambient·kd"),
-    mistake("no-shadows", Lighting, NotRendered,
+    mistake("no-shadows", Lighting, Integrator(Swap::NoShadows),
         "no shadow rays: every light sample counts as visible"),
-    mistake("light-blocks-itself", Lighting, NotRendered,
+    mistake("light-blocks-itself", Lighting, Integrator(Swap::LightBlocksItself),
         "shadow rays count the light's own surface as a blocker"),
     mistake("sum-light-samples", Lighting, Lights(edit::sum_light_samples),
         "light samples summed, not averaged"),
@@ -161,26 +170,26 @@ pub const CATALOGUE: &[Mistake] = &[
         "light samples over centre ± edge instead of centre ± edge/2"),
     mistake("light-colour-ignored", Lighting, Lights(edit::light_colour_ignored),
         "the lights' colour left out of the light term (white lights)"),
-    mistake("light-invisible", Lighting, NotRendered,
+    mistake("light-invisible", Lighting, Integrator(Swap::LightInvisible),
         "camera rays do not see area lights"),
     mistake("two-sided-light", Lighting, Scene(edit::two_sided_light),
         "area lights emit from both sides"),
     mistake("fixed-light-samples", Lighting, NoiseOnly,
         "the same light samples for every camera sample"),
-    mistake("view-sign", Shading, NotRendered,
+    mistake("view-sign", Shading, Integrator(Swap::ViewSign),
         "view vector with its sign flipped in the specular term"),
     mistake("blinn", Shading, Scene(edit::blinn),
         "the half vector (Blinn–Phong n·h) instead of the reflection vector, same exponent"),
     mistake("ks-as-kd", Shading, Scene(edit::ks_as_kd),
         "the diffuse colour kd used as the specular colour ks"),
-    mistake("specular-cosine", Shading, NotRendered,
+    mistake("specular-cosine", Shading, Integrator(Swap::SpecularCosine),
         "the specular term multiplied by n·l too"),
-    mistake("no-lambert-cosine", Shading, NotRendered,
+    mistake("no-lambert-cosine", Shading, Integrator(Swap::NoLambertCosine),
         "the diffuse term without n·l"),
-    mistake("cube-face-swapped", Environment, NotRendered,
-        "two faces of the cube map swapped"),
-    mistake("cube-face-mirrored", Environment, NotRendered,
-        "the cube map's faces read mirrored"),
+    mistake("cube-face-swapped", Environment, Integrator(Swap::CubeFaceSwapped),
+        "the cube map's +z and −z faces swapped"),
+    mistake("cube-face-mirrored", Environment, Integrator(Swap::CubeFaceMirrored),
+        "every cube-map face read mirrored left to right"),
     mistake("no-srgb", Stage::Film, Film(FilmMistake::NoSrgb),
         "linear values written to an 8-bit file without the sRGB curve"),
     mistake("gamma-2.2", Stage::Film, Film(FilmMistake::Gamma22),

@@ -112,6 +112,23 @@ pub fn checker_double(scene: &mut Table, _: &Context) -> bool {
     changed
 }
 
+/// Every image texture (and checkerboard image) read at its nearest texel.
+pub fn nearest_texel(scene: &mut Table, _: &Context) -> bool {
+    let mut changed = false;
+    for texture in tables_in(scene, "textures") {
+        for kind in ["image", "checker_image"] {
+            let Some(image) = texture.get_mut(kind).and_then(Value::as_table_mut) else {
+                continue;
+            };
+            if image.get("filter").and_then(Value::as_str) != Some("nearest") {
+                image.insert("filter".into(), Value::String("nearest".into()));
+                changed = true;
+            }
+        }
+    }
+    changed
+}
+
 /// Each area light's `color` times the light samples: their sum, not their
 /// mean (nothing changes at one sample).
 pub fn sum_light_samples(scene: &mut Table, context: &Context) -> bool {

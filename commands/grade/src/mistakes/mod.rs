@@ -29,6 +29,7 @@ use crate::test::{self, Bands, NoiseFit, Region, TestOptions};
 use crate::{Cache, GradeError, References, StatedSettings, Submission};
 use glam::Vec3;
 use glint_camera::SampleEncoding;
+use glint_integrator::mistakes::{Mistake as Swap, Mistakes};
 use serde::Serialize;
 
 /// A mistake as a finding about one submission.
@@ -101,22 +102,61 @@ pub fn edited_text(
     toml::to_string(&table).map(Some).map_err(|e| e.to_string())
 }
 
-/// `scene` with the edits of `mistakes` applied to its file, or `None` when
-/// one changes nothing (or the scene has no file to edit: it came from
-/// memory).
+/// `scene` with `mistakes` in it: the edits of those that are scene edits
+/// applied to its file, those the one-ray integrator makes switched on in
+/// it; or `None` when one changes nothing, is neither, or is an edit of a
+/// scene with no file to edit (it came from memory).
 pub fn edited_scene(
     scene: &GradeScene,
     mistakes: &[&Mistake],
     context: &edit::Context,
 ) -> Result<Option<GradeScene>, GradeError> {
     let edits: Vec<edit::Edit> = mistakes.iter().filter_map(|m| m.how.edit()).collect();
-    if scene.text_hash.is_some() || edits.len() != mistakes.len() {
+    let swaps: Vec<Swap> = mistakes.iter().filter_map(|m| m.how.swap()).collect();
+    if edits.len() + swaps.len() != mistakes.len() {
+        return Ok(None);
+    }
+    let Some(edited) = scene_edited(scene, mistakes, &edits, context)? else {
+        return Ok(None);
+    };
+    if swaps.is_empty() {
+        return Ok(Some(edited));
+    }
+    let rendered = &edited.description.scene;
+    if !swaps.iter().all(|s| s.applies_to(rendered)) {
+        return Ok(None);
+    }
+    let name = format!(
+        "{} with {}",
+        scene.path.display(),
+        joined(mistakes, |m| m.id, "+")
+    );
+    Ok(Some(
+        edited.with_mistakes(&name, swaps.into_iter().collect()),
+    ))
+}
+
+/// `scene` with `edits` (those of `mistakes`) applied to its file: a new
+/// scene, or the same (`None` when an edit changes nothing, or there are
+/// edits and no file).
+fn scene_edited(
+    scene: &GradeScene,
+    mistakes: &[&Mistake],
+    edits: &[edit::Edit],
+    context: &edit::Context,
+) -> Result<Option<GradeScene>, GradeError> {
+    if edits.is_empty() {
+        return Ok(Some(
+            scene.with_mistakes(&scene.path.to_string_lossy(), Mistakes::NONE),
+        ));
+    }
+    if scene.text_hash.is_some() {
         return Ok(None);
     }
     let path = &scene.path;
     let text = std::fs::read_to_string(path)
         .map_err(|e| GradeError::Input(format!("{}: {e}", path.display())))?;
-    let Some(edited) = edited_text(&text, &edits, context)
+    let Some(edited) = edited_text(&text, edits, context)
         .map_err(|e| GradeError::Input(format!("{}: {e}", path.display())))?
     else {
         return Ok(None);
@@ -147,7 +187,7 @@ pub fn render_mutants(
     let mut mutants = Vec::new();
     for mistake in CATALOGUE {
         let render = match mistake.how {
-            How::Scene(_) | How::Lights(_) => {
+            How::Scene(_) | How::Lights(_) | How::Integrator(_) => {
                 let edited = match edited_scene(scene, &[mistake], &context) {
                     Ok(Some(edited)) => edited,
                     Ok(None) => continue,
@@ -170,7 +210,7 @@ pub fn render_mutants(
                 mistake: film,
                 samples: through_film(scene, refs, film, mistake.id, cache, progress)?,
             },
-            How::NotRendered | How::NoiseOnly => continue,
+            How::NoiseOnly => continue,
         };
         mutants.push(Mutant { mistake, render });
     }

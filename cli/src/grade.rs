@@ -279,8 +279,19 @@ fn grade_or_merge(args: &GradeArgs) -> Result<(), Failure> {
         }
         Ok(())
     };
-    let grades = class::grade_class(&entries, &scenes, &base, &options, &bar, &on_graded)
-        .map_err(failure)?;
+    let on_diagnosed = |i: usize, fit: &[glam::Vec3], size: glam::UVec2| match report {
+        Some(dir) => {
+            let index = part.map_or(i, |p| p.submission(i));
+            glint_grade::html::write_fit_image(dir, index, size, fit)
+        }
+        None => Ok(()),
+    };
+    let hooks = class::Hooks {
+        on_graded: &on_graded,
+        on_diagnosed: &on_diagnosed,
+    };
+    let grades =
+        class::grade_class(&entries, &scenes, &base, &options, &bar, hooks).map_err(failure)?;
     bar.finish();
     if let Some(part) = part {
         let staging = staging.expect("--part requires --report");

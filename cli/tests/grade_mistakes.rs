@@ -233,6 +233,36 @@ fn a_failing_submission_is_named_by_its_mistake_and_a_pass_by_none() {
         !text.contains("consistent with") && text.contains("FAIL"),
         "{text}"
     );
+
+    // The report shows Glint's render of the best fit beside the
+    // submission: nearer it than the correct reference is.
+    let report = d.join("report");
+    table(&["--report", report.to_str().unwrap()]);
+    let page = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert!(
+        page.contains("images/0-mistake-small.png") && page.contains("mistake, no-ambient"),
+        "{page}"
+    );
+    let pixels = |name: &str| {
+        image::open(report.join("images").join(name))
+            .unwrap()
+            .to_rgb8()
+    };
+    let (fit, submitted) = (pixels("0-mistake.png"), pixels("0-submission.png"));
+    let reference = pixels("reference-0.png");
+    let distance = |a: &image::RgbImage| -> f64 {
+        let pairs = a.as_raw().iter().zip(submitted.as_raw());
+        pairs
+            .map(|(&x, &y)| (x as f64 - y as f64).abs())
+            .sum::<f64>()
+            / a.len() as f64
+    };
+    assert!(
+        distance(&fit) < distance(&reference) / 2.0,
+        "fit {} against reference {}",
+        distance(&fit),
+        distance(&reference)
+    );
 }
 
 /// `scene_file` rendered at 48 × 48 under [`STATED`] with seed `seed` by

@@ -344,6 +344,18 @@ pub trait Progress: Sync {
 pub type OnGraded<'a> =
     dyn Fn(usize, &Row, &Submission, &Group) -> Result<(), GradeError> + Sync + 'a;
 
+/// Called with each failing submission a mistake fits (by its row index),
+/// with Glint's render of the best fit as the submission would store it
+/// ([`mistakes::fit_image`]), from worker threads.
+pub type OnDiagnosed<'a> =
+    dyn Fn(usize, &[glam::Vec3], glam::UVec2) -> Result<(), GradeError> + Sync + 'a;
+
+/// What is done with each submission's images as the class is graded.
+pub struct Hooks<'a> {
+    pub on_graded: &'a OnGraded<'a>,
+    pub on_diagnosed: &'a OnDiagnosed<'a>,
+}
+
 /// Grades every entry; scenes are looked up in `scenes` (relative to `base`),
 /// whose presets fill the settings an entry leaves unknown.
 pub fn grade_class(
@@ -352,8 +364,9 @@ pub fn grade_class(
     base: &Path,
     options: &ClassOptions,
     progress: &dyn Progress,
-    on_graded: &OnGraded,
+    hooks: Hooks,
 ) -> Result<ClassGrades, GradeError> {
+    let on_graded = hooks.on_graded;
     let Prepared {
         entries,
         probes,
@@ -374,7 +387,7 @@ pub fn grade_class(
         .collect::<Result<_, GradeError>>()?;
     let mut rows = rows;
     if options.mistakes {
-        diagnose_failures(&mut rows, &groups, options, progress)?;
+        diagnose_failures(&mut rows, &groups, options, progress, hooks.on_diagnosed)?;
     }
     Ok(ClassGrades { rows, groups })
 }
@@ -386,6 +399,7 @@ fn diagnose_failures(
     groups: &[Group],
     options: &ClassOptions,
     progress: &dyn Progress,
+    on_diagnosed: &OnDiagnosed,
 ) -> Result<(), GradeError> {
     for (g, group) in groups.iter().enumerate() {
         let failing: Vec<usize> = (0..rows.len())
@@ -415,7 +429,13 @@ fn diagnose_failures(
             .map(|&i| match Submission::load(Path::new(&rows[i].file)) {
                 // A JPEG's mutants would go through its encoding: not yet.
                 Ok(s) if s.jpeg.is_none() && s.resolution() == group.references.resolution => {
-                    mistakes::diagnose(&against, &s, &options.test)
+                    let found = mistakes::diagnose(&against, &s, &options.test)?;
+                    if let Some(best) = found.first().filter(|m| m.consistent) {
+                        if let Some(image) = mistakes::fit_image(&against, &s, &best.id)? {
+                            on_diagnosed(i, &image, s.resolution())?;
+                        }
+                    }
+                    Ok(found)
                 }
                 _ => Ok(Vec::new()),
             })

@@ -42,7 +42,11 @@ pub fn grade_with_heatmaps(
         }
         Ok(())
     };
-    let grades = class::grade_class(entries, scenes, base, options, progress, &keep)?;
+    let hooks = class::Hooks {
+        on_graded: &keep,
+        on_diagnosed: &|_, _, _| Ok(()),
+    };
+    let grades = class::grade_class(entries, scenes, base, options, progress, hooks)?;
     let rows = crate::report::rows(&grades);
     Ok(Graded {
         document: crate::report::json(&rows),

@@ -105,6 +105,26 @@ pub fn write_images(
     Ok(())
 }
 
+/// Writes Glint's render of the mistake that best fits submission `index`
+/// (linear pixels of `size`), full size and thumbnail.
+pub fn write_fit_image(
+    dir: &Path,
+    index: usize,
+    size: UVec2,
+    pixels: &[Vec3],
+) -> Result<(), GradeError> {
+    let images = images_dir(dir);
+    std::fs::create_dir_all(&images).map_err(|e| internal(&images)(e.to_string()))?;
+    let [fit, _] = fit_images(index);
+    save_with_thumbnail(&images.join(fit), size, srgb8(pixels))
+}
+
+/// The image of the best-fitting mistake of submission `index` in a
+/// report's `images/`, and its thumbnail.
+pub fn fit_images(index: usize) -> [String; 2] {
+    ["mistake", "mistake-small"].map(|k| format!("{index}-{k}.png"))
+}
+
 /// The images of submission `index` in a report's `images/`: the
 /// submission and its heat map, each with its thumbnail.
 pub fn submission_images(index: usize) -> [String; 4] {
@@ -194,10 +214,17 @@ fn cell(index: usize, row: &ReportRow) -> String {
     let v = &row.verdict;
     let images = match row.reference.filter(|_| row.graded()) {
         Some(g) => format!(
-            "<div class=\"thumbs\">{}{}{}</div>",
+            "<div class=\"thumbs\">{}{}{}{}</div>",
             thumb(&format!("images/{index}-submission"), "submission"),
             thumb(&format!("images/reference-{g}"), "reference"),
             thumb(&format!("images/{index}-heatmap"), "heat map"),
+            match &row.best_fit {
+                Some(id) => thumb(
+                    &format!("images/{index}-mistake"),
+                    &format!("Glint's render with the best-fitting mistake, {id}"),
+                ),
+                None => String::new(),
+            },
         ),
         None => String::new(),
     };

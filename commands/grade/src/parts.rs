@@ -321,6 +321,11 @@ pub fn copy_images(merged: &Merged, dir: &Path) -> Result<(), GradeError> {
         for name in crate::html::submission_images(i) {
             copy(part.join("images").join(&name), images.join(&name))?;
         }
+        if row.best_fit.is_some() {
+            for name in crate::html::fit_images(i) {
+                copy(part.join("images").join(&name), images.join(&name))?;
+            }
+        }
     }
     let references = merged.references.iter().enumerate();
     for (g, (part, local)) in references.filter_map(|(g, r)| Some((g, r.as_ref()?))) {
@@ -384,6 +389,7 @@ mod tests {
             sort_key: String::new(),
             reference: None,
             views: Vec::new(),
+            best_fit: None,
         }
     }
 }

@@ -168,6 +168,10 @@ pub struct ReportRow {
     /// opens the submission framing it.
     #[serde(default)]
     pub views: Vec<View>,
+    /// The id of the mistake that fits a failed submission best, if one
+    /// fits: the report shows Glint's render of it (`images/I-mistake.png`).
+    #[serde(default)]
+    pub best_fit: Option<String>,
 }
 
 /// The rows of a class's grades as the report shows them.
@@ -262,6 +266,12 @@ impl ReportRow {
             sort_key: sort_key(row).to_string(),
             reference: row.group,
             views: Vec::new(),
+            best_fit: match &row.outcome {
+                Outcome::Graded(g) => (g.likely_mistakes.first())
+                    .filter(|m| m.consistent)
+                    .map(|m| m.id.clone()),
+                Outcome::Unreadable { .. } => None,
+            },
         }
     }
 

@@ -343,6 +343,53 @@ pub fn diagnose(
     Ok(found)
 }
 
+/// What Glint renders for the finding `id` (one mistake, or two joined by
+/// `+`, as [`diagnose`] names them) as `submission` would store it: the
+/// middle of its bands, for the report to show beside the submission.
+/// `None` for an id the mutants do not have.
+pub fn fit_image(
+    against: &Against,
+    submission: &Submission,
+    id: &str,
+) -> Result<Option<Vec<Vec3>>, GradeError> {
+    let refs = against.references;
+    let correct = Bands::new(submission, refs, None);
+    let lights = lights_by_object(against.scene);
+    let mutants = &against.mutants.mutants;
+    let index = |id: &str| mutants.iter().position(|m| m.mistake.id == id);
+    let single = |i: usize| bands(&mutants[i], &correct, refs, &lights, submission);
+    let parts: Vec<&str> = id.split('+').collect();
+    let found = match parts[..] {
+        [one] => index(one).and_then(single),
+        [a, b] => match (index(a), index(b)) {
+            (Some(i), Some(j)) if matches!(mutants[j].render, MutantRender::Flip) => {
+                let size = refs.resolution;
+                single(i).map(|b| flipped(&b, size.x, size.y))
+            }
+            (Some(i), Some(j)) => {
+                let singles: Vec<Option<Bands>> = (0..mutants.len())
+                    .map(|k| [i, j].contains(&k).then(|| single(k)).flatten())
+                    .collect();
+                let singles: Vec<Option<&Bands>> = singles.iter().map(Option::as_ref).collect();
+                let pair = Pair {
+                    against,
+                    submission,
+                    lights: &lights,
+                    singles: &singles,
+                };
+                pair.bands(i, j)?
+            }
+            _ => None,
+        },
+        _ => None,
+    };
+    Ok(found.map(|b| {
+        (b.lo.iter().zip(&b.hi))
+            .map(|(lo, hi)| (*lo + *hi) / 2.0)
+            .collect()
+    }))
+}
+
 /// Two mistakes rendered together.
 struct Pair<'a> {
     against: &'a Against<'a>,

@@ -98,55 +98,25 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
     }
 }
 
-/// The scene of `args` as a tracer with mistake `id` sees it: its file
-/// edited as `glint grade` renders the mistake, then the flags' settings.
+/// The scene of `args` as a tracer with mistake `id` sees it: only a
+/// mistake Glint renders as a change to the scene.
 fn with_mistake(args: &ExplainArgs, id: &str) -> Result<glint_scene::SceneDescription, Failure> {
-    use glint_grade::mistakes::{self, How};
-    let mistake = mistakes::find(id).ok_or_else(|| {
-        Failure::Input(format!(
-            "--mistake: no mistake is called \"{}\" (glint grade --mistakes lists them)",
-            glint_grade::text::shorten(id)
-        ))
-    })?;
+    use glint_grade::mistakes::How;
+    let mistake = crate::mistake::find(id)?;
     let why_not = match mistake.how {
-        How::Scene(edit) | How::Lights(edit) => Ok(edit),
-        How::Film(_) => Err("it changes what the file stores, after every stage of the pixel"),
-        How::NoiseOnly => Err("it changes only the noise"),
+        How::Scene(_) | How::Lights(_) => None,
+        How::Film(_) => Some("it changes what the file stores, after every stage of the pixel"),
+        How::NoiseOnly => Some("it changes only the noise"),
         How::Integrator(_) => {
-            Err("Glint renders it in its one-ray integrator, which glint explain does not trace")
+            Some("Glint renders it in its one-ray integrator, which glint explain does not trace")
         }
     };
-    let edit = why_not.map_err(|why| {
-        Failure::Input(format!(
+    if let Some(why) = why_not {
+        return Err(Failure::Input(format!(
             "--mistake {id}: {why}; glint explain shows only mistakes Glint renders as a change to the scene (glint grade --mistakes says how each is rendered)"
-        ))
-    })?;
-    let correct = args.scene.load()?;
-    let path = &args.scene().scene;
-    let text = glint_scene::read_text(path, glint_scene::MAX_SCENE_BYTES, "a scene file")
-        .map_err(Failure::Input)?;
-    let size = correct.scene.camera.resolution();
-    let context = mistakes::edit::Context {
-        aspect: f64::from(size.x) / f64::from(size.y),
-        light_samples: Some(correct.settings.light_samples),
-    };
-    let edited = mistakes::edited_text(&text, &[edit], &context)
-        .map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?
-        .ok_or_else(|| {
-            Failure::Input(format!(
-                "--mistake {id}: it changes nothing in {} at these settings",
-                path.display()
-            ))
-        })?;
-    let name = format!("{} with {id}", path.display());
-    let base = path.parent().unwrap_or(Path::new(""));
-    let mut description = glint_scene::parse_in(&edited, &name, base)
-        .map_err(|e| Failure::Other(format!("{id}: the edited scene: {e}")))?;
-    args.scene
-        .overrides()
-        .apply(&mut description)
-        .map_err(|e| Failure::Input(e.to_string()))?;
-    Ok(description)
+        )));
+    }
+    Ok(crate::mistake::load(&args.scene, mistake)?.description)
 }
 
 /// What `glint explain` prints, and with `--against`, where the student's

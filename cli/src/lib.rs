@@ -28,6 +28,7 @@ mod farm;
 mod grade;
 mod grade_stages;
 mod interrupt;
+mod mistake;
 mod output;
 mod render;
 mod stats;

@@ -6,9 +6,11 @@ use crate::{named, progress_bar, Failure};
 use clap::Args;
 use glam::UVec2;
 use glint_camera::{Film, ImageFormat, PartialFilm, Placement, Tile};
+use glint_grade::mistakes::FilmMistake;
+use glint_integrator::mistakes::{render_with_mistakes, Mistakes};
 use glint_integrator::{
-    Aov, AreaSampling, Crop, EnvironmentSampling, RenderControl, RenderSettings, SamplePattern,
-    TextureLevel,
+    Aov, AreaSampling, Crop, EnvironmentSampling, RenderControl, RenderOutput, RenderSettings,
+    RenderStats, SamplePattern, TextureLevel,
 };
 use glint_scene::{OverrideError, Overrides, SceneDescription};
 use glint_texture::TextureFilter;
@@ -76,6 +78,12 @@ pub(crate) struct RenderArgs {
     /// scene and settings the image is the uninterrupted render's, bit for bit
     #[arg(long)]
     resume: bool,
+
+    /// Render the scene as a ray tracer with this classic mistake renders it
+    /// (`glint grade --mistakes` lists them): what a student's image with it
+    /// looks like. A mistake in what the file stores needs a .png output
+    #[arg(long, value_name = "ID", conflicts_with_all = ["crop", "tile", "resume", "aov"])]
+    mistake: Option<String>,
 }
 
 /// The scene file and the settings that change its pixels, shared by the
@@ -182,13 +190,21 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
     if let Some(json) = &args.stats_json {
         crate::output::check_writable(json)?;
     }
+    let (description, swaps, film_mistake) = match &args.mistake {
+        Some(id) => {
+            let m = crate::mistake::load(&args.scene, crate::mistake::find(id)?)?;
+            check_film_mistake(id, m.film, &output)?;
+            (m.description, m.swaps, m.film)
+        }
+        None => (args.scene.load()?, Mistakes::NONE, None),
+    };
     let SceneDescription {
         scene,
         mut settings,
         timings,
         assets,
         ..
-    } = args.scene.load()?;
+    } = description;
     let outputs: Vec<(&str, &Path)> = [
         Some(("-o", output.as_path())),
         args.stats_json.as_deref().map(|p| ("--stats-json", p)),
@@ -272,16 +288,29 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         resume: partial.as_ref(),
         crop: args.crop,
     };
-    let rendered = glint_integrator::render_with(&scene, &settings, &on_tile, control)
-        .map_err(|e| Failure::Other(e.to_string()))?;
+    let rendered = match swaps.is_empty() {
+        true => glint_integrator::render_with(&scene, &settings, &on_tile, control),
+        false => one_ray(&scene, &settings, swaps),
+    }
+    .map_err(|e| Failure::Other(e.to_string()))?;
     if let Some(bar) = progress {
         bar.finish_and_clear();
+    }
+    if let (false, Some(status)) = (swaps.is_empty(), interrupts.exit_status()) {
+        return Err(Failure::Interrupted {
+            message: format!("stopped; {} was not written", output.display()),
+            status,
+        });
     }
     let film = match settings.aov {
         Some(aov) if ImageFormat::from_path(&output).ok() == Some(ImageFormat::Png) => {
             aov.false_color(&rendered.film)
         }
         _ => rendered.film,
+    };
+    let film = match film_mistake {
+        Some(mistake) => with_film_mistake(film, mistake),
+        None => film,
     };
     let finished = rendered.finished.iter().filter(|&&f| f).count();
     if finished < rendered.finished.len() {
@@ -375,14 +404,17 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
         None => format!("{}x{}", resolution.x, resolution.y),
     };
     crate::output::say(&format!(
-        "wrote {}: {size}, {} spp, {} light samples{environment_samples}, {:.3} s wall ({:.3} s rendering), {} rays ({:.2} M rays/s)\n",
+        "wrote {}: {size}, {} spp, {} light samples{environment_samples}, {:.3} s wall ({:.3} s rendering), {}\n",
         output.display(),
         settings.spp,
         settings.light_samples,
         start.elapsed().as_secs_f64(),
         stats.elapsed.as_secs_f64(),
-        stats.rays(),
-        stats.rays_per_second() / 1e6,
+        match (&args.mistake, swaps.is_empty()) {
+            (Some(id), false) => format!("the one-ray integrator with {id}"),
+            (Some(id), true) => format!("{} rays, with {id}", stats.rays()),
+            (None, _) => format!("{} rays ({:.2} M rays/s)", stats.rays(), stats.rays_per_second() / 1e6),
+        },
     ));
     if args.stats {
         crate::output::say(&format!("{}\n", report.to_text()));
@@ -392,6 +424,61 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
             stats.shading.nonfinite_samples));
     }
     Ok(())
+}
+
+/// The one-ray integrator's render with `swaps` on, as a whole render: every
+/// pixel finished (it cannot stop early), its time its only count.
+fn one_ray(
+    scene: &glint_integrator::Scene,
+    settings: &RenderSettings,
+    swaps: Mistakes,
+) -> Result<RenderOutput, glint_integrator::SettingsError> {
+    let start = std::time::Instant::now();
+    let film = render_with_mistakes(scene, settings, swaps)?;
+    Ok(RenderOutput {
+        finished: vec![true; film.pixels().len()],
+        film,
+        stats: RenderStats {
+            elapsed: start.elapsed(),
+            ..RenderStats::default()
+        },
+    })
+}
+
+/// Refuses a mistake in the file's encoding for an output that is not an
+/// 8-bit PNG: a float file has no curve to get wrong.
+fn check_film_mistake(id: &str, film: Option<FilmMistake>, output: &Path) -> Result<(), Failure> {
+    let encoding = matches!(film, Some(FilmMistake::NoSrgb | FilmMistake::Gamma22));
+    if encoding && ImageFormat::from_path(output).ok() != Some(ImageFormat::Png) {
+        return Err(Failure::Input(format!(
+            "--mistake {id}: a mistake in the 8-bit encoding needs a .png output, not {}",
+            output.display()
+        )));
+    }
+    Ok(())
+}
+
+/// `film` as a tracer with the film mistake `mistake` writes it: upside
+/// down, or its values such that the sRGB encoding of the PNG writes the
+/// mistaken codes (what the grader decodes from them).
+fn with_film_mistake(mut film: Film, mistake: FilmMistake) -> Film {
+    let width = film.resolution().x as usize;
+    let pixels = film.pixels_mut();
+    match mistake {
+        FilmMistake::FlipVertical => {
+            let rows = pixels.len() / width;
+            for y in 0..rows / 2 {
+                let (top, bottom) = pixels.split_at_mut((rows - 1 - y) * width);
+                top[y * width..(y + 1) * width].swap_with_slice(&mut bottom[..width]);
+            }
+        }
+        FilmMistake::NoSrgb | FilmMistake::Gamma22 => {
+            for p in pixels.iter_mut() {
+                *p = glam::Vec3::from_array(p.to_array().map(|c| mistake.decoded(c)));
+            }
+        }
+    }
+    film
 }
 
 /// Where an interrupted render of `output` keeps the pixels it finished, and
@@ -518,10 +605,13 @@ fn fingerprint(
         stats: false,
         ..settings.clone()
     };
-    let settings = format!(
+    let mut settings = format!(
         "{pixels_depend_on:?} {resolution} {:?} {:?}",
         args.scene.texture_filter, args.scene.texture_level
     );
+    if let Some(id) = &args.mistake {
+        settings += &format!(" mistake {id}");
+    }
     add(&mut hasher, settings.as_bytes());
     Ok(format!("blake3 {}", hasher.finalize().to_hex()))
 }

@@ -9,8 +9,6 @@
 mod common;
 
 use common::{assert_input_error, glint, scene, stderr, stdout};
-use glint_integrator::mistakes::{render_with_mistakes, Mistake as Swap, Mistakes};
-use glint_integrator::SamplePattern;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -38,6 +36,11 @@ fn edited_set1(dir: &Path, name: &str, from: &str, to: &str) -> String {
 
 /// `scene_file` rendered at 48 × 48 with [`STATED`] and its own seed.
 fn render(dir: &Path, scene_file: &str, name: &str, seed: &str) -> PathBuf {
+    render_with(dir, scene_file, name, seed, &[])
+}
+
+/// [`render`] with `extra` flags.
+fn render_with(dir: &Path, scene_file: &str, name: &str, seed: &str, extra: &[&str]) -> PathBuf {
     let out = dir.join(name);
     let mut args = vec![
         "render",
@@ -48,6 +51,7 @@ fn render(dir: &Path, scene_file: &str, name: &str, seed: &str) -> PathBuf {
         seed,
     ];
     args.extend_from_slice(&STATED);
+    args.extend_from_slice(extra);
     args.extend_from_slice(&["-o", out.to_str().unwrap()]);
     let o = glint(&args, dir);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -265,50 +269,26 @@ fn a_failing_submission_is_named_by_its_mistake_and_a_pass_by_none() {
     );
 }
 
-/// `scene_file` rendered at 48 × 48 under [`STATED`] with seed `seed` by
-/// the one-ray integrator with `mistakes` switched on, written to `name`.
-fn render_mistaken(
-    dir: &Path,
-    scene_file: &str,
-    mistakes: Mistakes,
-    name: &str,
-    seed: u64,
-) -> PathBuf {
-    let mut scene = glint_scene::load(Path::new(scene_file)).unwrap();
-    let size = glam::UVec2::new(48, 48);
-    scene.scene.camera = scene.scene.camera.with_resolution(size).unwrap();
-    let settings = glint_integrator::RenderSettings {
-        spp: 4,
-        pixel_pattern: SamplePattern::Stratified,
-        light_samples: 4,
-        light_pattern: SamplePattern::Stratified,
-        seed,
-        ..scene.settings
-    };
-    let film = render_with_mistakes(&scene.scene, &settings, mistakes).unwrap();
-    let out = dir.join(name);
-    film.save(&out).unwrap();
-    out
-}
-
-/// Mistakes Glint renders in its one-ray integrator, made by it with
-/// other seeds: each named first, alone and with a scene edit.
+/// Mistakes Glint renders in its one-ray integrator or in the file, made
+/// by `glint render --mistake` with other seeds: each named first, alone
+/// and with a scene edit.
 #[test]
-fn a_stage_swapped_in_the_integrator_is_named() {
+fn a_mistake_rendered_by_glint_render_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let set1 = scene("cornell-set1");
-    let cases = [
-        (Swap::NoShadows, "no-shadows"),
-        (Swap::LightInvisible, "light-invisible"),
-        (Swap::ViewSign, "view-sign"),
-        (Swap::AmbientWithoutKd, "ambient-without-kd"),
-        (Swap::LightBlocksItself, "light-blocks-itself"),
+    let ids = [
+        "no-shadows",
+        "light-invisible",
+        "view-sign",
+        "ambient-without-kd",
+        "light-blocks-itself",
+        "no-srgb",
     ];
-    let one = |swap| Mistakes::NONE.with(swap);
-    let mut files: Vec<PathBuf> = (cases.iter().enumerate())
-        .map(|(i, &(swap, id))| {
-            render_mistaken(d, &set1, one(swap), &format!("{id}.png"), 31 + i as u64)
+    let mut files: Vec<PathBuf> = (ids.iter().enumerate())
+        .map(|(i, id)| {
+            let seed = (31 + i).to_string();
+            render_with(d, &set1, &format!("{id}.png"), &seed, &["--mistake", id])
         })
         .collect();
     // A pair: no shadows in a tracer that also leaves out the ambient term.
@@ -318,20 +298,19 @@ fn a_stage_swapped_in_the_integrator_is_named() {
         "ambient = [0.1, 0.1, 0.1]",
         "ambient = [0, 0, 0]",
     );
-    files.push(render_mistaken(
+    files.push(render_with(
         d,
         &no_ambient,
-        one(Swap::NoShadows),
         "both.png",
-        41,
+        "41",
+        &["--mistake", "no-shadows"],
     ));
     let paths: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
     let grades = graded(d, &paths, &[]);
-    let ids = cases
+    for (grade, id) in grades
         .iter()
-        .map(|(_, id)| *id)
-        .chain(["no-shadows+no-ambient"]);
-    for (grade, id) in grades.iter().zip(ids) {
+        .zip(ids.into_iter().chain(["no-shadows+no-ambient"]))
+    {
         assert_eq!(grade["verdict"], "fail", "{id}: {grade}");
         let named = consistent(grade);
         let first = named.first().map(String::as_str);
@@ -342,6 +321,28 @@ fn a_stage_swapped_in_the_integrator_is_named() {
             "{id}: {grade:#}"
         );
     }
+
+    // What cannot be rendered so is refused before any work.
+    let out = d.join("x.exr");
+    let refused = |mistake: &str, says: &str| {
+        let o = glint(
+            &[
+                "render",
+                &set1,
+                "--mistake",
+                mistake,
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            d,
+        );
+        assert_input_error(&o, says);
+        assert!(!out.exists());
+    };
+    refused("no-srgb", "needs a .png output");
+    refused("fixed-light-samples", "changes only the noise");
+    refused("mip-level-ln", "changes nothing");
+    refused("no-such-mistake", "glint grade --mistakes lists them");
 }
 
 #[test]

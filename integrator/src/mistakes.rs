@@ -124,8 +124,7 @@ impl std::fmt::Debug for Mistakes {
     /// The mistakes by name (`[NoShadows, ViewSign]`): what `glint grade`'s
     /// reference cache keys hash.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let each = Mistake::ALL.into_iter().filter(|&m| self.has(m));
-        f.debug_list().entries(each).finish()
+        f.debug_list().entries(self.iter()).finish()
     }
 }
 
@@ -147,6 +146,11 @@ impl Mistakes {
 
     pub fn union(self, other: Mistakes) -> Mistakes {
         Mistakes(self.0 | other.0)
+    }
+
+    /// The mistakes in the set.
+    pub fn iter(self) -> impl Iterator<Item = Mistake> {
+        Mistake::ALL.into_iter().filter(move |&m| self.has(m))
     }
 
     /// Whether any of them changes a shading point's reflection of a light.

@@ -17,6 +17,10 @@ pub(crate) struct Mistaken {
     pub(crate) swaps: Mistakes,
     /// What the file stores changed, after rendering.
     pub(crate) film: Option<FilmMistake>,
+    /// For a mistake in how light reaches surfaces: the correct scene,
+    /// whose render the pixels that see a light are taken from (the
+    /// student's light looks right).
+    pub(crate) lights_from: Option<SceneDescription>,
 }
 
 /// The catalogue's mistake `id`, or the error that names the list.
@@ -36,10 +40,15 @@ pub(crate) fn load(scene: &SceneArgs, mistake: &Mistake) -> Result<Mistaken, Fai
     let (swaps, film) = match mistake.how {
         How::Scene(edit) | How::Lights(edit) => {
             let description = edited(scene, id, edit)?;
+            let lights_from = match mistake.how {
+                How::Lights(_) => Some(scene.load()?),
+                _ => None,
+            };
             return Ok(Mistaken {
                 description,
                 swaps: Mistakes::NONE,
                 film: None,
+                lights_from,
             });
         }
         How::Integrator(swap) => (Mistakes::NONE.with(swap), None),
@@ -61,7 +70,29 @@ pub(crate) fn load(scene: &SceneArgs, mistake: &Mistake) -> Result<Mistaken, Fai
         description,
         swaps,
         film,
+        lights_from: None,
     })
+}
+
+/// `film`, the render of `mistaken` with a mistake in the lights, with the
+/// pixels that see a light (and their neighbours) taken from the correct
+/// scene's render with the same `settings`, as `glint grade` keeps them.
+pub(crate) fn with_correct_lights(
+    mut film: glint_camera::Film,
+    (correct, mistaken): (&glint_integrator::Scene, &glint_integrator::Scene),
+    settings: &glint_integrator::RenderSettings,
+) -> Result<glint_camera::Film, Failure> {
+    let internal = |e: String| Failure::Other(format!("the correct lights: {e}"));
+    let mask = mistakes::light_pixels(correct, mistaken).map_err(|e| internal(e.to_string()))?;
+    let right = glint_integrator::render(correct, settings, &|_, _| {})
+        .map_err(|e| internal(e.to_string()))?
+        .film;
+    for ((pixel, &keep), &right) in film.pixels_mut().iter_mut().zip(&mask).zip(right.pixels()) {
+        if keep {
+            *pixel = right;
+        }
+    }
+    Ok(film)
 }
 
 /// The scene file of `args` with the edit of mistake `id` applied, then the

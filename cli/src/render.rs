@@ -190,13 +190,13 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
     if let Some(json) = &args.stats_json {
         crate::output::check_writable(json)?;
     }
-    let (description, swaps, film_mistake) = match &args.mistake {
+    let (description, swaps, film_mistake, lights_from) = match &args.mistake {
         Some(id) => {
             let m = crate::mistake::load(&args.scene, crate::mistake::find(id)?)?;
             check_film_mistake(id, m.film, &output)?;
-            (m.description, m.swaps, m.film)
+            (m.description, m.swaps, m.film, m.lights_from)
         }
-        None => (args.scene.load()?, Mistakes::NONE, None),
+        None => (args.scene.load()?, Mistakes::NONE, None, None),
     };
     let SceneDescription {
         scene,
@@ -310,6 +310,12 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
     };
     let film = match film_mistake {
         Some(mistake) => with_film_mistake(film, mistake),
+        None => film,
+    };
+    let film = match &lights_from {
+        Some(correct) => {
+            crate::mistake::with_correct_lights(film, (&correct.scene, &scene), &settings)?
+        }
         None => film,
     };
     let finished = rendered.finished.iter().filter(|&&f| f).count();

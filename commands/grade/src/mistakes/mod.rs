@@ -285,7 +285,7 @@ pub fn diagnose(
     let regions = test::regions(size.x, size.y, block, &refs.objects);
     let test = (submission, regions.as_slice(), options);
     let correct = Bands::new(submission, refs, None);
-    let lights = lights_by_object(against.scene);
+    let lights = lights_by_object(&against.scene.description.scene);
     let mutants = &against.mutants.mutants;
     let singles: Vec<(usize, Bands)> = (0..mutants.len())
         .filter_map(|i| Some((i, bands(&mutants[i], &correct, refs, &lights, submission)?)))
@@ -354,7 +354,7 @@ pub fn fit_image(
 ) -> Result<Option<Vec<Vec3>>, GradeError> {
     let refs = against.references;
     let correct = Bands::new(submission, refs, None);
-    let lights = lights_by_object(against.scene);
+    let lights = lights_by_object(&against.scene.description.scene);
     let mutants = &against.mutants.mutants;
     let index = |id: &str| mutants.iter().position(|m| m.mistake.id == id);
     let single = |i: usize| bands(&mutants[i], &correct, refs, &lights, submission);
@@ -578,10 +578,24 @@ fn flipped(bands: &Bands, width: u32, height: u32) -> Bands {
     }
 }
 
+/// The pixels a mistake in the lights leaves as the correct render has
+/// them, in renders of `correct` and of `mistaken` (the same scene with
+/// that mistake): those that see a light at their centre in either, and
+/// their neighbours ([`near_objects`]).
+pub fn light_pixels(
+    correct: &glint_integrator::Scene,
+    mistaken: &glint_integrator::Scene,
+) -> Result<Vec<bool>, GradeError> {
+    let lights = lights_by_object(correct);
+    let a = crate::reference::objects_at_pixel_centres(correct)?;
+    let b = crate::reference::objects_at_pixel_centres(mistaken)?;
+    Ok(near_objects(&lights, &a, &b, correct.camera.resolution().x))
+}
+
 /// Which objects are the scene's lights, by object index.
-fn lights_by_object(scene: &GradeScene) -> Vec<bool> {
-    let mut lights = vec![false; scene.description.object_names.len()];
-    for &i in &scene.description.scene.light_objects {
+fn lights_by_object(scene: &glint_integrator::Scene) -> Vec<bool> {
+    let mut lights = vec![false; scene.shapes.len()];
+    for &i in &scene.light_objects {
         if let Some(l) = lights.get_mut(i as usize) {
             *l = true;
         }

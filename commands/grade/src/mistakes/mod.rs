@@ -251,20 +251,23 @@ const PAIRING_SHARE: f64 = 0.5;
 /// the best fits.
 const PAIRED: usize = 4;
 
-/// The single mistakes the best fit is tried with: the next best fits.
+/// The single mistakes the best fit is tried with in a slow pair: the next
+/// best fits.
 const PAIRED_WITH_BEST: usize = 10;
 
 /// The pairs of `ranked` (mutants, best fit first) that are tried: the best
-/// with each of the next [`PAIRED_WITH_BEST`], and every pair of the first
-/// [`PAIRED`]. A second mistake hides behind the first's larger error, so
-/// its own rank says less; the best fit is most likely one of the two. A
-/// pair with a stage the one-ray integrator swaps is a slow render (at
-/// 512², seconds), so not every mistake is tried with the best.
-fn pairs(ranked: &[(usize, f64)]) -> Vec<(usize, usize)> {
+/// with each other one, and every pair of the first [`PAIRED`]. A second
+/// mistake hides behind the first's larger error, so its own rank says
+/// little; the best fit is most likely one of the two. A pair with a stage
+/// the one-ray integrator swaps (`slow`) is a slow render (at 512², tens of
+/// seconds): the best is tried in those only with the next
+/// [`PAIRED_WITH_BEST`].
+fn pairs(ranked: &[(usize, f64)], slow: impl Fn(usize) -> bool) -> Vec<(usize, usize)> {
     let mut pairs: Vec<(usize, usize)> = Vec::new();
     for (k, &(a, _)) in ranked.iter().enumerate() {
         for (l, &(b, _)) in ranked.iter().enumerate().skip(k + 1) {
-            if (k == 0 && l <= PAIRED_WITH_BEST) || l < PAIRED {
+            let with_best = l <= PAIRED_WITH_BEST || !(slow(a) || slow(b));
+            if (k == 0 && with_best) || l < PAIRED {
                 pairs.push((a, b));
             }
         }
@@ -329,7 +332,8 @@ pub fn diagnose(
             lights: &lights,
             singles: &by_index,
         };
-        for (a, b) in pairs(&best) {
+        let slow = |i: usize| mutants[i].mistake.how.swap().is_some();
+        for (a, b) in pairs(&best, slow) {
             if let Some(bands) = pair.bands(a, b)? {
                 found.push(judged(
                     &[mutants[a].mistake, mutants[b].mistake],
@@ -646,13 +650,22 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_best_fit_is_paired_with_the_next_ten_and_the_first_four_with_each_other() {
+    fn the_best_fit_is_paired_with_every_other_and_the_first_four_with_each_other() {
         let ranked: Vec<(usize, f64)> = (0..14).map(|i| (10 + i, i as f64)).collect();
-        let got = pairs(&ranked);
-        let mut want: Vec<(usize, usize)> = (11..21).map(|b| (10, b)).collect();
+        let got = pairs(&ranked, |_| false);
+        let mut want: Vec<(usize, usize)> = (11..24).map(|b| (10, b)).collect();
         want.extend([(11, 12), (11, 13), (12, 13)]);
         assert_eq!(got, want);
-        assert!(pairs(&ranked[..1]).is_empty());
+        assert!(pairs(&ranked[..1], |_| false).is_empty());
+        // Slow pairs (mutant 22 is slow) only with the next ten.
+        let got = pairs(&ranked, |i| i == 22);
+        assert!(
+            !got.contains(&(10, 22)) && got.contains(&(10, 23)),
+            "{got:?}"
+        );
+        // A slow best: the next ten only.
+        let got = pairs(&ranked, |i| i == 10);
+        assert_eq!(got.iter().filter(|p| p.0 == 10).count(), 10);
     }
 
     #[test]

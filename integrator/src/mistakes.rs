@@ -203,6 +203,14 @@ pub fn render_with_mistakes(
     Ok(film)
 }
 
+/// The most a mistaken sample's radiance counts for. A mistake can overflow
+/// `f32` (an unnormalised normal of radius `r` raises `r²` to the
+/// shininess): where the render leaves an infinite sample out, a tracer in
+/// doubles has a huge finite one and writes white; capped far above 1, the
+/// sample still makes its pixel white, and the clamp gap stays exact in
+/// `f32`. A NaN is still left out.
+const MISTAKEN_CAP: f32 = 1e3;
+
 impl DirectIntegrator {
     /// Pixel `(x, y)`: the mean of its finite camera samples, each traced by
     /// [`Self::li_one_ray`] with `ctx`'s mistakes.
@@ -234,6 +242,10 @@ impl DirectIntegrator {
             };
             ctx.begin_sample(settings.seed, pixel, sample as u64);
             let value = self.li_one_ray(scene, &ray, &diff, 0, ctx);
+            let value = match ctx.mistakes.is_empty() || value.is_nan() {
+                true => value,
+                false => value.min(Vec3::splat(MISTAKEN_CAP)),
+            };
             if value.is_finite() {
                 sum += value;
             }

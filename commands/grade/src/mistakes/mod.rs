@@ -251,17 +251,22 @@ const PAIRING_SHARE: f64 = 0.5;
 /// the best fits.
 const PAIRED: usize = 4;
 
-/// The single mistakes the best fit is tried with in a slow pair: the next
-/// best fits.
+/// The single mistakes the best fit is tried with in a slow pair, in an
+/// image of more than [`ALL_SLOW_PAIRS`] pixels: the next best fits.
 const PAIRED_WITH_BEST: usize = 10;
+
+/// The most pixels an image may have for the best fit to be tried with
+/// every other mistake in slow pairs too (256², where a one-ray pair takes
+/// a few seconds).
+const ALL_SLOW_PAIRS: u32 = 256 * 256;
 
 /// The pairs of `ranked` (mutants, best fit first) that are tried: the best
 /// with each other one, and every pair of the first [`PAIRED`]. A second
 /// mistake hides behind the first's larger error, so its own rank says
 /// little; the best fit is most likely one of the two. A pair with a stage
 /// the one-ray integrator swaps (`slow`) is a slow render (at 512², tens of
-/// seconds): the best is tried in those only with the next
-/// [`PAIRED_WITH_BEST`].
+/// seconds): above [`ALL_SLOW_PAIRS`] pixels the best is tried in those
+/// only with the next [`PAIRED_WITH_BEST`].
 fn pairs(ranked: &[(usize, f64)], slow: impl Fn(usize) -> bool) -> Vec<(usize, usize)> {
     let mut pairs: Vec<(usize, usize)> = Vec::new();
     for (k, &(a, _)) in ranked.iter().enumerate() {
@@ -332,7 +337,8 @@ pub fn diagnose(
             lights: &lights,
             singles: &by_index,
         };
-        let slow = |i: usize| mutants[i].mistake.how.swap().is_some();
+        let large = size.x * size.y > ALL_SLOW_PAIRS;
+        let slow = |i: usize| large && mutants[i].mistake.how.swap().is_some();
         for (a, b) in pairs(&best, slow) {
             if let Some(bands) = pair.bands(a, b)? {
                 found.push(judged(

@@ -21,6 +21,10 @@ use glint_lighting::{EnvironmentLight, Light, PhongMaterial};
 use glint_texture::{Environment, TexCoord};
 use rayon::prelude::*;
 
+/// The revision of how the mistakes render, for caches of their renders
+/// (`glint grade`'s references): raised whenever one renders differently.
+pub const REVISION: u32 = 2;
+
 /// One mistake the reference integrator can make.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mistake {

@@ -413,7 +413,11 @@ impl Job<'_> {
             };
             let mistakes = match self.scene.mistakes.is_empty() {
                 true => String::new(),
-                false => format!(", one-ray integrator with {:?}", self.scene.mistakes),
+                false => format!(
+                    ", one-ray integrator with {:?} (revision {})",
+                    self.scene.mistakes,
+                    glint_integrator::mistakes::REVISION
+                ),
             };
             format!(
                 "glint-grade {name} reference{tag}, transform {k} of {K}, rounds={rounds}{text}{mistakes} {}",

@@ -39,11 +39,8 @@ pub(crate) fn load(scene: &SceneArgs, mistake: &Mistake) -> Result<Mistaken, Fai
     let id = mistake.id;
     let (swaps, film) = match mistake.how {
         How::Scene(edit) | How::Lights(edit) => {
-            let description = edited(scene, id, edit)?;
-            let lights_from = match mistake.how {
-                How::Lights(_) => Some(scene.load()?),
-                _ => None,
-            };
+            let (description, correct) = edited(scene, id, edit)?;
+            let lights_from = matches!(mistake.how, How::Lights(_)).then_some(correct);
             return Ok(Mistaken {
                 description,
                 swaps: Mistakes::NONE,
@@ -96,12 +93,12 @@ pub(crate) fn with_correct_lights(
 }
 
 /// The scene file of `args` with the edit of mistake `id` applied, then the
-/// flags' settings.
+/// flags' settings; and the scene as it is.
 fn edited(
     args: &SceneArgs,
     id: &str,
     edit: mistakes::edit::Edit,
-) -> Result<SceneDescription, Failure> {
+) -> Result<(SceneDescription, SceneDescription), Failure> {
     let correct = args.load()?;
     let path = &args.scene;
     let text = glint_scene::read_text(path, glint_scene::MAX_SCENE_BYTES, "a scene file")
@@ -126,5 +123,5 @@ fn edited(
     args.overrides()
         .apply(&mut description)
         .map_err(|e| Failure::Input(e.to_string()))?;
-    Ok(description)
+    Ok((description, correct))
 }

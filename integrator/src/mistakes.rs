@@ -233,10 +233,11 @@ impl DirectIntegrator {
             false => Vec2::ZERO,
         };
         let scale = footprint_scale(settings.spp);
+        let differentials = scene.needs_differentials();
         let mut sum = Vec3::ZERO;
         for (sample, &jitter) in positions.iter().enumerate() {
             let raster = Vec2::new(x as f32, y as f32) + jitter - corner;
-            let (ray, diff) = match scene.needs_differentials() {
+            let (ray, diff) = match differentials {
                 true => camera_ray(&scene.camera, raster, scale),
                 false => {
                     let c = scene.camera.generate_ray(raster.x, raster.y);

@@ -97,32 +97,38 @@ fn edit_fov(scene: &mut Table, new_half: impl Fn(f64) -> Option<f64>) -> bool {
 
 /// Every checkerboard's `checks` doubled.
 pub fn checker_double(scene: &mut Table, _: &Context) -> bool {
-    let mut changed = false;
-    for texture in tables_in(scene, "textures") {
-        for kind in ["checkerboard", "checker_image"] {
-            let Some(pattern) = texture.get_mut(kind).and_then(Value::as_table_mut) else {
-                continue;
-            };
-            if let Some(Value::Integer(n)) = pattern.get("checks").cloned() {
-                pattern.insert("checks".into(), Value::Integer(2 * n));
-                changed = true;
-            }
-        }
-    }
-    changed
+    each_texture(scene, &["checkerboard", "checker_image"], |pattern| {
+        let Some(Value::Integer(n)) = pattern.get("checks").cloned() else {
+            return false;
+        };
+        pattern.insert("checks".into(), Value::Integer(2 * n));
+        true
+    })
 }
 
 /// Every image texture (and checkerboard image) read at its nearest texel.
 pub fn nearest_texel(scene: &mut Table, _: &Context) -> bool {
+    each_texture(scene, &["image", "checker_image"], |image| {
+        let nearest = image.get("filter").and_then(Value::as_str) == Some("nearest");
+        if !nearest {
+            image.insert("filter".into(), Value::String("nearest".into()));
+        }
+        !nearest
+    })
+}
+
+/// Applies `edit` to the table of each texture of one of `kinds`
+/// (`[textures.NAME.KIND]`); whether any changed.
+fn each_texture(
+    scene: &mut Table,
+    kinds: &[&str],
+    mut edit: impl FnMut(&mut Table) -> bool,
+) -> bool {
     let mut changed = false;
     for texture in tables_in(scene, "textures") {
-        for kind in ["image", "checker_image"] {
-            let Some(image) = texture.get_mut(kind).and_then(Value::as_table_mut) else {
-                continue;
-            };
-            if image.get("filter").and_then(Value::as_str) != Some("nearest") {
-                image.insert("filter".into(), Value::String("nearest".into()));
-                changed = true;
+        for kind in kinds {
+            if let Some(table) = texture.get_mut(*kind).and_then(Value::as_table_mut) {
+                changed |= edit(table);
             }
         }
     }

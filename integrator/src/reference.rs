@@ -13,7 +13,7 @@ use crate::context::SampleContext;
 use crate::direct::wave::mirror_ray;
 use crate::direct::PairAllocation;
 use crate::mistakes::{
-    invisible_light, mistaken_direction, mistaken_footprint, mistaken_uv, Mistake, Mistakes,
+    invisible_light, mistaken_direction, mistaken_footprint, mistaken_hit, Mistake, Mistakes,
 };
 use crate::sampling::{DimensionPair, SamplePoints};
 use crate::shading_point::ShadingPoint;
@@ -142,7 +142,7 @@ impl DirectIntegrator {
         if at.material.uses_footprint() {
             ctx.counters.footprints += 1;
         }
-        let hit = mistaken_uv(scene, at.hit, ctx.mistakes);
+        let hit = mistaken_hit(scene, at.hit, at.ray, ctx.mistakes);
         let tc = texture_footprint(scene, at.material, (&hit, depth), at.ray, at.diff);
         let tc = mistaken_footprint(at.material, tc, ctx.mistakes);
         if ctx.detailed {

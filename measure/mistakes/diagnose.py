@@ -78,27 +78,33 @@ def catalogue(glint):
     return found
 
 
-def build(corpus, quick, with_512):
+def build(corpus, quick, with_512, only=()):
+    """The corpus; with `only`, just those mistakes alone, each image with
+    the seed it has in the whole corpus."""
     seed = iter(range(500000, 900000))
     mistakes = list(IDS) if not quick else ["no-ambient", "light-centre", "specular-white", "flipped-image"]
     scenes = ("set1", "set2", "set3") if not quick else ("set1",)
+
+    def add(kind, scene, size, settings, mistake_names):
+        s = next(seed)
+        if only and not (kind == "mistake" and mistake_names[0] in only):
+            return
+        path = corpus.trace(scene, size, *settings, s, mistakes=mistake_names)
+        corpus.add(kind, scene, size, settings, path, mistake="+".join(mistake_names))
+
     for m in mistakes:
         for scene in scenes:
             for settings in SETTINGS_128 if not quick else SETTINGS_128[1:2]:
-                path = corpus.trace(scene, 128, *settings, next(seed), mistakes=(m,))
-                corpus.add("mistake", scene, 128, settings, path, mistake=m)
+                add("mistake", scene, 128, settings, (m,))
         if with_512:
             for settings in SETTINGS_512:
-                path = corpus.trace("set1", 512, *settings, next(seed), mistakes=(m,))
-                corpus.add("mistake", "set1", 512, settings, path, mistake=m)
+                add("mistake", "set1", 512, settings, (m,))
     for pair in PAIRS if not quick else PAIRS[:1]:
         for scene in scenes:
-            settings = SETTINGS_128[1]
-            path = corpus.trace(scene, 128, *settings, next(seed), mistakes=pair)
-            corpus.add("pair", scene, 128, settings, path, mistake="+".join(pair))
+            add("pair", scene, 128, SETTINGS_128[1], pair)
     for scene in scenes:
         for settings in SETTINGS_128:
-            corpus.add("correct", scene, 128, settings, corpus.trace(scene, 128, *settings, next(seed)))
+            add("correct", scene, 128, settings, ())
 
 
 def true_id_of(mistake):
@@ -162,18 +168,21 @@ def main():
     ap.add_argument("--cache", default=str(repo / "target/corpus/cache"))
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--no-512", action="store_true", help="only the 128² submissions")
+    ap.add_argument("--only", action="append", default=[], metavar="NAME",
+                    help="only this mistake of the tracer's, alone (repeatable): a quick look, not the table")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     corpus = Corpus(out, args.glint, sys.executable)
     start = time.time()
-    build(corpus, args.quick, not args.no_512)
+    build(corpus, args.quick, not args.no_512, args.only)
     made = time.time() - start
     graded, elapsed = grade_class(corpus, corpus.rows, cache=Path(args.cache))
     for r in corpus.rows:
         r["graded"] = graded[r["student"]]
     rows = summarise(corpus, catalogue(args.glint))
-    (out / "results.json").write_text(json.dumps(dict(rows=rows, grade_seconds=elapsed, trace_seconds=made), indent=1))
+    name = "results-only.json" if args.only else "results.json"
+    (out / name).write_text(json.dumps(dict(rows=rows, grade_seconds=elapsed, trace_seconds=made), indent=1))
     print(table(rows))
     print(f"\n{len(corpus.rows)} submissions; grading (mutants included) took {elapsed:.0f} s")
 

@@ -116,7 +116,8 @@ fn every_format_a_student_writes_is_graded_through_what_it_did() {
 }
 
 #[test]
-fn another_encoders_jpeg_of_a_right_render_passes_and_of_a_wrong_one_fails() {
+fn another_encoders_jpeg_of_a_right_render_passes_and_of_a_wrong_one_fails_with_its_mistake_named()
+{
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let set1 = scene("cornell-set1");
@@ -161,4 +162,8 @@ fn another_encoders_jpeg_of_a_right_render_passes_and_of_a_wrong_one_fails() {
         "{}",
         grades["wrong.jpg"]
     );
+    // Its mistake is named: the mutants judged through its encoding.
+    let first = &grades["wrong.jpg"]["likely_mistakes"][0];
+    assert_eq!(first["id"], "no-ambient", "{}", grades["wrong.jpg"]);
+    assert_eq!(first["consistent"], true, "{first}");
 }

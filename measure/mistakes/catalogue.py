@@ -2,7 +2,8 @@
 """Measures how well `glint grade` tells the mistakes of its catalogue apart:
 every mistake `glint render --mistake ID` renders, on scenes that have what
 each spoils (the Cornell sets, textured spheres, a MIP-mapped ground, a
-cube-map environment), at other seeds than the grader's, graded as a class.
+cube-map environment, a magnified texture: scenes/ here), at other seeds
+than the grader's, graded as a class.
 
     python3 measure/mistakes/catalogue.py [--glint target/release/glint]
         [--out target/mistakes-catalogue] [--settings 4s4s,16r16r,1r1r] [--res 128]
@@ -24,7 +25,14 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent.parent
-SCENES = ["cornell-set1", "cornell-set2", "cornell-set3", "textured-spheres", "ground-mipmap", "environment"]
+SCENES = ["cornell-set1", "cornell-set2", "cornell-set3", "textured-spheres", "ground-mipmap", "environment",
+          "texture-closeup"]
+
+
+def scene_file(name):
+    """A shipped scene, or one of this measurement's own (scenes/ here)."""
+    shipped = REPO / "scenes" / f"{name}.toml"
+    return shipped if shipped.exists() else Path(__file__).resolve().parent / "scenes" / f"{name}.toml"
 PATTERN = {"r": "random", "s": "stratified", "g": "grid"}
 
 
@@ -49,7 +57,7 @@ def render(glint, scene, out, res, settings, seed, mistake=None):
     if out.exists():
         return True
     spp, sampler, light, light_sampler = settings
-    cmd = [glint, "render", str(REPO / "scenes" / f"{scene}.toml"), "--resolution", f"{res}x{res}",
+    cmd = [glint, "render", str(scene_file(scene)), "--resolution", f"{res}x{res}",
            "--spp", str(spp), "--sampler", sampler, "--light-samples", str(light),
            "--light-sampler", light_sampler, "--seed", str(seed), "-o", str(out)]
     if mistake:
@@ -90,7 +98,7 @@ def main():
         w = csv.writer(f)
         w.writerow(["student", "scene", "file", "spp", "sampler", "light_samples", "light_sampler", "note"])
         for r in rows:
-            w.writerow([r["student"], str(REPO / "scenes" / f"{r['scene']}.toml"), r["file"], *r["settings"], r["mistake"]])
+            w.writerow([r["student"], str(scene_file(r["scene"])), r["file"], *r["settings"], r["mistake"]])
     start = time.time()
     g = subprocess.run([args.glint, "grade", "--class", str(manifest), "--format", "json",
                         "--cache", str(out / "cache")], capture_output=True, text=True)

@@ -409,13 +409,27 @@ fn diagnose_failures(
             continue;
         }
         let rendering = |what: &str| progress.rendering(what);
-        let mutants = mistakes::render_mutants(
+        let mut mutants = mistakes::render_mutants(
             &group.scene,
             &group.references,
             &group.stated,
             &options.cache,
             &rendering,
         )?;
+        let submissions: Vec<Option<Submission>> = failing
+            .par_iter()
+            .map(|&i| Submission::load(Path::new(&rows[i].file)).ok())
+            .map(|s| s.filter(|s| s.resolution() == group.references.resolution))
+            .collect();
+        let mut encodings = Vec::new();
+        for s in submissions.iter().flatten() {
+            if let Some(Ok(encoding)) = &s.jpeg {
+                if !encodings.contains(encoding) {
+                    mutants.through_jpeg(encoding, &options.cache, &rendering)?;
+                    encodings.push(encoding.clone());
+                }
+            }
+        }
         let against = mistakes::Against {
             scene: &group.scene,
             references: &group.references,
@@ -424,20 +438,19 @@ fn diagnose_failures(
             cache: &options.cache,
             progress: &rendering,
         };
-        let found: Vec<Vec<mistakes::LikelyMistake>> = failing
-            .par_iter()
-            .map(|&i| match Submission::load(Path::new(&rows[i].file)) {
-                // A JPEG's mutants would go through its encoding: not yet.
-                Ok(s) if s.jpeg.is_none() && s.resolution() == group.references.resolution => {
-                    let found = mistakes::diagnose(&against, &s, &options.test)?;
+        let found: Vec<Vec<mistakes::LikelyMistake>> = (failing.par_iter())
+            .zip(&submissions)
+            .map(|(&i, s)| match s {
+                Some(s) => {
+                    let found = mistakes::diagnose(&against, s, &options.test)?;
                     if let Some(best) = found.first().filter(|m| m.consistent) {
-                        if let Some(image) = mistakes::fit_image(&against, &s, &best.id)? {
+                        if let Some(image) = mistakes::fit_image(&against, s, &best.id)? {
                             on_diagnosed(i, &image, s.resolution())?;
                         }
                     }
                     Ok(found)
                 }
-                _ => Ok(Vec::new()),
+                None => Ok(Vec::new()),
             })
             .collect::<Result<_, GradeError>>()?;
         for (i, found) in failing.into_iter().zip(found) {

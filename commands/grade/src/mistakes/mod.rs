@@ -24,7 +24,8 @@ pub mod edit;
 
 pub use catalogue::{find, FilmMistake, How, Mistake, Stage, CATALOGUE};
 
-use crate::reference::{references, samples_through, Estimate, GradeScene};
+use crate::jpeg::JpegEncoding;
+use crate::reference::{references, samples_through, with_jpeg, Estimate, GradeScene};
 use crate::test::{self, Bands, NoiseFit, Region, TestOptions};
 use crate::{Cache, GradeError, References, StatedSettings, Submission};
 use glam::Vec3;
@@ -217,6 +218,45 @@ pub fn render_mutants(
     Ok(Mutants { mutants })
 }
 
+impl Mutants {
+    /// Each mutant rendered as a scene, its references also through
+    /// `encoding` ([`with_jpeg`]): for diagnosing a JPEG submission, whose
+    /// mutants are judged as it is, through its encoding.
+    pub fn through_jpeg(
+        &mut self,
+        encoding: &JpegEncoding,
+        cache: &Cache,
+        progress: &(dyn Fn(&str) + Sync),
+    ) -> Result<(), GradeError> {
+        for mutant in &mut self.mutants {
+            if let MutantRender::Scene {
+                scene, references, ..
+            } = &mut mutant.render
+            {
+                with_jpeg(references, scene, encoding, cache, progress)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `submission`'s bands under `refs`: through its encoding for a JPEG
+/// (`None` where `refs` were not passed through it, [`Mutants::through_jpeg`]).
+fn bands_of(submission: &Submission, refs: &References) -> Option<Bands> {
+    let jpeg = match &submission.jpeg {
+        Some(Ok(encoding)) => Some(refs.through_jpeg(encoding)?),
+        _ => None,
+    };
+    Some(Bands::new(submission, refs, jpeg))
+}
+
+/// Whether `submission`'s file stores what an encoding mistake changes:
+/// 8-bit codes, not floats and not a JPEG's coefficients.
+fn stores_codes(submission: &Submission) -> bool {
+    let float = matches!(submission.encoding, SampleEncoding::Float { .. });
+    !float && !matches!(submission.jpeg, Some(Ok(_)))
+}
+
 /// The sample reference of `scene` (`refs`) through the encoding mistake
 /// `film` (named `id`), round by round.
 fn through_film(
@@ -297,7 +337,9 @@ pub fn diagnose(
         .unwrap_or_else(|| test::block_side(size.x, size.y));
     let regions = test::regions(size.x, size.y, block, &refs.objects);
     let test = (submission, regions.as_slice(), options);
-    let correct = Bands::new(submission, refs, None);
+    let Some(correct) = bands_of(submission, refs) else {
+        return Ok(Vec::new());
+    };
     let lights = lights_by_object(&against.scene.description.scene);
     let mutants = &against.mutants.mutants;
     let singles: Vec<(usize, Bands)> = (0..mutants.len())
@@ -368,7 +410,9 @@ pub fn fit_image(
     id: &str,
 ) -> Result<Option<Vec<Vec3>>, GradeError> {
     let refs = against.references;
-    let correct = Bands::new(submission, refs, None);
+    let Some(correct) = bands_of(submission, refs) else {
+        return Ok(None);
+    };
     let lights = lights_by_object(&against.scene.description.scene);
     let mutants = &against.mutants.mutants;
     let index = |id: &str| mutants.iter().position(|m| m.mistake.id == id);
@@ -447,16 +491,27 @@ impl Pair<'_> {
                 let Ok(Some(both)) = edited_scene(against.scene, &both, &context) else {
                     return Ok(None);
                 };
-                let both_refs = references(
+                let mut both_refs = references(
                     &both,
                     refs.resolution,
                     &refs.plan,
                     against.cache,
                     against.progress,
                 )?;
-                let bands = Bands::new(self.submission, &both_refs, None);
+                if let Some(Ok(encoding)) = &self.submission.jpeg {
+                    with_jpeg(
+                        &mut both_refs,
+                        &both,
+                        encoding,
+                        against.cache,
+                        against.progress,
+                    )?;
+                }
+                let Some(bands) = bands_of(self.submission, &both_refs) else {
+                    return Ok(None);
+                };
                 let source = match (*keep_lights, *also) {
-                    (true, true) => Some(Bands::new(self.submission, refs, None)),
+                    (true, true) => bands_of(self.submission, refs),
                     (true, false) => self.singles[o].cloned(),
                     (false, true) => self.singles[s].cloned(),
                     (false, false) => None,
@@ -464,7 +519,7 @@ impl Pair<'_> {
                 (bands, both_refs.objects, source)
             }
             MutantRender::Encoding { mistake, .. } => {
-                if matches!(self.submission.encoding, SampleEncoding::Float { .. }) {
+                if !stores_codes(self.submission) {
                     return Ok(None);
                 }
                 let id = mutants[o].mistake.id;
@@ -536,7 +591,7 @@ fn bands(
             keep_lights,
             ..
         } => {
-            let mut bands = Bands::new(submission, references, None);
+            let mut bands = bands_of(submission, references)?;
             if *keep_lights {
                 let near = near_objects(lights, &refs.objects, &references.objects, size.x);
                 keep(&mut bands, correct, &near);
@@ -548,7 +603,7 @@ fn bands(
         }
         MutantRender::Flip => Some(flipped(correct, size.x, size.y)),
         MutantRender::Encoding { mistake, samples } => {
-            if matches!(submission.encoding, SampleEncoding::Float { .. }) {
+            if !stores_codes(submission) {
                 return None;
             }
             Some(through_encoding(*mistake, samples, refs))

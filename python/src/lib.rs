@@ -46,6 +46,7 @@ enum Origin {
     Text {
         name: String,
         text: String,
+        base: PathBuf,
     },
 }
 
@@ -65,14 +66,17 @@ impl Scene {
                 let text = std::fs::read_to_string(path).map_err(|e| {
                     pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", path.display()))
                 })?;
+                let base = path.parent().unwrap_or(Path::new("")).to_owned();
                 GradeScene::from_text(
                     &path.display().to_string(),
-                    &(text + &replaced),
+                    &(text.clone() + &replaced),
                     description,
                 )
+                .with_source(text, base)
             }
-            Origin::Text { name, text } => {
+            Origin::Text { name, text, base } => {
                 GradeScene::from_text(name, &format!("{text}{replaced}"), description)
+                    .with_source(text.clone(), base.clone())
             }
         })
     }
@@ -240,7 +244,13 @@ fn parse(
         .detach(|| glint_scene::parse_in(&text, name, &base_dir))
         .map_err(|e| scene_error(py, e))?;
     let name = name.to_owned();
-    prepared(py, description, Origin::Text { name, text }, overrides)
+    let base = base_dir;
+    prepared(
+        py,
+        description,
+        Origin::Text { name, text, base },
+        overrides,
+    )
 }
 
 /// The scene with `overrides` applied (prepared for them, checked).

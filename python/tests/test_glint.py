@@ -303,6 +303,23 @@ def test_grade_a_scene_from_memory_keys_the_cache_by_its_text(glint_bin, tmp_pat
     assert len(added) == 2 * len(texts), sorted(added)
 
 
+def test_a_scene_from_memory_has_its_mistakes_named_edits_included(glint_bin, tmp_path):
+    path = SCENES / "cornell-set1.toml"
+    flags = ["--spp", "4", "--sampler", "random", "--light-samples", "4", "--light-sampler", "random"]
+    stated = {"spp": 4, "pixel_sampler": "random", "light_samples": 4, "light_sampler": "random"}
+    wrong = tmp_path / "no-ambient.png"
+    cli(glint_bin, "render", str(path), *flags, "--resolution", "16x16", "--seed", "5", "--mistake", "no-ambient",
+        "-o", str(wrong))
+    # The text's settings replaced (depth) and the mistake an edit of the text;
+    # 16 × 16 pixels, as every mistake is rendered (in the dev profile).
+    scene = glint.load_string(path.read_text(), base_dir=SCENES, max_depth=2)
+    report = glint.grade(scene, wrong, cache=tmp_path / "cache", mistakes=True, **stated)
+    [graded] = report.submissions
+    assert graded["verdict"] == "fail"
+    first = graded["likely_mistakes"][0]
+    assert (first["id"], first["consistent"]) == ("no-ambient", True), graded["likely_mistakes"][:3]
+
+
 def test_explain_against_is_the_clis_comparison(glint_bin, tmp_path):
     path = SCENES / "cornell-set1.toml"
     flags = ["--spp", "4", "--resolution", "48x40"]

@@ -37,6 +37,17 @@ pub struct GradeScene {
     /// The mistakes its references are rendered with (by the one-ray
     /// integrator; none for the correct references).
     pub mistakes: Mistakes,
+    /// A scene from memory: the TOML text it was read from and the folder
+    /// its assets are relative to, for the mistakes made as edits of the
+    /// text ([`GradeScene::with_source`]).
+    pub source: Option<SceneSource>,
+}
+
+/// The text a scene from memory was read from.
+#[derive(Clone, Debug)]
+pub struct SceneSource {
+    pub text: String,
+    pub base: PathBuf,
 }
 
 impl GradeScene {
@@ -51,6 +62,17 @@ impl GradeScene {
             text_hash: Some(blake3::hash(text.as_bytes()).to_hex().to_string()),
             description,
             mistakes: Mistakes::NONE,
+            source: None,
+        }
+    }
+
+    /// The scene, read from the TOML `text` with its assets relative to
+    /// `base` (and its settings then replaced or not): what its mistakes
+    /// are edits of.
+    pub fn with_source(self, text: String, base: PathBuf) -> GradeScene {
+        GradeScene {
+            source: Some(SceneSource { text, base }),
+            ..self
         }
     }
 
@@ -71,6 +93,7 @@ impl GradeScene {
             inputs,
             text_hash: None,
             mistakes: Mistakes::NONE,
+            source: None,
         }
     }
 
@@ -83,6 +106,7 @@ impl GradeScene {
             inputs: self.inputs.clone(),
             text_hash: self.text_hash.clone(),
             mistakes: mistakes.union(self.mistakes),
+            source: self.source.clone(),
         }
     }
 

@@ -32,6 +32,7 @@ use glam::Vec3;
 use glint_camera::SampleEncoding;
 use glint_integrator::mistakes::{Mistake as Swap, Mistakes};
 use serde::Serialize;
+use std::path::Path;
 
 /// A mistake as a finding about one submission.
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -137,9 +138,10 @@ pub fn edited_scene(
     ))
 }
 
-/// `scene` with `edits` (those of `mistakes`) applied to its file: a new
-/// scene, or the same (`None` when an edit changes nothing, or there are
-/// edits and no file).
+/// `scene` with `edits` (those of `mistakes`) applied to its file or, from
+/// memory, its text: a new scene with the settings that replaced the
+/// text's, or the same (`None` when an edit changes nothing, or there are
+/// edits and no text).
 fn scene_edited(
     scene: &GradeScene,
     mistakes: &[&Mistake],
@@ -151,12 +153,16 @@ fn scene_edited(
             scene.with_mistakes(&scene.path.to_string_lossy(), Mistakes::NONE),
         ));
     }
-    if scene.text_hash.is_some() {
-        return Ok(None);
-    }
     let path = &scene.path;
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| GradeError::Input(format!("{}: {e}", path.display())))?;
+    let (text, base) = match (&scene.source, &scene.text_hash) {
+        (Some(source), _) => (source.text.clone(), source.base.clone()),
+        (None, Some(_)) => return Ok(None),
+        (None, None) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| GradeError::Input(format!("{}: {e}", path.display())))?;
+            (text, path.parent().unwrap_or(Path::new("")).to_owned())
+        }
+    };
     let Some(edited) = edited_text(&text, edits, context)
         .map_err(|e| GradeError::Input(format!("{}: {e}", path.display())))?
     else {
@@ -164,10 +170,17 @@ fn scene_edited(
     };
     let ids = joined(mistakes, |m| m.id, "+");
     let name = format!("{} with {ids}", path.display());
-    let base = path.parent().unwrap_or(std::path::Path::new(""));
-    let description = glint_scene::parse_in(&edited, &name, base)
+    let mut description = glint_scene::parse_in(&edited, &name, &base)
         .map_err(|e| GradeError::Internal(format!("{ids} edited: {e}")))?;
-    Ok(Some(GradeScene::from_text(&name, &edited, description)))
+    // No edit touches [render]: the settings are the scene's, replaced or not.
+    description.settings = scene.description.settings.clone();
+    // Keyed by the edited text and, from memory, by what the original's key
+    // hashed (its text and the settings that replaced the text's).
+    let key = match &scene.text_hash {
+        Some(hash) => format!("{edited}\nreplaced as in {hash}"),
+        None => edited,
+    };
+    Ok(Some(GradeScene::from_text(&name, &key, description)))
 }
 
 fn joined(mistakes: &[&Mistake], part: fn(&Mistake) -> &str, by: &str) -> String {

@@ -15,6 +15,7 @@ use glint_integrator::{
 use glint_scene::{OverrideError, Overrides, SceneDescription};
 use glint_texture::TextureFilter;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 
 #[derive(Args)]
 pub(crate) struct RenderArgs {
@@ -290,7 +291,7 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
     };
     let rendered = match swaps.is_empty() {
         true => glint_integrator::render_with(&scene, &settings, &on_tile, control),
-        false => one_ray(&scene, &settings, swaps),
+        false => one_ray(&scene, &settings, swaps, interrupts.stop()),
     }
     .map_err(|e| Failure::Other(e.to_string()))?;
     if let Some(bar) = progress {
@@ -432,15 +433,16 @@ pub(crate) fn render(args: &RenderArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The one-ray integrator's render with `swaps` on, as a whole render: every
-/// pixel finished (it cannot stop early), its time its only count.
+/// The one-ray integrator's render with `swaps` on, as a whole render (an
+/// interrupted one is not written), its time its only count.
 fn one_ray(
     scene: &glint_integrator::Scene,
     settings: &RenderSettings,
     swaps: Mistakes,
+    stop: &AtomicBool,
 ) -> Result<RenderOutput, glint_integrator::SettingsError> {
     let start = std::time::Instant::now();
-    let film = render_with_mistakes(scene, settings, swaps)?;
+    let film = render_with_mistakes(scene, settings, swaps, Some(stop))?;
     Ok(RenderOutput {
         finished: vec![true; film.pixels().len()],
         film,

@@ -258,3 +258,31 @@ fn resume_refuses_what_is_not_a_partial_render() {
         "does not record the scene and settings",
     );
 }
+
+#[test]
+fn ctrl_c_stops_a_mistaken_render_soon_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("out.png"), b"the previous image").unwrap();
+    let mut args = args(16384, "out.png");
+    args.extend(["--mistake".to_owned(), "no-shadows".to_owned()]);
+    let child = spawn(&args, dir.path());
+    std::thread::sleep(Duration::from_millis(400));
+    signal(&child, "INT");
+    let sent = Instant::now();
+    let out = child.wait_with_output().unwrap();
+    let took = sent.elapsed();
+    assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+    // The one-ray integrator stops between rows: far sooner than the
+    // minutes the whole render takes.
+    assert!(took < Duration::from_secs(5), "took {took:?} to stop");
+    assert!(
+        stderr(&out).contains("out.png was not written"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("out.png")).unwrap(),
+        b"the previous image"
+    );
+    no_hidden_files(dir.path());
+}

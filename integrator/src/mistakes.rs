@@ -20,6 +20,7 @@ use glint_geometry::{Hit, ObjectRef, Ray, RayDifferential, Shape};
 use glint_lighting::{EnvironmentLight, Light, PhongMaterial};
 use glint_texture::{Environment, TexCoord};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The revision of how the mistakes render, for caches of their renders
 /// (`glint grade`'s references): raised whenever one renders differently.
@@ -176,11 +177,13 @@ impl FromIterator<Mistake> for Mistakes {
 /// with `mistakes` switched on. With none, every pixel is [`crate::render`]'s
 /// bit for bit (the same sample positions, streams and rays; the AOV and
 /// crop settings are not read): the one-ray integrator is tested against
-/// the lanes bit for bit. About ten times slower than `render`.
+/// the lanes bit for bit. About ten times slower than `render`. Once `stop`
+/// is set, rows not yet begun are left black.
 pub fn render_with_mistakes(
     scene: &Scene,
     settings: &RenderSettings,
     mistakes: Mistakes,
+    stop: Option<&AtomicBool>,
 ) -> Result<Film, SettingsError> {
     settings.validate()?;
     scene.prepare(settings);
@@ -190,6 +193,9 @@ pub fn render_with_mistakes(
     let run = |pixels: &mut [Vec3]| {
         let rows = pixels.par_chunks_mut(size.x as usize);
         rows.enumerate().for_each(|(y, row)| {
+            if stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
+                return;
+            }
             let mut ctx = SampleContext::new(settings.light_samples, settings.environment_samples);
             ctx.mistakes = mistakes;
             let mut positions = vec![Vec2::ZERO; settings.spp as usize];
@@ -482,7 +488,7 @@ mod tests {
         ] {
             let settings = settings(spp, pattern, light);
             let lanes = render(&scene, &settings, &|_, _| {}).unwrap().film;
-            let one_ray = render_with_mistakes(&scene, &settings, Mistakes::NONE).unwrap();
+            let one_ray = render_with_mistakes(&scene, &settings, Mistakes::NONE, None).unwrap();
             assert_eq!(
                 bits(&one_ray),
                 bits(&lanes),
@@ -498,7 +504,7 @@ mod tests {
     fn each_mistake_that_applies_changes_the_image_as_it_should() {
         let scene = scene();
         let settings = settings(4, SamplePattern::Stratified, 4);
-        let right = render_with_mistakes(&scene, &settings, Mistakes::NONE).unwrap();
+        let right = render_with_mistakes(&scene, &settings, Mistakes::NONE, None).unwrap();
         let (right, mut applied) = (right.pixels(), 0);
         for mistake in Mistake::ALL {
             let cube = matches!(
@@ -513,7 +519,7 @@ mod tests {
             }
             applied += 1;
             let one = Mistakes::NONE.with(mistake);
-            let wrong = render_with_mistakes(&scene, &settings, one).unwrap();
+            let wrong = render_with_mistakes(&scene, &settings, one, None).unwrap();
             let changed = (right.iter().zip(wrong.pixels()))
                 .filter(|(a, b)| a != b)
                 .count();
@@ -522,7 +528,7 @@ mod tests {
                 threads: Some(2),
                 ..settings.clone()
             };
-            let again = render_with_mistakes(&scene, &two_threads, one).unwrap();
+            let again = render_with_mistakes(&scene, &two_threads, one, None).unwrap();
             assert_eq!(bits(&again), bits(&wrong), "{mistake:?}");
             let pairs = || right.iter().zip(wrong.pixels());
             match mistake {

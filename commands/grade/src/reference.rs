@@ -530,7 +530,7 @@ impl Job<'_> {
         let mistakes = self.scene.mistakes;
         match mistakes.is_empty() {
             true => glint_integrator::render(self.rendered, settings, &|_, _| {}).map(|o| o.film),
-            false => render_with_mistakes(self.rendered, settings, mistakes),
+            false => render_with_mistakes(self.rendered, settings, mistakes, None),
         }
         .map_err(|e| GradeError::Internal(format!("reference render: {e}")))
     }

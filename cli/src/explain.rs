@@ -5,7 +5,9 @@ use crate::Failure;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::Args;
 use glint_explain::against::{self, Node};
-use glint_explain::{Explanation, Stage};
+use glint_explain::{Explanation, MistakenPixel, Stage};
+use glint_grade::mistakes::{How, Mistake};
+use glint_integrator::mistakes::{pixel_with_mistakes, Mistakes};
 use glint_integrator::trace::SampleSelection;
 use glint_integrator::ExplainError;
 use std::path::{Path, PathBuf};
@@ -52,8 +54,10 @@ pub(crate) struct ExplainArgs {
     against: Option<PathBuf>,
 
     /// Explain the pixel as a ray tracer with this classic mistake renders
-    /// it (an id of glint grade --mistakes that Glint renders as a change to
-    /// the scene), so that the first number that goes wrong shows
+    /// it (an id of glint grade --mistakes): a change to the scene is traced,
+    /// so that the first number that goes wrong shows; for a stage the
+    /// one-ray integrator swaps, the right stages are shown and the pixel as
+    /// the mistake renders it
     #[arg(long, value_name = "ID")]
     mistake: Option<String>,
 }
@@ -86,11 +90,11 @@ fn parse_pixel(text: &str) -> Result<(u32, u32), String> {
 }
 
 pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
-    let description = match &args.mistake {
+    let (description, swapped) = match &args.mistake {
         Some(id) => with_mistake(args, id)?,
-        None => args.scene.load()?,
+        None => (args.scene.load()?, None),
     };
-    let Explained { text, parted } = explained(args, &description)?;
+    let Explained { text, parted } = explained(args, &description, swapped)?;
     print(&text);
     match parted {
         None => Ok(()),
@@ -98,25 +102,36 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
     }
 }
 
-/// The scene of `args` as a tracer with mistake `id` sees it: only a
-/// mistake Glint renders as a change to the scene.
-fn with_mistake(args: &ExplainArgs, id: &str) -> Result<glint_scene::SceneDescription, Failure> {
-    use glint_grade::mistakes::How;
+/// A stage swapped for a wrong one: the mistake, and the swap that renders it.
+type Swapped = (&'static Mistake, Mistakes);
+
+/// The scene of `args` as a tracer with mistake `id` sees it: edited for a
+/// mistake Glint renders as a change to the scene; as it is, with the swap,
+/// for one its one-ray integrator renders (whose stages it does not trace).
+fn with_mistake(
+    args: &ExplainArgs,
+    id: &str,
+) -> Result<(glint_scene::SceneDescription, Option<Swapped>), Failure> {
     let mistake = crate::mistake::find(id)?;
     let why_not = match mistake.how {
-        How::Scene(_) | How::Lights(_) => None,
+        How::Scene(_) | How::Lights(_) | How::Integrator(_) => None,
         How::Film(_) => Some("it changes what the file stores, after every stage of the pixel"),
         How::NoiseOnly => Some("it changes only the noise"),
-        How::Integrator(_) => {
-            Some("Glint renders it in its one-ray integrator, which glint explain does not trace")
-        }
     };
     if let Some(why) = why_not {
         return Err(Failure::Input(format!(
-            "--mistake {id}: {why}; glint explain shows only mistakes Glint renders as a change to the scene (glint grade --mistakes says how each is rendered)"
+            "--mistake {id}: {why}; glint explain shows the mistakes Glint renders in the scene or the integrator (glint grade --mistakes says how each is rendered)"
         )));
     }
-    Ok(crate::mistake::load(&args.scene, mistake)?.description)
+    let against = matches!(mistake.how, How::Integrator(_)) && args.against.is_some();
+    if against {
+        return Err(Failure::Input(format!(
+            "--mistake {id}: a stage the one-ray integrator swaps is not traced, so there is nothing to compare --against; without --against, the pixel's numbers are shown beside it"
+        )));
+    }
+    let mistaken = crate::mistake::load(&args.scene, mistake)?;
+    let swapped = (!mistaken.swaps.is_empty()).then_some((mistake, mistaken.swaps));
+    Ok((mistaken.description, swapped))
 }
 
 /// What `glint explain` prints, and with `--against`, where the student's
@@ -131,13 +146,14 @@ pub(crate) struct Explained {
 pub(crate) fn explained(
     args: &ExplainArgs,
     description: &glint_scene::SceneDescription,
+    swapped: Option<Swapped>,
 ) -> Result<Explained, Failure> {
     let selection = match args.all_samples {
         true => SampleSelection::All,
         false => SampleSelection::One(args.sample),
     };
     let (x, y) = args.pixel;
-    let explanation =
+    let mut explanation =
         glint_explain::explain(&description.scene, &description.settings, x, y, selection)
             .map_err(|e| match e {
                 ExplainError::Outside { .. } => Failure::Input(format!("--pixel: {e}")),
@@ -147,6 +163,17 @@ pub(crate) fn explained(
             })?;
     if let Some(path) = &args.against {
         return compare(&explanation, path, args);
+    }
+    if let Some((mistake, swaps)) = swapped {
+        let (scene, settings) = (&description.scene, &description.settings);
+        let radiance = pixel_with_mistakes(scene, settings, (x, y), swaps)
+            .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
+        let shown = MistakenPixel {
+            id: mistake.id,
+            stage: mistake.stage.name(),
+            description: mistake.description,
+        };
+        explanation.with_mistake(&shown, radiance);
     }
     let text = match args.json {
         true => {

@@ -217,7 +217,9 @@ impl Backend for CliBackend {
         }
         let parsed = ExplainFlags::try_parse_from(argv).map_err(clap_message)?;
         let scene = self.loaded(parsed.explain.scene())?;
-        Ok(explained(&parsed.explain, &scene).map_err(message)?.text)
+        Ok(explained(&parsed.explain, &scene, None)
+            .map_err(message)?
+            .text)
     }
 }
 

@@ -371,22 +371,16 @@ fn a_mistake_outside_the_catalogue_is_not_given_a_name() {
 }
 
 #[test]
-fn explain_shows_a_pixel_with_a_mistake_switched_on() {
+fn explain_shows_a_pixel_with_a_mistake_switched_on_traced_or_beside_the_right_stages() {
     let dir = tempfile::tempdir().unwrap();
     let set1 = scene("cornell-set1");
-    let explain = |extra: &[&str]| {
-        let mut args = vec![
-            "explain",
-            set1.as_str(),
-            "--pixel",
-            "30,60",
-            "--resolution",
-            "64x64",
-        ];
-        args.extend_from_slice(&["--stage", "light"]);
+    let explain_at = |pixel: &str, extra: &[&str]| {
+        let mut args = vec!["explain", set1.as_str(), "--pixel", pixel];
+        args.extend_from_slice(&["--resolution", "64x64", "--stage", "light"]);
         args.extend_from_slice(extra);
         glint(&args, dir.path())
     };
+    let explain = |extra: &[&str]| explain_at("30,60", extra);
     let correct = stdout(&explain(&[]));
     assert!(correct.contains("ambient·kd (0.07"), "{correct}");
     let o = explain(&["--mistake", "no-ambient"]);
@@ -396,12 +390,61 @@ fn explain_shows_a_pixel_with_a_mistake_switched_on() {
         "{}",
         stdout(&o)
     );
+    // A stage the one-ray integrator swaps: the right stages, and the pixel
+    // as the mistake renders it, glint render --mistake's pixel.
+    let o = explain_at("29,58", &["--mistake", "no-shadows", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let document: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let mistake = &document["mistake"];
+    assert_eq!(mistake["id"], "no-shadows");
+    assert_eq!(mistake["stage"], "lighting");
+    let rendered = dir.path().join("no-shadows.pfm");
+    let o = glint(
+        &[
+            "render",
+            &set1,
+            "--resolution",
+            "64x64",
+            "--mistake",
+            "no-shadows",
+            "-o",
+            rendered.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let film = glint_camera::Film::read(&rendered).unwrap().film;
+    let pixel = film.pixels()[58 * 64 + 29];
+    for c in 0..3 {
+        let shown = mistake["radiance"][c].as_f64().unwrap();
+        let want = pixel[c] as f64;
+        assert!((shown - want).abs() <= 1e-4 * want, "{shown} for {want}");
+    }
+    // A pixel in the shadow of a sphere: lit by the mistake.
+    let right = &document["samples"][0]["ray"]["radiance"]["value"];
+    assert!(right[0].as_f64().unwrap() < 0.5 * pixel.x as f64, "{right}");
+    let plain = stdout(&explain_at("29,58", &[]));
+    let text = stdout(&explain_at("29,58", &["--mistake", "no-shadows"]));
+    assert!(
+        text.starts_with(plain.trim_end()),
+        "the right stages first:\n{text}"
+    );
+    assert!(
+        text.contains("with the mistake no-shadows (lighting stage: "),
+        "{text}"
+    );
     for (id, says) in [
         ("no-such-mistake", "glint grade --mistakes lists them"),
         ("no-srgb", "what the file stores"),
-        ("view-sign", "one-ray integrator"),
         ("light-colour-ignored", "changes nothing"),
     ] {
         assert_input_error(&explain(&["--mistake", id]), says);
     }
+    let student = dir.path().join("student.json");
+    std::fs::write(&student, "{}").unwrap();
+    let against = format!("--against={}", student.display());
+    assert_input_error(
+        &explain(&["--mistake", "view-sign", &against]),
+        "nothing to compare --against",
+    );
 }

@@ -216,6 +216,22 @@ pub fn render_with_mistakes(
     Ok(film)
 }
 
+/// Pixel `(x, y)` of [`render_with_mistakes`]'s film, alone.
+pub fn pixel_with_mistakes(
+    scene: &Scene,
+    settings: &RenderSettings,
+    (x, y): (u32, u32),
+    mistakes: Mistakes,
+) -> Result<Vec3, SettingsError> {
+    settings.validate()?;
+    scene.prepare(settings);
+    let integrator = DirectIntegrator::new(settings);
+    let mut ctx = SampleContext::new(settings.light_samples, settings.environment_samples);
+    ctx.mistakes = mistakes;
+    let mut positions = vec![Vec2::ZERO; settings.spp as usize];
+    Ok(integrator.mistaken_pixel(scene, settings, (x, y), &mut positions, &mut ctx))
+}
+
 /// The most a mistaken sample's radiance counts for. A mistake can overflow
 /// `f32` (an unnormalised normal of radius `r` raises `r²` to the
 /// shininess): where the render leaves an infinite sample out, a tracer in
@@ -520,6 +536,8 @@ mod tests {
             applied += 1;
             let one = Mistakes::NONE.with(mistake);
             let wrong = render_with_mistakes(&scene, &settings, one, None).unwrap();
+            let alone = pixel_with_mistakes(&scene, &settings, (5, 17), one).unwrap();
+            assert_eq!(alone, wrong.pixels()[17 * 24 + 5], "{mistake:?}");
             let changed = (right.iter().zip(wrong.pixels()))
                 .filter(|(a, b)| a != b)
                 .count();

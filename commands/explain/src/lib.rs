@@ -112,6 +112,30 @@ impl Explanation {
     pub fn text(&self, stage: Option<Stage>) -> String {
         text::render(&self.json(stage))
     }
+
+    /// The document with the pixel as a tracer with a mistake in one stage
+    /// renders it (`radiance`, by the one-ray integrator with the stage
+    /// swapped): under `mistake`, beside the right stages' numbers, which
+    /// it does not trace.
+    pub fn with_mistake(&mut self, mistake: &MistakenPixel, radiance: Vec3) {
+        let srgb: Vec<u8> = (radiance.to_array().iter())
+            .map(|&c| glint_camera::linear_to_srgb8(c))
+            .collect();
+        self.document["mistake"] = json!({
+            "id": mistake.id,
+            "stage": mistake.stage,
+            "description": mistake.description,
+            "radiance": v3(radiance),
+            "srgb8": srgb,
+        });
+    }
+}
+
+/// A classic mistake in one stage, as [`Explanation::with_mistake`] shows it.
+pub struct MistakenPixel<'a> {
+    pub id: &'a str,
+    pub stage: &'a str,
+    pub description: &'a str,
 }
 
 /// Pixel `(x, y)` of `scene` under `settings`, the samples `selection` names.

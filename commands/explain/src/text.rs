@@ -71,6 +71,25 @@ pub(crate) fn render(doc: &Value) -> String {
         )
         .unwrap();
     }
+    let mistake = &doc["mistake"];
+    if !mistake.is_null() {
+        let id = mistake["id"].as_str().unwrap_or_default();
+        let stage = mistake["stage"].as_str().unwrap_or_default();
+        let what = mistake["description"].as_str().unwrap_or_default();
+        writeln!(
+            out,
+            "
+with the mistake {id} ({stage} stage: {what})"
+        )
+        .unwrap();
+        writeln!(out, "  pixel radiance {}", f(&mistake["radiance"])).unwrap();
+        writeln!(out, "  sRGB 8-bit {}", f(&mistake["srgb8"])).unwrap();
+        writeln!(
+            out,
+            "  (the stages above are right; from the {stage} stage on, a tracer with it parts from them)"
+        )
+        .unwrap();
+    }
     out
 }
 

@@ -31,6 +31,7 @@ use crate::{Cache, GradeError, References, StatedSettings, Submission};
 use glam::Vec3;
 use glint_camera::SampleEncoding;
 use glint_integrator::mistakes::{Mistake as Swap, Mistakes};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::path::Path;
 
@@ -355,21 +356,25 @@ pub fn diagnose(
     };
     let lights = lights_by_object(&against.scene.description.scene);
     let mutants = &against.mutants.mutants;
+    // Each test is independent of the others: in parallel, in order.
     let singles: Vec<(usize, Bands)> = (0..mutants.len())
+        .into_par_iter()
         .filter_map(|i| Some((i, bands(&mutants[i], &correct, refs, &lights, submission)?)))
         .collect();
     let mut found: Vec<LikelyMistake> = singles
-        .iter()
+        .par_iter()
         .map(|(i, b)| judged(&[mutants[*i].mistake], b, test))
         .collect();
     if !found.iter().any(|f| f.consistent) {
         let flip = find("flip-vertical").expect("in the catalogue");
-        for (i, b) in &singles {
-            if mutants[*i].mistake.id != flip.id {
+        let upside_down: Vec<LikelyMistake> = (singles.par_iter())
+            .filter(|(i, _)| mutants[*i].mistake.id != flip.id)
+            .map(|(i, b)| {
                 let flipped = flipped(b, size.x, size.y);
-                found.push(judged(&[mutants[*i].mistake, flip], &flipped, test));
-            }
-        }
+                judged(&[mutants[*i].mistake, flip], &flipped, test)
+            })
+            .collect();
+        found.extend(upside_down);
     }
     let mut best: Vec<(usize, f64)> = (singles.iter().zip(&found))
         .filter(|((i, _), _)| !matches!(mutants[*i].render, MutantRender::Flip))
@@ -394,15 +399,13 @@ pub fn diagnose(
         };
         let large = size.x * size.y > ALL_SLOW_PAIRS;
         let slow = |i: usize| large && mutants[i].mistake.how.swap().is_some();
-        for (a, b) in pairs(&best, slow) {
-            if let Some(bands) = pair.bands(a, b)? {
-                found.push(judged(
-                    &[mutants[a].mistake, mutants[b].mistake],
-                    &bands,
-                    test,
-                ));
-            }
-        }
+        let tried: Vec<Option<LikelyMistake>> = (pairs(&best, slow).into_par_iter())
+            .map(|(a, b)| {
+                let both = [mutants[a].mistake, mutants[b].mistake];
+                Ok(pair.bands(a, b)?.map(|bands| judged(&both, &bands, test)))
+            })
+            .collect::<Result<_, GradeError>>()?;
+        found.extend(tried.into_iter().flatten());
     }
     found.sort_by(|a, b| {
         b.consistent

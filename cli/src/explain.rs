@@ -6,7 +6,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::Args;
 use glint_explain::against::{self, Node};
 use glint_explain::{Explanation, MistakenPixel, Stage};
-use glint_grade::mistakes::{How, Mistake};
+use glint_grade::mistakes::{FilmMistake, How, Mistake};
 use glint_integrator::mistakes::{pixel_with_mistakes, Mistakes};
 use glint_integrator::trace::SampleSelection;
 use glint_integrator::ExplainError;
@@ -56,8 +56,8 @@ pub(crate) struct ExplainArgs {
     /// Explain the pixel as a ray tracer with this classic mistake renders
     /// it (an id of glint grade --mistakes): a change to the scene is traced,
     /// so that the first number that goes wrong shows; for a stage the
-    /// one-ray integrator swaps, the right stages are shown and the pixel as
-    /// the mistake renders it
+    /// one-ray integrator swaps or a mistake in the file, the right stages
+    /// are shown, then the pixel as the mistake writes it
     #[arg(long, value_name = "ID")]
     mistake: Option<String>,
 }
@@ -90,11 +90,11 @@ fn parse_pixel(text: &str) -> Result<(u32, u32), String> {
 }
 
 pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
-    let (description, swapped) = match &args.mistake {
+    let (description, untraced) = match &args.mistake {
         Some(id) => with_mistake(args, id)?,
         None => (args.scene.load()?, None),
     };
-    let Explained { text, parted } = explained(args, &description, swapped)?;
+    let Explained { text, parted } = explained(args, &description, untraced)?;
     print(&text);
     match parted {
         None => Ok(()),
@@ -102,36 +102,57 @@ pub(crate) fn explain(args: &ExplainArgs) -> Result<(), Failure> {
     }
 }
 
-/// A stage swapped for a wrong one: the mistake, and the swap that renders it.
-type Swapped = (&'static Mistake, Mistakes);
+/// A mistake the trace does not follow, shown after the right stages: a
+/// stage the one-ray integrator swaps, or what the file stores.
+#[derive(Clone, Copy)]
+pub(crate) struct Untraced {
+    mistake: &'static Mistake,
+    swaps: Mistakes,
+    film: Option<FilmMistake>,
+}
+
+impl Untraced {
+    /// The radiance the file holds at `(x, y)` for a tracer with the
+    /// mistake: the swapped render's pixel; for a mistake in the file, the
+    /// right `radiance` as the file reads back (rows flipped: another pixel's).
+    fn radiance(
+        &self,
+        description: &glint_scene::SceneDescription,
+        (x, y): (u32, u32),
+        radiance: glam::Vec3,
+    ) -> Result<glam::Vec3, Failure> {
+        let (scene, settings) = (&description.scene, &description.settings);
+        let from = match self.film {
+            Some(FilmMistake::FlipVertical) => (x, scene.camera.resolution().y - 1 - y),
+            Some(film) => return Ok(radiance.to_array().map(|c| film.decoded(c)).into()),
+            None => (x, y),
+        };
+        pixel_with_mistakes(scene, settings, from, self.swaps)
+            .map_err(|e| Failure::Input(format!("render settings: {e}")))
+    }
+}
 
 /// The scene of `args` as a tracer with mistake `id` sees it: edited for a
-/// mistake Glint renders as a change to the scene; as it is, with the swap,
-/// for one its one-ray integrator renders (whose stages it does not trace).
+/// mistake Glint renders as a change to the scene; as it is, with what the
+/// trace does not follow, for the others.
 fn with_mistake(
     args: &ExplainArgs,
     id: &str,
-) -> Result<(glint_scene::SceneDescription, Option<Swapped>), Failure> {
+) -> Result<(glint_scene::SceneDescription, Option<Untraced>), Failure> {
     let mistake = crate::mistake::find(id)?;
-    let why_not = match mistake.how {
-        How::Scene(_) | How::Lights(_) | How::Integrator(_) => None,
-        How::Film(_) => Some("it changes what the file stores, after every stage of the pixel"),
-        How::NoiseOnly => Some("it changes only the noise"),
-    };
-    if let Some(why) = why_not {
+    let untraced = matches!(mistake.how, How::Integrator(_) | How::Film(_));
+    if untraced && args.against.is_some() {
         return Err(Failure::Input(format!(
-            "--mistake {id}: {why}; glint explain shows the mistakes Glint renders in the scene or the integrator (glint grade --mistakes says how each is rendered)"
-        )));
-    }
-    let against = matches!(mistake.how, How::Integrator(_)) && args.against.is_some();
-    if against {
-        return Err(Failure::Input(format!(
-            "--mistake {id}: a stage the one-ray integrator swaps is not traced, so there is nothing to compare --against; without --against, the pixel's numbers are shown beside it"
+            "--mistake {id}: the trace does not follow it (glint grade --mistakes says how it is rendered), so there is nothing to compare --against; without --against, the pixel with it is shown after the right stages"
         )));
     }
     let mistaken = crate::mistake::load(&args.scene, mistake)?;
-    let swapped = (!mistaken.swaps.is_empty()).then_some((mistake, mistaken.swaps));
-    Ok((mistaken.description, swapped))
+    let untraced = untraced.then_some(Untraced {
+        mistake,
+        swaps: mistaken.swaps,
+        film: mistaken.film,
+    });
+    Ok((mistaken.description, untraced))
 }
 
 /// What `glint explain` prints, and with `--against`, where the student's
@@ -146,7 +167,7 @@ pub(crate) struct Explained {
 pub(crate) fn explained(
     args: &ExplainArgs,
     description: &glint_scene::SceneDescription,
-    swapped: Option<Swapped>,
+    untraced: Option<Untraced>,
 ) -> Result<Explained, Failure> {
     let selection = match args.all_samples {
         true => SampleSelection::All,
@@ -164,10 +185,9 @@ pub(crate) fn explained(
     if let Some(path) = &args.against {
         return compare(&explanation, path, args);
     }
-    if let Some((mistake, swaps)) = swapped {
-        let (scene, settings) = (&description.scene, &description.settings);
-        let radiance = pixel_with_mistakes(scene, settings, (x, y), swaps)
-            .map_err(|e| Failure::Input(format!("render settings: {e}")))?;
+    if let Some(untraced) = untraced {
+        let radiance = untraced.radiance(description, (x, y), explanation.radiance)?;
+        let mistake = untraced.mistake;
         let shown = MistakenPixel {
             id: mistake.id,
             stage: mistake.stage.name(),

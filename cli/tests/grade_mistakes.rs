@@ -433,9 +433,34 @@ fn explain_shows_a_pixel_with_a_mistake_switched_on_traced_or_beside_the_right_s
         text.contains("with the mistake no-shadows (lighting stage: "),
         "{text}"
     );
+    // What the file stores: the right pixel written without the sRGB
+    // curve; rows upside down, the mirrored pixel's.
+    let film = |pixel: &str, extra: &[&str]| {
+        let mut args = vec!["explain", set1.as_str(), "--pixel", pixel];
+        args.extend_from_slice(&["--resolution", "64x64", "--stage", "film", "--json"]);
+        args.extend_from_slice(extra);
+        let o = glint(&args, dir.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_str::<serde_json::Value>(&stdout(&o)).unwrap()
+    };
+    let right = film("29,58", &[]);
+    let linear = film("29,58", &["--mistake", "no-srgb"]);
+    let codes = |v: &serde_json::Value| v["srgb8"].as_array().unwrap().clone();
+    let radiance = right["film"]["radiance"][0].as_f64().unwrap();
+    let written = (radiance.clamp(0.0, 1.0) * 255.0).round();
+    assert_eq!(
+        codes(&linear["mistake"])[0].as_f64(),
+        Some(written),
+        "{linear}"
+    );
+    let flipped = film("29,58", &["--mistake", "flip-vertical"]);
+    assert_eq!(
+        codes(&flipped["mistake"]),
+        codes(&film("29,5", &[])["film"])
+    );
     for (id, says) in [
         ("no-such-mistake", "glint grade --mistakes lists them"),
-        ("no-srgb", "what the file stores"),
+        ("fixed-light-samples", "only the noise"),
         ("light-colour-ignored", "changes nothing"),
     ] {
         assert_input_error(&explain(&["--mistake", id]), says);
@@ -445,6 +470,10 @@ fn explain_shows_a_pixel_with_a_mistake_switched_on_traced_or_beside_the_right_s
     let against = format!("--against={}", student.display());
     assert_input_error(
         &explain(&["--mistake", "view-sign", &against]),
+        "nothing to compare --against",
+    );
+    assert_input_error(
+        &explain(&["--mistake", "no-srgb", &against]),
         "nothing to compare --against",
     );
 }

@@ -82,8 +82,18 @@ pub(crate) fn render(doc: &Value) -> String {
 with the mistake {id} ({stage} stage: {what})"
         )
         .unwrap();
-        writeln!(out, "  pixel radiance {}", f(&mistake["radiance"])).unwrap();
-        writeln!(out, "  sRGB 8-bit {}", f(&mistake["srgb8"])).unwrap();
+        let radiance = f(&mistake["radiance"]);
+        writeln!(
+            out,
+            "  pixel radiance {radiance} (linear; as its file reads back)"
+        )
+        .unwrap();
+        writeln!(
+            out,
+            "  sRGB 8-bit {} (as written to a PNG)",
+            f(&mistake["srgb8"])
+        )
+        .unwrap();
         writeln!(
             out,
             "  (the stages above are right; from the {stage} stage on, a tracer with it parts from them)"

@@ -78,7 +78,7 @@ def main():
     ap.add_argument("--res", type=int, default=128)
     ap.add_argument("--scenes", default=",".join(SCENES))
     args = ap.parse_args()
-    out = Path(args.out)
+    out = Path(args.out).resolve()  # the manifest names files by absolute paths
     (out / "images").mkdir(parents=True, exist_ok=True)
     mistakes = catalogue(args.glint)
     rows, seed = [], 700000

@@ -171,7 +171,7 @@ def main():
     ap.add_argument("--only", action="append", default=[], metavar="NAME",
                     help="only this mistake of the tracer's, alone (repeatable): a quick look, not the table")
     args = ap.parse_args()
-    out = Path(args.out)
+    out = Path(args.out).resolve()  # the manifest names files by absolute paths
     out.mkdir(parents=True, exist_ok=True)
     corpus = Corpus(out, args.glint, sys.executable)
     start = time.time()

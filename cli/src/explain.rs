@@ -124,7 +124,7 @@ impl Untraced {
         let (scene, settings) = (&description.scene, &description.settings);
         let from = match self.film {
             Some(FilmMistake::FlipVertical) => (x, scene.camera.resolution().y - 1 - y),
-            Some(film) => return Ok(radiance.to_array().map(|c| film.decoded(c)).into()),
+            Some(film) => return Ok(film.decoded_rgb(radiance)),
             None => (x, y),
         };
         pixel_with_mistakes(scene, settings, from, self.swaps)

@@ -482,7 +482,7 @@ fn with_film_mistake(mut film: Film, mistake: FilmMistake) -> Film {
         }
         FilmMistake::NoSrgb | FilmMistake::Gamma22 => {
             for p in pixels.iter_mut() {
-                *p = glam::Vec3::from_array(p.to_array().map(|c| mistake.decoded(c)));
+                *p = mistake.decoded_rgb(*p);
             }
         }
     }

@@ -196,9 +196,7 @@ pub fn render_with_mistakes(
             if stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
                 return;
             }
-            let mut ctx = SampleContext::new(settings.light_samples, settings.environment_samples);
-            ctx.mistakes = mistakes;
-            let mut positions = vec![Vec2::ZERO; settings.spp as usize];
+            let (mut ctx, mut positions) = mistaken_context(settings, mistakes);
             for (x, pixel) in row.iter_mut().enumerate() {
                 let at = (x as u32, y as u32);
                 *pixel = integrator.mistaken_pixel(scene, settings, at, &mut positions, &mut ctx);
@@ -226,10 +224,16 @@ pub fn pixel_with_mistakes(
     settings.validate()?;
     scene.prepare(settings);
     let integrator = DirectIntegrator::new(settings);
+    let (mut ctx, mut positions) = mistaken_context(settings, mistakes);
+    Ok(integrator.mistaken_pixel(scene, settings, (x, y), &mut positions, &mut ctx))
+}
+
+/// A sample context with `mistakes` on, and room for a pixel's sample
+/// positions: what [`DirectIntegrator::mistaken_pixel`] reuses pixel to pixel.
+fn mistaken_context(settings: &RenderSettings, mistakes: Mistakes) -> (SampleContext, Vec<Vec2>) {
     let mut ctx = SampleContext::new(settings.light_samples, settings.environment_samples);
     ctx.mistakes = mistakes;
-    let mut positions = vec![Vec2::ZERO; settings.spp as usize];
-    Ok(integrator.mistaken_pixel(scene, settings, (x, y), &mut positions, &mut ctx))
+    (ctx, vec![Vec2::ZERO; settings.spp as usize])
 }
 
 /// The most a mistaken sample's radiance counts for. A mistake can overflow

@@ -76,12 +76,7 @@ pub(crate) fn render(doc: &Value) -> String {
         let id = mistake["id"].as_str().unwrap_or_default();
         let stage = mistake["stage"].as_str().unwrap_or_default();
         let what = mistake["description"].as_str().unwrap_or_default();
-        writeln!(
-            out,
-            "
-with the mistake {id} ({stage} stage: {what})"
-        )
-        .unwrap();
+        writeln!(out, "\nwith the mistake {id} ({stage} stage: {what})").unwrap();
         let radiance = f(&mistake["radiance"]);
         writeln!(
             out,

@@ -416,18 +416,21 @@ fn diagnose_failures(
             &options.cache,
             &rendering,
         )?;
-        let submissions: Vec<Option<Submission>> = failing
-            .par_iter()
-            .map(|&i| Submission::load(Path::new(&rows[i].file)).ok())
-            .map(|s| s.filter(|s| s.resolution() == group.references.resolution))
+        // A failing submission, if it can be diagnosed: read where needed,
+        // not kept (a class's failing images may not fit in memory at once).
+        let load = |i: usize| {
+            Submission::load(Path::new(&rows[i].file))
+                .ok()
+                .filter(|s| s.resolution() == group.references.resolution)
+        };
+        let jpegs: Vec<JpegEncoding> = (failing.par_iter())
+            .filter_map(|&i| load(i)?.jpeg?.ok())
             .collect();
-        let mut encodings = Vec::new();
-        for s in submissions.iter().flatten() {
-            if let Some(Ok(encoding)) = &s.jpeg {
-                if !encodings.contains(encoding) {
-                    mutants.through_jpeg(encoding, &options.cache, &rendering)?;
-                    encodings.push(encoding.clone());
-                }
+        let mut encodings: Vec<&JpegEncoding> = Vec::new();
+        for encoding in &jpegs {
+            if !encodings.contains(&encoding) {
+                mutants.through_jpeg(encoding, &options.cache, &rendering)?;
+                encodings.push(encoding);
             }
         }
         let against = mistakes::Against {
@@ -439,12 +442,11 @@ fn diagnose_failures(
             progress: &rendering,
         };
         let found: Vec<Vec<mistakes::LikelyMistake>> = (failing.par_iter())
-            .zip(&submissions)
-            .map(|(&i, s)| match s {
+            .map(|&i| match load(i) {
                 Some(s) => {
-                    let found = mistakes::diagnose(&against, s, &options.test)?;
+                    let found = mistakes::diagnose(&against, &s, &options.test)?;
                     if let Some(best) = found.first().filter(|m| m.consistent) {
-                        if let Some(image) = mistakes::fit_image(&against, s, &best.id)? {
+                        if let Some(image) = mistakes::fit_image(&against, &s, &best.id)? {
                             on_diagnosed(i, &image, s.resolution())?;
                         }
                     }

@@ -129,6 +129,11 @@ impl FilmMistake {
             FilmMistake::Gamma22 => glint_camera::srgb_to_linear(c.powf(1.0 / 2.2)),
         }
     }
+
+    /// [`Self::decoded`] of each channel of `linear`.
+    pub fn decoded_rgb(self, linear: glam::Vec3) -> glam::Vec3 {
+        linear.to_array().map(|c| self.decoded(c)).into()
+    }
 }
 
 const fn mistake(id: &'static str, stage: Stage, how: How, description: &'static str) -> Mistake {

@@ -282,7 +282,7 @@ fn through_film(
     progress: &(dyn Fn(&str) + Sync),
 ) -> Result<Estimate, GradeError> {
     let tag = format!(" with {id}");
-    let f = move |p: Vec3| Vec3::from_array(p.to_array().map(|c| film.decoded(c)));
+    let f = move |p: Vec3| film.decoded_rgb(p);
     samples_through(scene, refs, &tag, &f, cache, progress)
 }
 
@@ -674,7 +674,7 @@ pub(crate) fn scaled_per_object(
 /// sample reference's rounds through it) and `f(M)`, as a clamped file's
 /// lie between `M − G` and `min(M, 1)`.
 fn through_encoding(mistake: FilmMistake, samples: &Estimate, refs: &References) -> Bands {
-    let f = |p: Vec3| Vec3::from_array(p.to_array().map(|c| mistake.decoded(c)));
+    let f = |p: Vec3| mistake.decoded_rgb(p);
     let (a, m) = (&samples.mean, &refs.mean);
     let b: Vec<Vec3> = m.mean.iter().map(|&p| f(p)).collect();
     // The mean reference's variance through the curve: times its slope².
